@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# Installs every Debian package pathlab needs to build and test.
+# Usage: scripts/install-deps.sh [--browser]   (--browser adds Chromium for the report's browser test)
+set -euo pipefail
+
+packages=(
+  build-essential cmake pkg-config
+  libembree-dev libtbb-dev libopenexr-dev libstb-dev
+  libcli11-dev libfmt-dev nlohmann-json3-dev libpugixml-dev libtinyobjloader-dev
+  libgtest-dev libbenchmark-dev
+)
+if [[ "${1:-}" == "--browser" ]]; then
+  packages+=(chromium)
+fi
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]} == 0)); then
+  echo "install-deps: all packages present"
+  exit 0
+fi
+
+SUDO=""
+if [[ $(id -u) -ne 0 ]]; then SUDO="sudo"; fi
+echo "install-deps: installing ${missing[*]}"
+$SUDO apt-get update -qq
+DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"

@@ -1,0 +1,85 @@
+#include "app/cli.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <fmt/format.h>
+
+#include "app/render_command.hpp"
+#include "app/usage_error.hpp"
+#include "render/estimator.hpp"
+#include "scene/builtin_scenes.hpp"
+
+namespace pathlab {
+namespace {
+
+// Every long option of `app` (and its subcommands' names), for "unknown option" messages.
+std::string valid_options(const CLI::App& app) {
+    std::vector<std::string> names;
+    for (const CLI::Option* o : app.get_options()) {
+        std::string n = o->get_name(false, true);
+        if (!n.empty()) names.push_back(n);
+    }
+    for (const CLI::App* sub : app.get_subcommands({})) names.push_back(sub->get_name());
+    return fmt::format("{}", fmt::join(names, ", "));
+}
+
+void print_scenes() {
+    for (const BuiltinSceneInfo& s : builtin_scenes()) fmt::print("{}  {:<16} {}\n", s.index, s.name, s.summary);
+}
+
+void print_algorithms() {
+    for (const EstimatorInfo& e : estimators()) {
+        const std::string alias = e.aliases.empty() ? "" : fmt::format("({})", fmt::join(e.aliases, "/"));
+        fmt::print("{:<14} {:<5} {}\n", e.name, alias, e.summary);
+    }
+}
+
+}  // namespace
+
+int run_cli(int argc, const char* const* argv) {
+    CLI::App app{"pathlab: a physically based Monte Carlo renderer and light-transport laboratory.\n"
+                 "Renders the 8 NPGR010 Cornell-box scenes (or a scene file) with a chosen estimator."};
+    app.set_version_flag("--version", PATHLAB_VERSION);
+    app.require_subcommand(0, 1);
+
+    RenderCommandOptions render_opt;
+    add_render_options(app, render_opt);
+    CLI::App* scenes_cmd = app.add_subcommand("scenes", "List the built-in scenes, one per line");
+    CLI::App* algorithms_cmd = app.add_subcommand("algorithms", "List the estimators (--algorithm values)");
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForAllHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::Success& e) {
+        return app.exit(e);
+    } catch (const CLI::ExtrasError& e) {
+        fmt::print(stderr, "pathlab: {}\nValid options: {}\n(see pathlab --help)\n", e.what(), valid_options(app));
+        return 2;
+    } catch (const CLI::ParseError& e) {
+        fmt::print(stderr, "pathlab: {}\n(see pathlab --help)\n", e.what());
+        return 2;
+    }
+
+    try {
+        if (*scenes_cmd) {
+            print_scenes();
+            return 0;
+        }
+        if (*algorithms_cmd) {
+            print_algorithms();
+            return 0;
+        }
+        return run_render_command(render_opt);
+    } catch (const UsageError& e) {
+        fmt::print(stderr, "pathlab: {}\n", e.what());
+        return 2;
+    } catch (const std::exception& e) {
+        fmt::print(stderr, "pathlab: error: {}\n", e.what());
+        return 1;
+    }
+}
+
+}  // namespace pathlab

@@ -1,0 +1,199 @@
+#include "app/render_command.hpp"
+
+#include <tbb/global_control.h>
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+#include <fmt/format.h>
+
+#include "app/interrupt.hpp"
+#include "app/usage_error.hpp"
+#include "core/image_io.hpp"
+#include "render/renderer.hpp"
+#include "scene/builtin_scenes.hpp"
+
+namespace pathlab {
+namespace {
+
+constexpr int kDefaultSpp = 64;
+const char* const kDefaultOutputs[] = {"out/{index}-{scene}-{algorithm}.exr", "out/{index}-{scene}-{algorithm}.png"};
+
+struct SceneJob {
+    std::string name;   // for {scene}
+    std::string index;  // for {index}: the course index, or empty for scene files
+    SceneDescription desc;
+};
+
+std::string scene_list() {
+    std::string out;
+    for (const BuiltinSceneInfo& s : builtin_scenes()) out += fmt::format("\n  {} {}", s.index, s.name);
+    return out;
+}
+
+std::vector<SceneJob> resolve_scenes(const std::string& spec) {
+    std::vector<SceneJob> jobs;
+    const auto add_builtin = [&](int i) {
+        jobs.push_back({builtin_scenes()[size_t(i)].name, std::to_string(i), make_builtin_scene(i)});
+    };
+    if (spec == "all") {
+        for (const BuiltinSceneInfo& s : builtin_scenes()) add_builtin(s.index);
+        return jobs;
+    }
+    size_t start = 0;
+    while (start <= spec.size()) {
+        const size_t comma = std::min(spec.find(',', start), spec.size());
+        const std::string key = spec.substr(start, comma - start);
+        const auto index = find_builtin_scene(key);
+        if (!index)
+            throw UsageError(fmt::format("unknown scene '{}'. Valid scenes (index or name, comma-separated, or 'all'):{}",
+                                         key, scene_list()));
+        add_builtin(*index);
+        start = comma + 1;
+    }
+    return jobs;
+}
+
+std::string expand_output(const std::string& pattern, const SceneJob& job, const std::string& algorithm) {
+    return fmt::format(fmt::runtime(pattern), fmt::arg("scene", job.name), fmt::arg("index", job.index),
+                       fmt::arg("algorithm", algorithm));
+}
+
+void write_stats(const std::string& path, const SceneJob& job, const std::string& algorithm, const RenderSettings& rs,
+                 const RenderResult& r, const std::vector<std::string>& outputs, int threads) {
+    const RenderStats& s = r.stats;
+    nlohmann::json j = {
+        {"pathlab_version", PATHLAB_VERSION},
+        {"scene", job.name},
+        {"algorithm", algorithm},
+        {"resolution", {r.film.width(), r.film.height()}},
+        {"spp", s.spp},
+        {"seed", rs.seed},
+        {"threads", threads},
+        {"seconds", s.seconds},
+        {"samples", s.samples},
+        {"samples_per_second", s.seconds > 0 ? double(s.samples) / s.seconds : 0.0},
+        {"rays", s.rays},
+        {"rays_per_second", s.seconds > 0 ? double(s.rays) / s.seconds : 0.0},
+        {"invalid_samples", s.invalid_samples},
+        {"interrupted", s.interrupted},
+        {"outputs", outputs},
+    };
+    write_text_file(path, j.dump(2) + "\n");
+}
+
+}  // namespace
+
+bool parse_resolution(const std::string& text, int& width, int& height) {
+    char x = 0;
+    char rest = 0;
+    if (std::sscanf(text.c_str(), "%d%c%d%c", &width, &x, &height, &rest) != 3 || (x != 'x' && x != 'X')) return false;
+    return width > 0 && height > 0 && width <= 1 << 15 && height <= 1 << 15;
+}
+
+void add_render_options(CLI::App& app, RenderCommandOptions& o) {
+    app.add_option("-s,--scene", o.scene, "Scene: course index 0-7, name (see `pathlab scenes`), a comma-separated list, or 'all'")
+        ->capture_default_str();
+    app.add_option("-a,--algorithm", o.algorithm, "Estimator name or course alias (see `pathlab algorithms`)")
+        ->capture_default_str();
+    app.add_option_function<int>("--spp", [&o](const int& v) { o.spp = v, o.spp_given = true; },
+                                 fmt::format("Samples per pixel (default {}, or unlimited with --time)", kDefaultSpp));
+    app.add_option("--time", o.time_limit, "Time budget in seconds per scene (stops at --spp if that comes first)");
+    app.add_option("--resolution", o.resolution, "Image size WxH (default: the scene's, 512x512 for the course)");
+    app.add_option("--seed", o.seed, "Random seed; the image is a pure function of it")->capture_default_str();
+    app.add_option("--threads", o.threads, "Worker threads (default: all cores)");
+    app.add_option("-o,--output", o.outputs,
+                   "Output file, repeatable; format by extension: .exr .hdr .pfm .png. Placeholders {scene} {index} "
+                   "{algorithm}. Default: out/{index}-{scene}-{algorithm}.exr and .png");
+    app.add_option("--exposure", o.exposure, "Exposure in stops for .png output")->capture_default_str();
+    app.add_option("--stats", o.stats_path, "Write render statistics as JSON (placeholders as for -o)");
+    app.add_option("--max-depth", o.max_depth, "Longest path in bounces (-1: unlimited)")->capture_default_str();
+    app.add_option("--rr-depth", o.rr_depth, "Bounces before Russian roulette starts")->capture_default_str();
+    app.add_flag("-q,--quiet", o.quiet, "No progress line and no summary");
+}
+
+int run_render_command(const RenderCommandOptions& o) {
+    const EstimatorInfo* est_info = find_estimator(o.algorithm);
+    if (!est_info) throw UsageError(fmt::format("unknown algorithm '{}'. Valid algorithms: {}", o.algorithm, estimator_names()));
+    std::vector<SceneJob> jobs = resolve_scenes(o.scene);
+
+    int width = 0, height = 0;
+    if (!o.resolution.empty() && !parse_resolution(o.resolution, width, height))
+        throw UsageError(fmt::format("invalid --resolution '{}': expected WxH with positive integers, e.g. 512x512", o.resolution));
+    if (o.spp_given && o.spp <= 0) throw UsageError(fmt::format("--spp must be a positive number of samples, got {}", o.spp));
+    if (o.time_limit < 0 || !std::isfinite(o.time_limit)) throw UsageError("--time must be a positive number of seconds");
+    if (o.threads < 0) throw UsageError("--threads must be positive");
+    if (o.rr_depth < 0) throw UsageError("--rr-depth must be zero or positive");
+    if (o.max_depth < -1 || o.max_depth == 0) throw UsageError("--max-depth must be positive, or -1 for unlimited");
+
+    std::vector<std::string> patterns(o.outputs.begin(), o.outputs.end());
+    if (patterns.empty()) patterns.assign(std::begin(kDefaultOutputs), std::end(kDefaultOutputs));
+    // Check every output before the first render starts.
+    std::vector<std::vector<std::string>> outputs(jobs.size());
+    for (size_t j = 0; j < jobs.size(); ++j) {
+        for (const std::string& p : patterns) {
+            std::string path;
+            try {
+                path = expand_output(p, jobs[j], est_info->name);
+            } catch (const fmt::format_error& e) {
+                throw UsageError(fmt::format("invalid output pattern '{}': {} (placeholders: {{scene}}, {{index}}, {{algorithm}})", p, e.what()));
+            }
+            try {
+                check_writable_image_path(path);
+            } catch (const ImageIoError& e) {
+                throw UsageError(e.what());
+            }
+            outputs[j].push_back(path);
+        }
+        for (size_t k = 0; k < j; ++k)
+            for (const std::string& path : outputs[j])
+                if (std::find(outputs[k].begin(), outputs[k].end(), path) != outputs[k].end())
+                    throw UsageError(fmt::format("scenes {} and {} would both write {}: add {{scene}} or {{index}} to -o",
+                                                 jobs[k].name, jobs[j].name, path));
+    }
+
+    std::optional<tbb::global_control> thread_limit;
+    if (o.threads > 0) thread_limit.emplace(tbb::global_control::max_allowed_parallelism, size_t(o.threads));
+    const int threads = int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+
+    EstimatorOptions est_opt;
+    est_opt.max_depth = o.max_depth;
+    est_opt.rr_depth = o.rr_depth;
+    const std::unique_ptr<Estimator> estimator = est_info->make(est_opt);
+    const bool show_progress = !o.quiet && isatty(STDERR_FILENO);
+
+    InterruptGuard interrupt;
+    for (size_t j = 0; j < jobs.size(); ++j) {
+        const SceneJob& job = jobs[j];
+        const std::unique_ptr<Scene> scene = Scene::build(job.desc);
+        RenderSettings rs;
+        rs.width = width;
+        rs.height = height;
+        rs.spp = o.spp_given ? o.spp : (o.time_limit > 0 ? 0 : kDefaultSpp);
+        rs.time_limit = o.time_limit;
+        rs.seed = o.seed;
+        rs.progress = show_progress;
+        rs.cancel = &InterruptGuard::flag();
+        if (show_progress) fmt::print(stderr, "{} / {}\n", job.name, est_info->name);
+        const RenderResult result = render(*scene, *estimator, rs);
+
+        const Image image = result.film.mean();
+        for (const std::string& path : outputs[j]) write_image(image, path, o.exposure);
+        if (!o.stats_path.empty())
+            write_stats(expand_output(o.stats_path, job, est_info->name), job, est_info->name, rs, result, outputs[j], threads);
+        const RenderStats& s = result.stats;
+        if (!o.quiet)
+            fmt::print(stderr, "{}: {} spp in {:.2f}s ({:.2f} Msamples/s, {:.2f} Mrays/s){} -> {}\n", job.name, s.spp,
+                       s.seconds, s.seconds > 0 ? s.samples / s.seconds * 1e-6 : 0.0,
+                       s.seconds > 0 ? s.rays / s.seconds * 1e-6 : 0.0,
+                       s.invalid_samples ? fmt::format(", {} NaN/Inf samples discarded", s.invalid_samples) : "",
+                       fmt::join(outputs[j], ", "));
+        if (s.interrupted) {
+            if (j + 1 < jobs.size()) fmt::print(stderr, "pathlab: interrupted; {} scene(s) not rendered\n", jobs.size() - j - 1);
+            return 130;
+        }
+    }
+    return 0;
+}
+
+}  // namespace pathlab

@@ -1,0 +1,35 @@
+// `pathlab [options]`: render built-in scenes (or scene files) with a chosen estimator.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <string>
+#include <vector>
+
+namespace pathlab {
+
+struct RenderCommandOptions {
+    std::string scene = "all";
+    std::string algorithm = "direct-light";
+    int spp = 0;
+    bool spp_given = false;  // otherwise 64, or unlimited when --time is given
+    double time_limit = 0;
+    std::string resolution;  // "WxH"; empty: the scene's own
+    uint64_t seed = 1234;
+    int threads = 0;
+    std::vector<std::string> outputs;
+    float exposure = 0;
+    std::string stats_path;
+    int max_depth = -1;
+    int rr_depth = 3;
+    bool quiet = false;
+};
+
+void add_render_options(CLI::App& app, RenderCommandOptions& opt);
+// Validates the options (exit code 2 on bad usage) and runs the renders.
+int run_render_command(const RenderCommandOptions& opt);
+
+// Parses "WxH"; returns false if malformed or not positive.
+bool parse_resolution(const std::string& text, int& width, int& height);
+
+}  // namespace pathlab

@@ -1,0 +1,33 @@
+#include <algorithm>
+
+#include <fmt/format.h>
+
+#include "render/estimators.hpp"
+
+namespace pathlab {
+
+const std::vector<EstimatorInfo>& estimators() {
+    static const std::vector<EstimatorInfo> table = {
+        {"eyelight", {}, "debug view: |cos| between camera ray and surface normal", false, make_eyelight},
+        {"direct-light", {"1"}, "direct illumination by light sampling (one light chosen by power)", false, make_direct_light},
+    };
+    return table;
+}
+
+const EstimatorInfo* find_estimator(const std::string& key) {
+    for (const EstimatorInfo& e : estimators())
+        if (e.name == key || std::find(e.aliases.begin(), e.aliases.end(), key) != e.aliases.end()) return &e;
+    return nullptr;
+}
+
+std::string estimator_names() {
+    std::string out;
+    for (const EstimatorInfo& e : estimators()) {
+        if (!out.empty()) out += ", ";
+        out += e.name;
+        if (!e.aliases.empty()) out += fmt::format(" ({})", fmt::join(e.aliases, "/"));
+    }
+    return out;
+}
+
+}  // namespace pathlab

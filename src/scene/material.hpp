@@ -1,0 +1,50 @@
+// Materials (BSDFs). A closed set of types dispatched with std::visit in the hot loop.
+//
+// Conventions, stated once for every material:
+//  - Directions are unit vectors in the local shading frame (normal = +z), and both point
+//    away from the surface: `wi` towards where the path came from (the camera side), `wo`
+//    the other direction (towards a light, or the sampled continuation).
+//  - eval(wi, wo) returns the BSDF value f (no cosine factor).
+//  - pdf(wi, wo) and BsdfSample::pdfW are densities per unit solid angle of wo.
+//  - sample(wi, u) draws wo given two uniform numbers in [0,1).
+#pragma once
+
+#include <optional>
+#include <variant>
+
+#include "scene/phong.hpp"
+
+namespace pathlab {
+
+using MaterialModel = std::variant<PhongMaterial>;
+
+struct Material {
+    MaterialModel model;
+    // Two-sided materials shade the back of a surface like its front (the frame is flipped
+    // to face the incoming direction); one-sided ones are black from behind.
+    bool two_sided = true;
+
+    Rgb eval(const Vec3f& wi, const Vec3f& wo) const {
+        return std::visit([&](const auto& m) { return m.eval(wi, wo); }, model);
+    }
+    float pdf(const Vec3f& wi, const Vec3f& wo) const {
+        return std::visit([&](const auto& m) { return m.pdf(wi, wo); }, model);
+    }
+    std::optional<BsdfSample> sample(const Vec3f& wi, const Vec2f& u) const {
+        return std::visit([&](const auto& m) { return m.sample(wi, u); }, model);
+    }
+    // True when the material reflects nothing (pure emitters): estimators stop there.
+    bool is_black() const {
+        if (const auto* p = std::get_if<PhongMaterial>(&model))
+            return pathlab::is_black(p->diffuse) && pathlab::is_black(p->specular);
+        return false;
+    }
+    // True when every lobe is a Dirac delta: light sampling cannot contribute there.
+    bool is_delta() const { return false; }
+};
+
+inline Material make_phong(const Rgb& diffuse, const Rgb& specular = Rgb(0.0f), float exponent = 1) {
+    return Material{PhongMaterial{diffuse, specular, exponent}};
+}
+
+}  // namespace pathlab

@@ -1,0 +1,157 @@
+#include "scene/scene.hpp"
+
+#include <algorithm>
+#include <numeric>
+
+#include <fmt/format.h>
+
+namespace pathlab {
+namespace {
+
+thread_local uint64_t t_rays_traced = 0;
+
+void validate(const SceneDescription& d) {
+    const auto check_material = [&](uint32_t m, const std::string& what) {
+        if (m >= d.materials.size())
+            throw SceneError(fmt::format("{} refers to material {}, but the scene has {} materials", what, m, d.materials.size()));
+    };
+    for (size_t i = 0; i < d.meshes.size(); ++i) {
+        const MeshDesc& m = d.meshes[i];
+        const std::string what = fmt::format("mesh '{}'", m.name.empty() ? std::to_string(i) : m.name);
+        if (m.triangles.empty()) throw SceneError(what + " has no faces");
+        check_material(m.material, what);
+        for (const Vec3f& p : m.positions)
+            if (!is_finite(p)) throw SceneError(what + " has a NaN or infinite vertex");
+        if (!m.normals.empty() && m.normals.size() != m.positions.size())
+            throw SceneError(fmt::format("{} has {} normals for {} vertices", what, m.normals.size(), m.positions.size()));
+        for (const auto& tri : m.triangles)
+            for (uint32_t v : tri)
+                if (v >= m.positions.size())
+                    throw SceneError(fmt::format("{} has a vertex index {} out of range (it has {} vertices)", what, v, m.positions.size()));
+        if (!is_finite(m.emission) || min_component(m.emission) < 0)
+            throw SceneError(what + " has an invalid emitted radiance");
+    }
+    for (size_t i = 0; i < d.spheres.size(); ++i) {
+        const SphereDesc& s = d.spheres[i];
+        const std::string what = fmt::format("sphere {}", i);
+        check_material(s.material, what);
+        if (!is_finite(s.center) || !(s.radius > 0) || !std::isfinite(s.radius))
+            throw SceneError(what + " needs a finite centre and a positive radius");
+    }
+    int environments = 0;
+    for (const FreeLight& l : d.lights) environments += std::holds_alternative<EnvironmentLight>(l);
+    if (environments > 1) throw SceneError("a scene can have at most one environment light");
+}
+
+}  // namespace
+
+uint64_t Scene::rays_traced_by_this_thread() { return t_rays_traced; }
+
+std::unique_ptr<Scene> Scene::build(const SceneDescription& desc) {
+    validate(desc);
+    std::unique_ptr<Scene> s(new Scene());
+    s->desc_ = desc;
+    s->name_ = desc.name;
+    s->camera_ = desc.camera;
+    s->width_ = desc.width;
+    s->height_ = desc.height;
+    s->materials_ = desc.materials;
+
+    for (const FreeLight& l : desc.lights) {
+        std::visit([&](const auto& light) { s->lights_.emplace_back(light); }, l);
+        if (std::holds_alternative<EnvironmentLight>(l)) s->environment_ = int(s->lights_.size()) - 1;
+    }
+
+    Vec3f lo(kInf), hi(-kInf);
+    for (size_t i = 0; i < desc.meshes.size(); ++i) {
+        const MeshDesc& m = desc.meshes[i];
+        const uint32_t id = s->accel_.add_mesh(m);
+        if (id >= s->geometry_.size()) s->geometry_.resize(id + 1);
+        GeometryRecord rec{false, uint32_t(i), -1};
+        if (!is_black(m.emission)) {
+            rec.first_light = int32_t(s->lights_.size());
+            for (const auto& t : m.triangles)
+                s->lights_.emplace_back(TriangleLight(m.positions[t[0]], m.positions[t[1]], m.positions[t[2]], m.emission));
+        }
+        s->geometry_[id] = rec;
+        for (const Vec3f& p : m.positions) lo = min(lo, p), hi = max(hi, p);
+    }
+    for (size_t i = 0; i < desc.spheres.size(); ++i) {
+        const SphereDesc& sp = desc.spheres[i];
+        const uint32_t id = s->accel_.add_sphere(sp);
+        if (id >= s->geometry_.size()) s->geometry_.resize(id + 1);
+        s->geometry_[id] = GeometryRecord{true, uint32_t(i), -1};
+        lo = min(lo, sp.center - Vec3f(sp.radius)), hi = max(hi, sp.center + Vec3f(sp.radius));
+    }
+    s->accel_.commit();
+    if (lo.x <= hi.x) {
+        s->center_ = (lo + hi) * 0.5f;
+        s->radius_ = std::max(1e-3f, 0.5f * length(hi - lo));
+    }
+
+    // Light selection proportional to power.
+    const size_t n = s->lights_.size();
+    s->pmf_.resize(n);
+    for (size_t i = 0; i < n; ++i) s->pmf_[i] = std::max(0.0f, light_power(s->lights_[i], s->radius_));
+    const double total = std::accumulate(s->pmf_.begin(), s->pmf_.end(), 0.0);
+    for (float& p : s->pmf_) p = total > 0 ? float(p / total) : 1.0f / float(n);
+    s->cdf_.resize(n);
+    double running = 0;
+    for (size_t i = 0; i < n; ++i) s->cdf_[i] = float(running += s->pmf_[i]);
+    if (n) s->cdf_.back() = 1.0f;
+    return s;
+}
+
+bool Scene::has_delta_lights() const {
+    return std::any_of(lights_.begin(), lights_.end(), [](const Light& l) {
+        return std::holds_alternative<PointLight>(l) || std::holds_alternative<DirectionalLight>(l);
+    });
+}
+
+LightChoice Scene::choose_light(float u) const {
+    if (lights_.empty()) return {};
+    const auto it = std::upper_bound(cdf_.begin(), cdf_.end(), u);
+    const int index = int(std::min<ptrdiff_t>(it - cdf_.begin(), ptrdiff_t(cdf_.size()) - 1));
+    return {index, pmf_[size_t(index)]};
+}
+
+bool Scene::intersect(const Ray& ray, Intersection& hit) const {
+    ++t_rays_traced;
+    RawHit raw;
+    if (!accel_.intersect(ray, raw)) return false;
+    const GeometryRecord& rec = geometry_[raw.geom_id];
+    hit.t = raw.t;
+    if (rec.is_sphere) {
+        const SphereDesc& sp = desc_.spheres[rec.index];
+        // Project the hit back onto the sphere in double precision.
+        const Vec3d c(sp.center);
+        const Vec3d q = Vec3d(ray.o) + Vec3d(ray.d) * double(raw.t) - c;
+        const Vec3d n = q / length(q);
+        hit.p = Vec3f(c + n * double(sp.radius));
+        hit.ng = hit.ns = Vec3f(sp.flip_normals ? -n : n);
+        hit.material = sp.material;
+        hit.light = -1;
+    } else {
+        const MeshDesc& m = desc_.meshes[rec.index];
+        const auto& tri = m.triangles[raw.prim_id];
+        const Vec3f &p0 = m.positions[tri[0]], &p1 = m.positions[tri[1]], &p2 = m.positions[tri[2]];
+        const float b1 = raw.u, b2 = raw.v, b0 = 1 - b1 - b2;
+        hit.p = p0 * b0 + p1 * b1 + p2 * b2;
+        hit.ng = normalize(cross(p1 - p0, p2 - p0));
+        hit.ns = hit.ng;
+        if (!m.normals.empty()) {
+            const Vec3f n = m.normals[tri[0]] * b0 + m.normals[tri[1]] * b1 + m.normals[tri[2]] * b2;
+            if (dot(n, n) > 0) hit.ns = normalize(n);
+        }
+        hit.material = m.material;
+        hit.light = rec.first_light >= 0 ? rec.first_light + int32_t(raw.prim_id) : -1;
+    }
+    return true;
+}
+
+bool Scene::occluded(const Ray& ray) const {
+    ++t_rays_traced;
+    return accel_.occluded(ray);
+}
+
+}  // namespace pathlab

@@ -1,0 +1,90 @@
+// A renderable scene: geometry in Embree, materials, lights with a power-proportional light
+// selection distribution, and the camera. Built once from a SceneDescription; immutable and
+// shared by all render threads afterwards.
+#pragma once
+
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "scene/accel.hpp"
+#include "scene/scene_description.hpp"
+
+namespace pathlab {
+
+struct SceneError : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+// A ray's hit on a surface.
+struct Intersection {
+    Vec3f p;             // hit point, recomputed from the primitive (not o + t d) for accuracy
+    Vec3f ng;            // unit geometric normal as the shape defines it (winding / outward)
+    Vec3f ns;            // unit shading normal (ng unless the mesh has vertex normals)
+    float t = 0;
+    uint32_t material = 0;
+    int32_t light = -1;  // index into Scene::lights() of the area light here, or -1
+};
+
+struct LightChoice {
+    int index = -1;
+    float pmf = 0;  // probability of having chosen this light
+};
+
+class Scene {
+public:
+    // Validates the description (indices in range, finite vertices, non-empty meshes) and
+    // throws SceneError naming the offending element.
+    static std::unique_ptr<Scene> build(const SceneDescription& desc);
+
+    bool intersect(const Ray& ray, Intersection& hit) const;
+    bool occluded(const Ray& ray) const;
+
+    const std::string& name() const { return name_; }
+    const Camera& camera() const { return camera_; }
+    int default_width() const { return width_; }
+    int default_height() const { return height_; }
+    const SceneDescription& description() const { return desc_; }
+
+    const Material& material(uint32_t index) const { return materials_[index]; }
+    const std::vector<Light>& lights() const { return lights_; }
+    bool has_delta_lights() const;
+
+    // Radiance along a ray that escapes the scene (the constant environment, if any).
+    Rgb escaped_radiance() const { return environment_ >= 0 ? std::get<EnvironmentLight>(lights_[environment_]).radiance : Rgb(0.0f); }
+    int environment_light() const { return environment_; }
+
+    // Chooses a light with probability proportional to its power (uniformly if all are 0).
+    LightChoice choose_light(float u) const;
+    float light_pmf(int index) const { return pmf_[size_t(index)]; }
+
+    Vec3f bounds_center() const { return center_; }
+    float bounds_radius() const { return radius_; }
+
+    // Rays traced by the calling thread since it started (for throughput statistics).
+    static uint64_t rays_traced_by_this_thread();
+
+private:
+    Scene() = default;
+    struct GeometryRecord {
+        bool is_sphere = false;
+        uint32_t index = 0;        // into desc_.meshes or desc_.spheres
+        int32_t first_light = -1;  // area light of triangle k is first_light + k
+    };
+
+    SceneDescription desc_;
+    std::string name_;
+    Camera camera_;
+    int width_ = 512, height_ = 512;
+    Accel accel_;
+    std::vector<GeometryRecord> geometry_;  // by Embree geometry id
+    std::vector<Material> materials_;
+    std::vector<Light> lights_;
+    std::vector<float> pmf_, cdf_;
+    int environment_ = -1;
+    Vec3f center_{0.0f};
+    float radius_ = 1;
+};
+
+}  // namespace pathlab

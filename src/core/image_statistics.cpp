@@ -1,0 +1,72 @@
+#include "core/image_statistics.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+namespace pathlab {
+
+double normal_quantile_two_sided(double alpha) {
+    // Bisection on erfc: P(|Z| > z) = erfc(z / sqrt 2).
+    double lo = 0, hi = 40;
+    for (int i = 0; i < 200; ++i) {
+        const double mid = 0.5 * (lo + hi);
+        (std::erfc(mid / std::sqrt(2.0)) > alpha ? lo : hi) = mid;
+    }
+    return 0.5 * (lo + hi);
+}
+
+long binomial_upper_quantile(long n, double p, double alpha) {
+    // Accumulate the pmf in log space until the upper tail is below alpha.
+    double cdf = 0;
+    for (long k = 0; k <= n; ++k) {
+        const double log_pmf = std::lgamma(double(n) + 1) - std::lgamma(double(k) + 1) - std::lgamma(double(n - k) + 1) +
+                               double(k) * std::log(p) + double(n - k) * std::log1p(-p);
+        cdf += std::exp(log_pmf);
+        if (1 - cdf <= alpha) return k;
+    }
+    return n;
+}
+
+std::string AgreementResult::describe() const {
+    return fmt::format("{}: {} outliers (allowed {}) of {} pixel-channels, max |z| = {:.2f}, bias z = ({:.2f}, {:.2f}, "
+                       "{:.2f}) (limit {:.2f})",
+                       agree ? "agree" : "DISAGREE", outliers, allowed_outliers, pixels, max_abs_z, bias_z[0], bias_z[1],
+                       bias_z[2], bias_limit);
+}
+
+AgreementResult test_agreement(const Image& a, const Image& se_a, const Image& b, const Image& se_b,
+                               const AgreementOptions& o) {
+    if (a.width() != b.width() || a.height() != b.height() || se_a.pixel_count() != a.pixel_count() ||
+        se_b.pixel_count() != b.pixel_count())
+        throw std::invalid_argument("test_agreement: images differ in size");
+    AgreementResult r;
+    const double channel_pixel_alpha = o.pixel_alpha;
+    const double channel_family_alpha = o.family_alpha / 6;  // 3 channels x 2 checks
+    const double z_pixel = normal_quantile_two_sided(channel_pixel_alpha);
+    const long n = long(a.pixel_count());
+    r.pixels = 3 * n;
+    r.allowed_outliers = binomial_upper_quantile(n, channel_pixel_alpha, channel_family_alpha);
+    r.bias_limit = normal_quantile_two_sided(channel_family_alpha);
+    for (int c = 0; c < 3; ++c) {
+        long outliers = 0, tested = 0;
+        double sum_z = 0;
+        for (size_t i = 0; i < a.pixel_count(); ++i) {
+            const double d = double(a[i][c]) - double(b[i][c]);
+            const double se = std::sqrt(double(se_a[i][c]) * se_a[i][c] + double(se_b[i][c]) * se_b[i][c]);
+            double z = 0;
+            if (se > 0) z = d / se;
+            else if (d != 0) z = INFINITY;
+            if (std::abs(z) > z_pixel) ++outliers;
+            if (se > 0) sum_z += z, ++tested;
+            r.max_abs_z = std::max(r.max_abs_z, std::abs(z));
+        }
+        r.bias_z[c] = tested ? sum_z / std::sqrt(double(tested)) : 0.0;
+        r.outliers = std::max(r.outliers, outliers);
+        if (outliers > r.allowed_outliers || std::abs(r.bias_z[c]) > r.bias_limit) r.agree = false;
+    }
+    return r;
+}
+
+}  // namespace pathlab

@@ -51,7 +51,8 @@ TEST_P(PowerCosine, MatchesPdf) {
     EXPECT_GT(r.p_value, kAlpha) << "n = " << n << ": " << r.describe();
     EXPECT_NEAR(r.pdf_integral, 1.0, 1e-3);
 }
-INSTANTIATE_TEST_SUITE_P(Exponents, PowerCosine, ::testing::Values(1.0f, 90.0f, 600.0f));
+INSTANTIATE_TEST_SUITE_P(Exponents, PowerCosine, ::testing::Values(1.0f, 90.0f, 600.0f),
+                         [](const auto& info) { return "n" + std::to_string(int(info.param)); });
 
 // Tests of the tests. A lobe of the wrong shape (exponent 100 claimed for samples drawn with
 // exponent 90) must fail the chi-square test; a wrong normalisation ((n+2)/(2pi), the BRDF's,
@@ -154,7 +155,8 @@ TEST_P(TriangleLightDirections, MatchSolidAnglePdf) {
     EXPECT_NEAR(r.pdf_integral, 1.0, 2e-3) << r.describe();
 }
 INSTANTIATE_TEST_SUITE_P(ReferencePoints, TriangleLightDirections,
-                         ::testing::Values(Vec3f(0.0f, 0.0f, 0.0f), Vec3f(1.5f, 0.3f, 0.6f), Vec3f(-0.3f, 0.1f, 0.5f)));
+                         ::testing::Values(Vec3f(0.0f, 0.0f, 0.0f), Vec3f(1.5f, 0.3f, 0.6f), Vec3f(-0.3f, 0.1f, 0.5f)),
+                         [](const auto& info) { return "point" + std::to_string(info.index); });
 
 TEST(Sampling, EnvironmentLightIsUniformOverTheSphere) {
     const EnvironmentLight env{Rgb(1.0f)};

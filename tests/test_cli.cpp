@@ -1,0 +1,163 @@
+// The command line: helpful errors with exit code 2, outputs and statistics, Ctrl-C.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sys/wait.h>
+
+#include <fmt/format.h>
+
+#include "app/cli.hpp"
+#include "core/image_io.hpp"
+
+namespace pathlab::test {
+namespace {
+namespace fs = std::filesystem;
+
+struct CliResult {
+    int code;
+    std::string out, err;
+};
+
+CliResult run(std::vector<std::string> args) {
+    args.insert(args.begin(), "pathlab");
+    std::vector<const char*> argv;
+    for (const std::string& a : args) argv.push_back(a.c_str());
+    testing::internal::CaptureStdout();
+    testing::internal::CaptureStderr();
+    const int code = run_cli(int(argv.size()), argv.data());
+    std::string out = testing::internal::GetCapturedStdout();
+    std::string err = testing::internal::GetCapturedStderr();
+    return {code, out, err};
+}
+
+bool contains(const std::string& s, const std::string& needle) { return s.find(needle) != std::string::npos; }
+
+class Cli : public ::testing::Test {
+protected:
+    void SetUp() override {
+        dir_ = fs::temp_directory_path() / ("pathlab-cli-" + std::to_string(::getpid()));
+        fs::create_directories(dir_);
+    }
+    void TearDown() override { fs::remove_all(dir_); }
+    std::string path(const std::string& name) const { return (dir_ / name).string(); }
+    fs::path dir_;
+};
+
+TEST_F(Cli, UnknownSceneListsTheValidOnes) {
+    const CliResult r = run({"--scene", "kitchen", "-o", path("x.exr")});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_TRUE(contains(r.err, "unknown scene 'kitchen'")) << r.err;
+    EXPECT_TRUE(contains(r.err, "ceiling-glossy")) << r.err;
+    EXPECT_TRUE(contains(r.err, "env-diffuse")) << r.err;
+}
+
+TEST_F(Cli, UnknownAlgorithmListsTheValidOnes) {
+    const CliResult r = run({"--scene", "0", "--algorithm", "bdpt-magic", "-o", path("x.exr")});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_TRUE(contains(r.err, "unknown algorithm 'bdpt-magic'")) << r.err;
+    EXPECT_TRUE(contains(r.err, "direct-light (1)")) << r.err;
+    EXPECT_TRUE(contains(r.err, "eyelight")) << r.err;
+}
+
+TEST_F(Cli, BadResolutionIsExplained) {
+    for (const char* bad : {"0x512", "512", "-3x4", "12x", "axb", "512x512x3"}) {
+        const CliResult r = run({"--scene", "0", "--resolution", bad, "-o", path("x.exr")});
+        EXPECT_EQ(r.code, 2) << bad;
+        EXPECT_TRUE(contains(r.err, "invalid --resolution")) << r.err;
+    }
+}
+
+TEST_F(Cli, NonPositiveSampleCountIsExplained) {
+    for (const char* bad : {"0", "-4"}) {
+        const CliResult r = run({"--scene", "0", "--spp", bad, "-o", path("x.exr")});
+        EXPECT_EQ(r.code, 2) << bad;
+        EXPECT_TRUE(contains(r.err, "--spp must be a positive")) << r.err;
+    }
+}
+
+TEST_F(Cli, UnknownOptionListsTheValidOnes) {
+    const CliResult r = run({"--sample-count", "4"});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_TRUE(contains(r.err, "--sample-count")) << r.err;
+    EXPECT_TRUE(contains(r.err, "Valid options")) << r.err;
+    EXPECT_TRUE(contains(r.err, "--spp")) << r.err;
+    EXPECT_TRUE(contains(r.err, "--scene")) << r.err;
+}
+
+TEST_F(Cli, UnwritableOutputFailsBeforeRendering) {
+    const CliResult r = run({"--scene", "0", "-o", "/proc/pathlab/x.exr"});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_TRUE(contains(r.err, "/proc/pathlab/x.exr")) << r.err;
+    EXPECT_FALSE(contains(r.err, "spp in")) << "rendered before failing: " << r.err;
+}
+
+TEST_F(Cli, UnknownOutputExtensionIsExplained) {
+    const CliResult r = run({"--scene", "0", "-o", path("x.jpg")});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_TRUE(contains(r.err, ".exr, .hdr, .pfm, .png")) << r.err;
+}
+
+TEST_F(Cli, SeveralScenesNeedAPlaceholderInTheOutputName) {
+    const CliResult r = run({"--scene", "0,1", "-o", path("x.exr")});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_TRUE(contains(r.err, "{scene}")) << r.err;
+}
+
+TEST_F(Cli, ScenesListsTheEightCourseScenes) {
+    const CliResult r = run({"scenes"});
+    EXPECT_EQ(r.code, 0);
+    EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 8) << r.out;
+    EXPECT_TRUE(contains(r.out, "5  box-glossy")) << r.out;
+}
+
+TEST_F(Cli, RendersScenesToEveryRequestedFormatWithStatistics) {
+    const CliResult r = run({"--scene", "2,point-glossy", "--resolution", "24x16", "--spp", "3", "--quiet", "-o",
+                             path("{index}-{scene}.exr"), "-o", path("{scene}.pfm"), "-o", path("{scene}.png"), "--stats",
+                             path("{scene}.json")});
+    ASSERT_EQ(r.code, 0) << r.err;
+    for (const char* f : {"2-ceiling-diffuse.exr", "ceiling-diffuse.pfm", "ceiling-diffuse.png", "1-point-glossy.exr"})
+        EXPECT_TRUE(fs::exists(path(f))) << f;
+    const Image exr = read_image(path("2-ceiling-diffuse.exr")), pfm = read_image(path("ceiling-diffuse.pfm"));
+    EXPECT_EQ(exr.width(), 24);
+    EXPECT_EQ(exr.height(), 16);
+    for (size_t i = 0; i < exr.pixel_count(); ++i) ASSERT_EQ(exr[i], pfm[i]);
+    const auto stats = nlohmann::json::parse(std::ifstream(path("ceiling-diffuse.json")));
+    EXPECT_EQ(stats["scene"], "ceiling-diffuse");
+    EXPECT_EQ(stats["algorithm"], "direct-light");
+    EXPECT_EQ(stats["spp"], 3);
+    EXPECT_EQ(stats["resolution"], nlohmann::json::array({24, 16}));
+    EXPECT_EQ(stats["samples"], 24 * 16 * 3);
+    EXPECT_GE(stats["rays"].get<long>(), 24 * 16 * 3);
+    EXPECT_EQ(stats["invalid_samples"], 0);
+    EXPECT_GT(stats["samples_per_second"].get<double>(), 0);
+}
+
+TEST_F(Cli, AliasesSelectTheSameEstimator) {
+    ASSERT_EQ(run({"-s", "0", "-a", "1", "--resolution", "8x8", "--spp", "2", "-q", "-o", path("a.pfm")}).code, 0);
+    ASSERT_EQ(run({"-s", "point-diffuse", "-a", "direct-light", "--resolution", "8x8", "--spp", "2", "-q", "-o", path("b.pfm")}).code, 0);
+    const Image a = read_image(path("a.pfm")), b = read_image(path("b.pfm"));
+    for (size_t i = 0; i < a.pixel_count(); ++i) ASSERT_EQ(a[i], b[i]);
+}
+
+// Ctrl-C during a long render: the binary writes the passes it finished, normalised by them,
+// so the image equals a one-shot render with that many samples, bit for bit.
+TEST_F(Cli, InterruptedRenderWritesWhatItHasCorrectlyNormalised) {
+    const std::string common = fmt::format("{} --scene 3 --resolution 64x64 --seed 9 --quiet", PATHLAB_BINARY);
+    const std::string cmd = fmt::format("timeout --preserve-status -s INT 1.5 {} --spp 100000000 -o {} --stats {}", common,
+                                        path("interrupted.exr"), path("interrupted.json"));
+    const int status = std::system(cmd.c_str());
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 130);
+    const auto stats = nlohmann::json::parse(std::ifstream(path("interrupted.json")));
+    EXPECT_TRUE(stats["interrupted"].get<bool>());
+    const int spp = stats["spp"];
+    ASSERT_GT(spp, 0);
+    ASSERT_EQ(std::system(fmt::format("{} --spp {} -o {}", common, spp, path("oneshot.exr")).c_str()), 0);
+    const Image a = read_image(path("interrupted.exr")), b = read_image(path("oneshot.exr"));
+    for (size_t i = 0; i < a.pixel_count(); ++i) ASSERT_EQ(a[i], b[i]) << i;
+}
+
+}  // namespace
+}  // namespace pathlab::test

@@ -56,6 +56,7 @@ std::string Chi2Result::describe() const {
 }
 
 Chi2Result chi2_from_counts(const std::vector<double>& observed, const std::vector<double>& expected) {
+    // The last cell holds rejections (see chi2_directions); it is not a cell of zero pdf.
     Chi2Result r;
     // Pool cells with expected counts below 5 (chi-square needs reasonably large counts).
     std::vector<size_t> order(observed.size());
@@ -64,7 +65,7 @@ Chi2Result chi2_from_counts(const std::vector<double>& observed, const std::vect
     double pooled_e = 0, pooled_o = 0, stat = 0;
     int cells = 0;
     for (size_t i : order) {
-        if (expected[i] == 0) r.zero_pdf_samples += observed[i];
+        if (expected[i] == 0 && i + 1 < observed.size()) r.zero_pdf_samples += observed[i];
         if (expected[i] < 5) {
             pooled_e += expected[i];
             pooled_o += observed[i];
@@ -110,7 +111,9 @@ Chi2Result chi2_directions(const DirectionSampler& sample, const DirectionPdf& p
             continue;
         }
         const Vec3f l = frame.to_local(normalize(*w));
-        const double theta = std::acos(std::clamp(double(l.z), -1.0, 1.0));
+        // atan2 keeps precision near the pole, where acos of a float z cannot resolve
+        // angles below ~5e-4 rad.
+        const double theta = std::atan2(std::hypot(double(l.x), double(l.y)), double(l.z));
         double phi = std::atan2(double(l.y), double(l.x));
         if (phi < 0) phi += 2 * M_PI;
         const int p = std::min(int(phi / (2 * M_PI) * np), np - 1);

@@ -41,7 +41,7 @@ struct Chi2Result {
 };
 
 // Pearson's test of observed against expected counts (same cells), pooling cells whose
-// expected count is below 5.
+// expected count is below 5. The last cell holds rejected samples (see chi2_directions).
 Chi2Result chi2_from_counts(const std::vector<double>& observed, const std::vector<double>& expected);
 
 using DirectionSampler = std::function<std::optional<Vec3f>(Vec2f)>;
@@ -54,5 +54,10 @@ Chi2Result chi2_directions(const DirectionSampler& sample, const DirectionPdf& p
 
 // Per-test significance level: 1% for the whole suite, split over `tests` tests (Sidak).
 double sidak_alpha(int tests, double family_alpha = 0.01);
+
+// Number of chi-square goodness-of-fit tests in the whole suite (an upper bound), and the
+// resulting per-test level: a false alarm anywhere in the suite has probability <= 1%.
+constexpr int kSuiteChi2Tests = 64;
+inline double suite_chi2_alpha() { return sidak_alpha(kSuiteChi2Tests); }
 
 }  // namespace pathlab::test

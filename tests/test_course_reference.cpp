@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "core/image_io.hpp"
-#include "render/light_sampling.hpp"
+#include "render/direct_lighting.hpp"
 #include "render_helpers.hpp"
 #include "tools/course_reference.hpp"
 

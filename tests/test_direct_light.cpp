@@ -72,7 +72,7 @@ AgreementResult render_against_closed_form(float intensity) {
                 }
             exact.at(x, y) = Rgb(float(sum / (kSub * kSub)));
         }
-    return test_agreement(r.film.mean(), r.film.standard_error(), exact, Image(32, 32));
+    return test_agreement(r.film.mean(), r.film.standard_error(), exact, Image());
 }
 
 TEST(PointLightOverPlane, RenderAgreesWithThePixelAveragedClosedForm) {

@@ -3,7 +3,7 @@
 // the front) plus one light sample (light chosen by power, see Scene::choose_light) with a
 // shadow ray. Rays that escape return the environment's radiance.
 #include "render/estimators.hpp"
-#include "render/light_sampling.hpp"
+#include "render/direct_lighting.hpp"
 
 namespace pathlab {
 namespace {

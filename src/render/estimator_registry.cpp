@@ -10,6 +10,10 @@ const std::vector<EstimatorInfo>& estimators() {
     static const std::vector<EstimatorInfo> table = {
         {"eyelight", {}, "debug view: |cos| between camera ray and surface normal", false, make_eyelight},
         {"direct-light", {"1"}, "direct illumination by light sampling (one light chosen by power)", false, make_direct_light},
+        {"direct-uniform", {"2a"}, "direct illumination by uniform hemisphere sampling", true, make_direct_uniform},
+        {"direct-cosine", {"2b"}, "direct illumination by cosine-weighted hemisphere sampling", true, make_direct_cosine},
+        {"direct-brdf", {"2c"}, "direct illumination by BRDF importance sampling", true, make_direct_brdf},
+        {"direct-mis", {"3"}, "light + BRDF sampling combined by MIS (balance heuristic)", false, make_direct_mis},
     };
     return table;
 }

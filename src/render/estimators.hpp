@@ -7,5 +7,9 @@ namespace pathlab {
 
 std::unique_ptr<Estimator> make_eyelight(const EstimatorOptions&);
 std::unique_ptr<Estimator> make_direct_light(const EstimatorOptions&);
+std::unique_ptr<Estimator> make_direct_uniform(const EstimatorOptions&);
+std::unique_ptr<Estimator> make_direct_cosine(const EstimatorOptions&);
+std::unique_ptr<Estimator> make_direct_brdf(const EstimatorOptions&);
+std::unique_ptr<Estimator> make_direct_mis(const EstimatorOptions&);
 
 }  // namespace pathlab

@@ -1,5 +1,6 @@
 // The render driver: progressive passes of one sample per pixel over image tiles, in parallel
 // with oneTBB, until a sample count or a time budget is reached or the render is cancelled.
+// Small images run several passes per parallel loop (a batch) to keep every core busy.
 // Sample s of pixel p always uses Sampler(seed, p, s), and each pixel accumulates its samples
 // in index order, so the result is bit-identical for any thread count, and a render split into
 // parts (first_sample) sums to the one-shot render.
@@ -29,10 +30,10 @@ struct RenderSettings {
     double time_limit = 0;      // seconds; 0: none
     uint64_t seed = 0;
     uint64_t first_sample = 0;  // sample index of the first pass
-    int tile_size = 32;
+    int tile_size = 32;         // largest tile edge; smaller when the image has too few tiles
     bool progress = false;      // progress line on stderr
-    const std::atomic<bool>* cancel = nullptr;  // checked after every pass
-    // Called after every pass (for convergence checkpoints); may be empty.
+    const std::atomic<bool>* cancel = nullptr;  // checked after every batch of passes
+    // Called after every batch of passes (for convergence checkpoints); may be empty.
     std::function<void(const Film&, const RenderStats&)> after_pass;
 };
 

@@ -19,8 +19,9 @@ render: build
 test: build
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 
+# Benchmarks (several minutes each); they print Markdown tables.
 bench: build
-	$(BUILD)/bench/pathlab_bench
+	$(BUILD)/bench/pathlab_bench direct
 
 clean:
 	rm -rf $(BUILD)

@@ -14,6 +14,9 @@ const std::vector<EstimatorInfo>& estimators() {
         {"direct-cosine", {"2b"}, "direct illumination by cosine-weighted hemisphere sampling", true, make_direct_cosine},
         {"direct-brdf", {"2c"}, "direct illumination by BRDF importance sampling", true, make_direct_brdf},
         {"direct-mis", {"3"}, "light + BRDF sampling combined by MIS (balance heuristic)", false, make_direct_mis},
+        {"pt-naive", {"4a"}, "path tracing by BRDF sampling, Russian roulette", true, make_pt_naive},
+        {"pt-mis3", {"4b"}, "path tracing, MIS direct lighting at every bounce + a third continuation ray", false, make_pt_mis3},
+        {"pt-mis", {"4c"}, "path tracing, MIS direct lighting whose BRDF ray continues the path", false, make_pt_mis},
     };
     return table;
 }

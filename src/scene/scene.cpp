@@ -108,6 +108,12 @@ bool Scene::has_delta_lights() const {
     });
 }
 
+bool Scene::has_hittable_emitters() const {
+    return std::any_of(lights_.begin(), lights_.end(), [](const Light& l) {
+        return std::holds_alternative<TriangleLight>(l) || std::holds_alternative<EnvironmentLight>(l);
+    });
+}
+
 LightChoice Scene::choose_light(float u) const {
     if (lights_.empty()) return {};
     const auto it = std::upper_bound(cdf_.begin(), cdf_.end(), u);

@@ -50,6 +50,8 @@ public:
     const Material& material(uint32_t index) const { return materials_[index]; }
     const std::vector<Light>& lights() const { return lights_; }
     bool has_delta_lights() const;
+    // True when a sampled direction can find emission (an area light or the environment).
+    bool has_hittable_emitters() const;
 
     // Radiance along a ray that escapes the scene (the constant environment, if any).
     Rgb escaped_radiance() const { return environment_ >= 0 ? std::get<EnvironmentLight>(lights_[environment_]).radiance : Rgb(0.0f); }

@@ -12,9 +12,11 @@ build:
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release
 	cmake --build $(BUILD) -j $(JOBS)
 
-# The main job: the 8 course scenes into out/ as EXR + PNG.
+# The main job: the 8 course scenes into out/ as EXR + PNG, with direct illumination (the
+# course's assignments 1-3) and with global illumination (assignment 4).
 render: build
-	$(BUILD)/pathlab --scene all -o 'out/{index}-{scene}.exr' -o 'out/{index}-{scene}.png'
+	$(BUILD)/pathlab --scene all --algorithm direct-light -o 'out/direct/{index}-{scene}.exr' -o 'out/direct/{index}-{scene}.png'
+	$(BUILD)/pathlab --scene all --algorithm pt-mis -o 'out/global/{index}-{scene}.exr' -o 'out/global/{index}-{scene}.png'
 
 test: build
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
@@ -22,6 +24,7 @@ test: build
 # Benchmarks (several minutes each); they print Markdown tables.
 bench: build
 	$(BUILD)/bench/pathlab_bench direct
+	$(BUILD)/bench/pathlab_bench pt
 
 clean:
 	rm -rf $(BUILD)

@@ -2,6 +2,7 @@
 //
 //   pathlab_bench direct   RMSE of 1, 2a, 2b, 2c, 3 against a high-spp reference, at equal
 //                          spp and at equal time, and samples per second
+//   pathlab_bench pt       the same for the path tracers 4a, 4b, 4c (reference: pt-mis)
 //
 // RMSE is over all pixels and channels of the linear image, with the reference's own noise
 // removed (its mean squared standard error is subtracted from the measured MSE). Timed
@@ -119,7 +120,8 @@ int main(int argc, char** argv) {
     CLI::App app{"pathlab benchmarks: estimator efficiency on the course scenes"};
     app.require_subcommand(1);
     Options o;
-    for (CLI::App* sub : {app.add_subcommand("direct", "Direct-illumination estimators 1, 2a, 2b, 2c, 3")}) {
+    for (CLI::App* sub : {app.add_subcommand("direct", "Direct-illumination estimators 1, 2a, 2b, 2c, 3"),
+                          app.add_subcommand("pt", "Path tracers 4a, 4b, 4c")}) {
         sub->add_option("--size", o.size, "Image width and height")->capture_default_str();
         sub->add_option("--ref-spp", o.ref_spp, "Samples per pixel of the reference")->capture_default_str();
         sub->add_option("--spp", o.spp, "Samples per pixel for the equal-spp column")->capture_default_str();
@@ -130,5 +132,6 @@ int main(int argc, char** argv) {
     CLI11_PARSE(app, argc, argv);
     if (app.got_subcommand("direct"))
         efficiency_table(o, {"direct-light", "direct-uniform", "direct-cosine", "direct-brdf", "direct-mis"}, "direct-mis");
+    if (app.got_subcommand("pt")) efficiency_table(o, {"pt-naive", "pt-mis3", "pt-mis"}, "pt-mis");
     return 0;
 }

@@ -10,7 +10,7 @@ namespace pathlab {
 
 struct RenderCommandOptions {
     std::string scene = "all";
-    std::string algorithm = "direct-light";
+    std::string algorithm = "pt-mis";
     int spp = 0;
     bool spp_given = false;  // otherwise 64, or unlimited when --time is given
     double time_limit = 0;

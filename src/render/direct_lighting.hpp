@@ -54,10 +54,11 @@ inline EmitterHit trace_to_emitter(const Scene& scene, const Ray& ray, const Vec
         }
         return e;
     }
-    if (e.isect.light < 0) return e;
-    const auto& tri = std::get<TriangleLight>(scene.lights()[size_t(e.isect.light)]);
-    e.Le = tri.emitted(-ray.d / length(ray.d));
-    if (!is_black(e.Le)) e.pdf_light = scene.light_pmf(e.isect.light) * tri.pdfW(from, e.isect.p);
+    e.Le = emitted_radiance(scene, e.isect, -ray.d / length(ray.d));
+    if (!is_black(e.Le)) {
+        const Light& light = scene.lights()[size_t(e.isect.light)];
+        e.pdf_light = scene.light_pmf(e.isect.light) * surface_light_pdfW(light, from, e.isect.p, e.isect.ng);
+    }
     return e;
 }
 

@@ -68,8 +68,8 @@ struct TriangleLight {
         if (cos_light <= 0) return std::nullopt;  // the reference point is behind the emitter
         return LightSample{wi, dist, q, normal, radiance, area_to_solid_angle(1 / area, dist, cos_light), false};
     }
-    // Solid-angle density with which sample(p) would produce the point q (seen along wi).
-    float pdfW(const Vec3f& p, const Vec3f& q) const {
+    // Solid-angle density with which sample(p) would produce the point q (normal n).
+    float pdfW(const Vec3f& p, const Vec3f& q, const Vec3f& = {}) const {
         const Vec3f d = q - p;
         const float dist = length(d);
         return area_to_solid_angle(1 / area, dist, -dot(d / dist, normal));
@@ -77,6 +77,38 @@ struct TriangleLight {
     // Radiance leaving the emitter towards direction w (unit, pointing away from it).
     Rgb emitted(const Vec3f& w) const { return dot(w, normal) > 0 ? radiance : Rgb(0.0f); }
     float power(float) const { return kPi * mean(radiance) * area; }
+};
+
+// One-sided Lambertian emitter on a sphere: radiance L on the side its normal points to
+// (outwards, or inwards with flip_normals). Points are sampled uniformly by area
+// (pdfA = 1 / (4 pi r^2)); those facing away from the reference point are rejected. Power
+// pi L A.
+struct SphereLight {
+    Vec3f center;
+    float radius = 1;
+    bool inward = false;
+    Rgb radiance;
+
+    std::optional<LightSample> sample(const Vec3f& p, Vec2f u) const {
+        const Vec3f outward = square_to_uniform_sphere(u);
+        const Vec3f n = inward ? -outward : outward;
+        const Vec3f q = center + outward * radius;
+        const Vec3f d = q - p;
+        const float dist2 = dot(d, d);
+        if (!(dist2 > 0)) return std::nullopt;
+        const float dist = std::sqrt(dist2);
+        const Vec3f wi = d / dist;
+        const float cos_light = -dot(wi, n);
+        if (cos_light <= 0) return std::nullopt;
+        return LightSample{wi, dist, q, n, radiance, area_to_solid_angle(1 / area(), dist, cos_light), false};
+    }
+    float pdfW(const Vec3f& p, const Vec3f& q, const Vec3f& n) const {
+        const Vec3f d = q - p;
+        const float dist = length(d);
+        return area_to_solid_angle(1 / area(), dist, -dot(d / dist, n));
+    }
+    float area() const { return 4 * kPi * radius * radius; }
+    float power(float) const { return kPi * mean(radiance) * area(); }
 };
 
 // Constant environment: radiance L from every direction, sampled uniformly over the sphere.
@@ -103,7 +135,21 @@ struct DirectionalLight {
     float power(float scene_radius) const { return kPi * scene_radius * scene_radius * mean(irradiance); }
 };
 
-using Light = std::variant<PointLight, TriangleLight, EnvironmentLight, DirectionalLight>;
+using Light = std::variant<PointLight, TriangleLight, SphereLight, EnvironmentLight, DirectionalLight>;
+
+// Radiance of a surface emitter (triangle or sphere), black for other lights.
+inline Rgb surface_radiance(const Light& light) {
+    if (const auto* t = std::get_if<TriangleLight>(&light)) return t->radiance;
+    if (const auto* s = std::get_if<SphereLight>(&light)) return s->radiance;
+    return Rgb(0.0f);
+}
+// Solid-angle density with which sampling the surface emitter `light` from p produces the
+// point q with normal n (0 for other lights).
+inline float surface_light_pdfW(const Light& light, const Vec3f& p, const Vec3f& q, const Vec3f& n) {
+    if (const auto* t = std::get_if<TriangleLight>(&light)) return t->pdfW(p, q);
+    if (const auto* s = std::get_if<SphereLight>(&light)) return s->pdfW(p, q, n);
+    return 0.0f;
+}
 
 inline std::optional<LightSample> sample_light(const Light& light, const Vec3f& p, const Vec2f& u) {
     return std::visit([&](const auto& l) { return l.sample(p, u); }, light);

@@ -13,15 +13,17 @@
 #include <variant>
 
 #include "scene/phong.hpp"
+#include "scene/specular.hpp"
 
 namespace pathlab {
 
-using MaterialModel = std::variant<PhongMaterial>;
+using MaterialModel = std::variant<PhongMaterial, MirrorMaterial, DielectricMaterial>;
 
 struct Material {
     MaterialModel model;
     // Two-sided materials shade the back of a surface like its front (the frame is flipped
-    // to face the incoming direction); one-sided ones are black from behind.
+    // to face the incoming direction); one-sided ones are black from behind. A dielectric
+    // is neither: both of its sides are meaningful, and its frame is never flipped.
     bool two_sided = true;
 
     Rgb eval(const Vec3f& wi, const Vec3f& wo) const {
@@ -40,11 +42,16 @@ struct Material {
         return false;
     }
     // True when every lobe is a Dirac delta: light sampling cannot contribute there.
-    bool is_delta() const { return false; }
+    bool is_delta() const { return !std::holds_alternative<PhongMaterial>(model); }
+    bool is_dielectric() const { return std::holds_alternative<DielectricMaterial>(model); }
 };
 
 inline Material make_phong(const Rgb& diffuse, const Rgb& specular = Rgb(0.0f), float exponent = 1) {
     return Material{PhongMaterial{diffuse, specular, exponent}};
+}
+inline Material make_mirror(const Rgb& reflectance = Rgb(1.0f)) { return Material{MirrorMaterial{reflectance}}; }
+inline Material make_dielectric(float int_ior, float ext_ior = 1.000277f) {
+    return Material{DielectricMaterial{int_ior, ext_ior}, false};
 }
 
 }  // namespace pathlab

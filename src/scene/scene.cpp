@@ -37,6 +37,8 @@ void validate(const SceneDescription& d) {
         check_material(s.material, what);
         if (!is_finite(s.center) || !(s.radius > 0) || !std::isfinite(s.radius))
             throw SceneError(what + " needs a finite centre and a positive radius");
+        if (!is_finite(s.emission) || min_component(s.emission) < 0)
+            throw SceneError(what + " has an invalid emitted radiance");
     }
     int environments = 0;
     for (const FreeLight& l : d.lights) environments += std::holds_alternative<EnvironmentLight>(l);
@@ -80,7 +82,12 @@ std::unique_ptr<Scene> Scene::build(const SceneDescription& desc) {
         const SphereDesc& sp = desc.spheres[i];
         const uint32_t id = s->accel_.add_sphere(sp);
         if (id >= s->geometry_.size()) s->geometry_.resize(id + 1);
-        s->geometry_[id] = GeometryRecord{true, uint32_t(i), -1};
+        GeometryRecord rec{true, uint32_t(i), -1};
+        if (!is_black(sp.emission)) {
+            rec.first_light = int32_t(s->lights_.size());
+            s->lights_.emplace_back(SphereLight{sp.center, sp.radius, sp.flip_normals, sp.emission});
+        }
+        s->geometry_[id] = rec;
         lo = min(lo, sp.center - Vec3f(sp.radius)), hi = max(hi, sp.center + Vec3f(sp.radius));
     }
     s->accel_.commit();
@@ -110,7 +117,8 @@ bool Scene::has_delta_lights() const {
 
 bool Scene::has_hittable_emitters() const {
     return std::any_of(lights_.begin(), lights_.end(), [](const Light& l) {
-        return std::holds_alternative<TriangleLight>(l) || std::holds_alternative<EnvironmentLight>(l);
+        return std::holds_alternative<TriangleLight>(l) || std::holds_alternative<SphereLight>(l) ||
+               std::holds_alternative<EnvironmentLight>(l);
     });
 }
 
@@ -136,7 +144,7 @@ bool Scene::intersect(const Ray& ray, Intersection& hit) const {
         hit.p = Vec3f(c + n * double(sp.radius));
         hit.ng = hit.ns = Vec3f(sp.flip_normals ? -n : n);
         hit.material = sp.material;
-        hit.light = -1;
+        hit.light = rec.first_light;
     } else {
         const MeshDesc& m = desc_.meshes[rec.index];
         const auto& tri = m.triangles[raw.prim_id];

@@ -28,6 +28,7 @@ struct SphereDesc {
     float radius = 1;
     uint32_t material = 0;
     bool flip_normals = false;  // normals point inwards
+    Rgb emission{0.0f};         // radiance of a one-sided area emitter on the normal side
 };
 
 // Lights that are not attached to geometry (area emitters come from MeshDesc::emission).

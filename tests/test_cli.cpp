@@ -125,7 +125,7 @@ TEST_F(Cli, RendersScenesToEveryRequestedFormatWithStatistics) {
     for (size_t i = 0; i < exr.pixel_count(); ++i) ASSERT_EQ(exr[i], pfm[i]);
     const auto stats = nlohmann::json::parse(std::ifstream(path("ceiling-diffuse.json")));
     EXPECT_EQ(stats["scene"], "ceiling-diffuse");
-    EXPECT_EQ(stats["algorithm"], "direct-light");
+    EXPECT_EQ(stats["algorithm"], "pt-mis");  // the default
     EXPECT_EQ(stats["spp"], 3);
     EXPECT_EQ(stats["resolution"], nlohmann::json::array({24, 16}));
     EXPECT_EQ(stats["samples"], 24 * 16 * 3);

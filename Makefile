@@ -3,7 +3,7 @@
 BUILD ?= build
 JOBS ?= $(shell nproc)
 
-.PHONY: deps build render test bench clean
+.PHONY: deps build render test bench bench-estimators clean
 
 deps:
 	scripts/install-deps.sh
@@ -21,8 +21,13 @@ render: build
 test: build
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 
-# Benchmarks (several minutes each); they print Markdown tables.
+# The performance suite (about 6 minutes): throughput, scaling, Embree's bound, scene growth,
+# memory, allocations and pt-mis efficiency; Markdown on stdout, JSON in out/bench/.
 bench: build
+	$(BUILD)/bench/pathlab_bench perf --json out/bench/performance.json
+
+# Equal-spp and equal-time RMSE of the course's estimators on the 8 scenes (about 10 minutes).
+bench-estimators: build
 	$(BUILD)/bench/pathlab_bench direct
 	$(BUILD)/bench/pathlab_bench pt
 

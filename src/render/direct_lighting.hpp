@@ -21,13 +21,14 @@ inline Rgb estimate_light_sample(const Scene& scene, const ShadingPoint& sp, Sam
     const auto ls = sample_light(scene.lights()[size_t(choice.index)], sp.p, u);
     if (!ls || is_black(ls->Le) || dot(ls->wi, sp.ng) <= 0) return Rgb(0.0f);
     const Vec3f wo = sp.frame.to_local(ls->wi);
-    const Rgb f = sp.material->eval(sp.wi, wo);
+    float pdf_bsdf;
+    const Rgb f = sp.material->eval_and_pdf(sp.wi, wo, pdf_bsdf);
     if (is_black(f)) return Rgb(0.0f);
     const Ray shadow = std::isinf(ls->distance) ? spawn_ray(sp.p, sp.ng, ls->wi)
                                                 : spawn_segment(sp.p, sp.ng, ls->point, ls->normal);
     if (scene.occluded(shadow)) return Rgb(0.0f);
     const float pdf_light = choice.pmf * ls->pdfW;
-    const float weight = (mis && !ls->delta) ? balance_heuristic(pdf_light, sp.material->pdf(sp.wi, wo)) : 1.0f;
+    const float weight = (mis && !ls->delta) ? balance_heuristic(pdf_light, pdf_bsdf) : 1.0f;
     return f * ls->Le * (std::abs(wo.z) * weight / pdf_light);
 }
 

@@ -35,6 +35,9 @@ public:
     bool intersect(const Ray& ray, RawHit& hit) const;
     bool occluded(const Ray& ray) const;
 
+    // The Embree scene itself, for benchmarks that measure Embree's raw throughput on it.
+    RTCSceneTy* embree_scene() const { return scene_; }
+
 private:
     RTCDeviceTy* device_ = nullptr;
     RTCSceneTy* scene_ = nullptr;

@@ -32,6 +32,19 @@ struct Material {
     float pdf(const Vec3f& wi, const Vec3f& wo) const {
         return std::visit([&](const auto& m) { return m.pdf(wi, wo); }, model);
     }
+    // eval() and pdf() together, for models that can share work between them.
+    Rgb eval_and_pdf(const Vec3f& wi, const Vec3f& wo, float& pdf) const {
+        return std::visit(
+            [&](const auto& m) {
+                if constexpr (requires { m.eval_and_pdf(wi, wo, pdf); }) {
+                    return m.eval_and_pdf(wi, wo, pdf);
+                } else {
+                    pdf = m.pdf(wi, wo);
+                    return m.eval(wi, wo);
+                }
+            },
+            model);
+    }
     std::optional<BsdfSample> sample(const Vec3f& wi, const Vec2f& u) const {
         return std::visit([&](const auto& m) { return m.sample(wi, u); }, model);
     }

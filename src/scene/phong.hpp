@@ -41,21 +41,32 @@ struct PhongMaterial {
     }
 
     Rgb eval(const Vec3f& wi, const Vec3f& wo) const {
-        if (wi.z <= 0 || wo.z <= 0) return Rgb(0.0f);
-        Rgb f = diffuse * kInvPi;
-        if (!is_black(specular)) {
-            const float cos_alpha = dot(mirror(wi), wo);
-            if (cos_alpha > 0) f += specular * ((exponent + 2) / (2 * kPi) * std::pow(cos_alpha, exponent));
-        }
-        return f;
+        float unused;
+        return eval_and_pdf(wi, wo, unused);
     }
 
     float pdf(const Vec3f& wi, const Vec3f& wo) const {
-        if (wi.z <= 0 || wo.z <= 0) return 0.0f;
-        const float pd = diffuse_probability();
-        float p = pd * cosine_hemisphere_pdf(wo);
-        if (pd < 1) p += (1 - pd) * power_cosine_pdf(dot(mirror(wi), wo), exponent);
+        float p;
+        eval_and_pdf(wi, wo, p);
         return p;
+    }
+
+    // Both at once, sharing the one pow() they need (the hot path of light sampling with MIS).
+    Rgb eval_and_pdf(const Vec3f& wi, const Vec3f& wo, float& pdf) const {
+        pdf = 0;
+        if (wi.z <= 0 || wo.z <= 0) return Rgb(0.0f);
+        const float pd = diffuse_probability();
+        Rgb f = diffuse * kInvPi;
+        pdf = pd * cosine_hemisphere_pdf(wo);
+        if (pd < 1) {
+            const float cos_alpha = dot(mirror(wi), wo);
+            if (cos_alpha > 0) {
+                const float lobe = std::pow(cos_alpha, exponent) * (1 / (2 * kPi));  // cos^n / (2 pi)
+                f += specular * ((exponent + 2) * lobe);
+                pdf += (1 - pd) * (exponent + 1) * lobe;  // the normalised cos^n lobe, as power_cosine_pdf
+            }
+        }
+        return f;
     }
 
     std::optional<BsdfSample> sample(const Vec3f& wi, Vec2f u) const {
@@ -70,9 +81,10 @@ struct PhongMaterial {
             wo = Frame(mirror(wi)).to_world(square_to_power_cosine(u, exponent));
         }
         if (wo.z <= 0) return std::nullopt;
-        const float p = pdf(wi, wo);
+        float p;
+        const Rgb f = eval_and_pdf(wi, wo, p);
         if (!(p > 0)) return std::nullopt;
-        return BsdfSample{wo, eval(wi, wo), p, false};
+        return BsdfSample{wo, f, p, false};
     }
 
     static Vec3f mirror(const Vec3f& w) { return {-w.x, -w.y, w.z}; }

@@ -61,6 +61,7 @@ public:
     LightChoice choose_light(float u) const;
     float light_pmf(int index) const { return pmf_[size_t(index)]; }
 
+    const Accel& accel() const { return accel_; }
     Vec3f bounds_center() const { return center_; }
     float bounds_radius() const { return radius_; }
 

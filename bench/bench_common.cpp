@@ -7,7 +7,7 @@
 namespace pathlab::bench {
 
 RenderResult run(const Scene& scene, const std::string& algorithm, int size, int spp, double seconds, uint64_t seed,
-                 std::function<void(const Film&, const RenderStats&)> after_pass) {
+                 std::function<void(const Film&, const RenderStats&)> after_pass, SamplerKind sampler) {
     const auto estimator = find_estimator(algorithm)->make({});
     RenderSettings rs;
     rs.width = rs.height = size;
@@ -15,6 +15,7 @@ RenderResult run(const Scene& scene, const std::string& algorithm, int size, int
     rs.time_limit = seconds;
     rs.seed = seed;
     rs.after_pass = std::move(after_pass);
+    rs.sampler = sampler;
     return render(scene, *estimator, rs);
 }
 

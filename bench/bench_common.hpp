@@ -37,7 +37,8 @@ inline double rmse(const Image& img, const Reference& ref) {
 
 // One render of `size` x `size` pixels: `spp` samples per pixel, or (spp = 0) `seconds`.
 RenderResult run(const Scene& scene, const std::string& algorithm, int size, int spp, double seconds, uint64_t seed,
-                 std::function<void(const Film&, const RenderStats&)> after_pass = {});
+                 std::function<void(const Film&, const RenderStats&)> after_pass = {},
+                 SamplerKind sampler = SamplerKind::Independent);
 Reference make_reference(const Scene& scene, const std::string& algorithm, int size, int spp);
 
 // Peak resident set size of this process so far, in MiB.

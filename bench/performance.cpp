@@ -5,8 +5,8 @@
 //      for pathlab's rays/s, and pathlab's own intersect() on the same rays;
 //   3. BVH build time and per-sample cost as a tessellated sphere of 1k..1M triangles is added
 //      to the box;
-//   4. efficiency of pt-mis: RMSE against a high-spp reference after 5, 10 and 20 seconds and
-//      1/(MSE x seconds);
+//   4. efficiency of pt-mis with the independent and the Sobol sampler: RMSE against a
+//      high-spp reference after 5, 10 and 20 seconds, and 1/(MSE x seconds);
 // plus peak resident memory. Every figure is a median over repeats measured in this one
 // process, so ratios are meaningful on a shared machine. Markdown tables go to stdout, all
 // figures to a JSON file (rewritten after each section, so an interrupted run keeps them).
@@ -263,34 +263,42 @@ void performance_suite(const PerfOptions& o) {
     // 4: efficiency of pt-mis over time.
     fmt::print("\n## pt-mis efficiency at {0}x{0}: reference {1} spp; checkpoints of one progressive render\n\n",
                o.efficiency_size, o.efficiency_ref_spp);
-    fmt::print("| scene | seconds | spp | RMSE | 1/(MSE x s) |\n|---|---|---|---|---|\n");
+    fmt::print("| scene | sampler | seconds | spp | RMSE | 1/(MSE x s) |\n|---|---|---|---|---|---|\n");
     for (int index : o.scenes) {
         const auto scene = Scene::build(make_builtin_scene(index));
         const std::string name = fmt::format("{} {}", index, builtin_scenes()[size_t(index)].name);
         const Reference ref = with_threads(max_threads, [&] {
             return make_reference(*scene, "pt-mis", o.efficiency_size, o.efficiency_ref_spp);
         });
-        // Checkpoints during one progressive render; the last is the render's end.
-        const auto record = [&](const Film& film, const RenderStats& st) {
-            const double e = rmse(film.mean(), ref);
-            const double efficiency = 1.0 / (e * e * st.seconds);
-            fmt::print("| {} | {:.2f} | {} | {:.5f} | {:.4g} |\n", name, st.seconds, st.spp, e, efficiency);
-            std::fflush(stdout);
-            report["efficiency"].push_back(
-                {{"scene", name}, {"seconds", st.seconds}, {"spp", st.spp}, {"rmse", e}, {"inverse_mse_seconds", efficiency}});
-        };
-        size_t next = 0;
-        const auto checkpoint = [&](const Film& film, const RenderStats& st) {
-            if (next + 1 >= o.checkpoints.size() || st.seconds < o.checkpoints[next]) return;
-            record(film, st);
-            while (next + 1 < o.checkpoints.size() && st.seconds >= o.checkpoints[next]) ++next;
-        };
-        const RenderResult r = with_threads(max_threads, [&] {
-            return run(*scene, "pt-mis", o.efficiency_size, 0, o.checkpoints.back(), 77, checkpoint);
-        });
-        record(r.film, r.stats);
+        for (const SamplerKind kind : {SamplerKind::Independent, SamplerKind::Sobol}) {
+            const char* sampler = kind == SamplerKind::Sobol ? "sobol" : "independent";
+            // Checkpoints during one progressive render; the last is the render's end.
+            const auto record = [&](const Film& film, const RenderStats& st) {
+                const double e = rmse(film.mean(), ref);
+                const double efficiency = 1.0 / (e * e * st.seconds);
+                fmt::print("| {} | {} | {:.2f} | {} | {:.5f} | {:.4g} |\n", name, sampler, st.seconds, st.spp, e, efficiency);
+                std::fflush(stdout);
+                report["efficiency"].push_back({{"scene", name},
+                                                {"sampler", sampler},
+                                                {"seconds", st.seconds},
+                                                {"spp", st.spp},
+                                                {"rmse", e},
+                                                {"inverse_mse_seconds", efficiency}});
+            };
+            size_t next = 0;
+            const auto checkpoint = [&](const Film& film, const RenderStats& st) {
+                if (next + 1 >= o.checkpoints.size() || st.seconds < o.checkpoints[next]) return;
+                record(film, st);
+                while (next + 1 < o.checkpoints.size() && st.seconds >= o.checkpoints[next]) ++next;
+            };
+            const RenderResult r = with_threads(max_threads, [&] {
+                return run(*scene, "pt-mis", o.efficiency_size, 0, o.checkpoints.back(), 77, checkpoint, kind);
+            });
+            record(r.film, r.stats);
+        }
         save(report, o.json);
     }
+
     // Heap allocations per sample of a whole render (driver included), all threads.
     {
         const auto scene = Scene::build(make_builtin_scene(o.scenes.front()));

@@ -10,7 +10,7 @@
 namespace pathlab::test {
 namespace {
 
-RenderResult render_with(int threads, int tile_size, uint64_t seed = 5) {
+RenderResult render_with(int threads, int tile_size, uint64_t seed = 5, SamplerKind sampler = SamplerKind::Independent) {
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
     const auto scene = Scene::build(make_builtin_scene(3));
     const auto estimator = find_estimator("direct-light")->make({});
@@ -20,6 +20,7 @@ RenderResult render_with(int threads, int tile_size, uint64_t seed = 5) {
     rs.spp = 6;
     rs.seed = seed;
     rs.tile_size = tile_size;
+    rs.sampler = sampler;
     return render(*scene, *estimator, rs);
 }
 
@@ -32,6 +33,12 @@ TEST(Determinism, OneAndTwoThreadsGiveBitIdenticalImages) {
     EXPECT_TRUE(bit_identical(one.film.mean(), two.film.mean()));
     EXPECT_TRUE(bit_identical(one.film.standard_error(), two.film.standard_error()));
     EXPECT_EQ(one.stats.rays, two.stats.rays);
+}
+
+TEST(Determinism, SobolSamplingIsDeterministicToo) {
+    const RenderResult one = render_with(1, 16, 5, SamplerKind::Sobol), two = render_with(2, 9, 5, SamplerKind::Sobol);
+    EXPECT_TRUE(bit_identical(one.film.mean(), two.film.mean()));
+    EXPECT_FALSE(bit_identical(one.film.mean(), render_with(2, 16, 5).film.mean()));  // it is another sampler
 }
 
 TEST(Determinism, TileSizeDoesNotChangeTheImage) {

@@ -16,6 +16,7 @@ struct RenderCommandOptions {
     double time_limit = 0;
     std::string resolution;  // "WxH"; empty: the scene's own
     uint64_t seed = 1234;
+    std::string sampler = "independent";
     int threads = 0;
     std::vector<std::string> outputs;
     float exposure = 0;

@@ -56,7 +56,7 @@ RenderResult render(const Scene& scene, const Estimator& estimator, const Render
                     for (int x = x0; x < std::min(x0 + ts, w); ++x) {
                         const size_t pixel = size_t(y) * size_t(w) + size_t(x);
                         for (int k = 0; k < passes; ++k) {
-                            Sampler sampler(settings.seed, pixel, settings.first_sample + uint64_t(done + k));
+                            Sampler sampler(settings.seed, pixel, settings.first_sample + uint64_t(done + k), settings.sampler);
                             const Vec2f jitter = sampler.next2d();
                             const Ray ray = camera.generate(float(x) + jitter.x, float(y) + jitter.y);
                             const Rgb L = estimator.radiance(scene, ray, sampler);

@@ -12,6 +12,9 @@
 #include "core/image_io.hpp"
 #include "render/renderer.hpp"
 #include "scene/builtin_scenes.hpp"
+#include "scenefile/scene_file.hpp"
+
+#include <filesystem>
 
 namespace pathlab {
 namespace {
@@ -31,7 +34,11 @@ std::string scene_list() {
     return out;
 }
 
-std::vector<SceneJob> resolve_scenes(const std::string& spec) {
+bool looks_like_scene_file(const std::string& key) {
+    return key.size() > 4 && key.compare(key.size() - 4, 4, ".xml") == 0;
+}
+
+std::vector<SceneJob> resolve_scenes(const std::string& spec, const SceneDefines& defines) {
     std::vector<SceneJob> jobs;
     const auto add_builtin = [&](int i) {
         jobs.push_back({builtin_scenes()[size_t(i)].name, std::to_string(i), make_builtin_scene(i)});
@@ -44,9 +51,21 @@ std::vector<SceneJob> resolve_scenes(const std::string& spec) {
     while (start <= spec.size()) {
         const size_t comma = std::min(spec.find(',', start), spec.size());
         const std::string key = spec.substr(start, comma - start);
+        if (looks_like_scene_file(key)) {
+            // Scene-file errors (file:line:column) are usage errors: exit code 2.
+            try {
+                const std::string stem = std::filesystem::path(key).stem().string();
+                jobs.push_back({stem, stem, load_scene_file(key, defines)});
+            } catch (const SceneFileError& e) {
+                throw UsageError(e.what());
+            }
+            start = comma + 1;
+            continue;
+        }
         const auto index = find_builtin_scene(key);
         if (!index)
-            throw UsageError(fmt::format("unknown scene '{}'. Valid scenes (index or name, comma-separated, or 'all'):{}",
+            throw UsageError(fmt::format("unknown scene '{}'. Valid scenes (index or name, comma-separated, or 'all'), "
+                                         "or a scene file ending in .xml:{}",
                                          key, scene_list()));
         add_builtin(*index);
         start = comma + 1;
@@ -93,10 +112,13 @@ bool parse_resolution(const std::string& text, int& width, int& height) {
 }
 
 void add_render_options(CLI::App& app, RenderCommandOptions& o) {
-    app.add_option("-s,--scene", o.scene, "Scene: course index 0-7, name (see `pathlab scenes`), a comma-separated list, or 'all'")
+    app.add_option("-s,--scene", o.scene,
+                   "Scene: course index 0-7, name (see `pathlab scenes`), a scene file (.xml), a comma-separated list, or 'all'")
         ->capture_default_str();
-    app.add_option("-a,--algorithm", o.algorithm, "Estimator name or course alias (see `pathlab algorithms`)")
-        ->capture_default_str();
+    app.add_option_function<std::string>(
+        "-a,--algorithm", [&o](const std::string& v) { o.algorithm = v, o.algorithm_given = true; },
+        "Estimator name or course alias (see `pathlab algorithms`); default: the scene file's integrator, else pt-mis");
+    app.add_option("-D,--define", o.defines, "name=value for $name in scene files (repeatable; overrides <default>)");
     app.add_option_function<int>("--spp", [&o](const int& v) { o.spp = v, o.spp_given = true; },
                                  fmt::format("Samples per pixel (default {}, or unlimited with --time)", kDefaultSpp));
     app.add_option("--time", o.time_limit, "Time budget in seconds per scene (stops at --spp if that comes first)");
@@ -112,15 +134,30 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
                    "{algorithm}. Default: out/{index}-{scene}-{algorithm}.exr and .png");
     app.add_option("--exposure", o.exposure, "Exposure in stops for .png output")->capture_default_str();
     app.add_option("--stats", o.stats_path, "Write render statistics as JSON (placeholders as for -o)");
-    app.add_option("--max-depth", o.max_depth, "Longest path in bounces (-1: unlimited)")->capture_default_str();
+    app.add_option_function<int>("--max-depth", [&o](const int& v) { o.max_depth = v, o.max_depth_given = true; },
+                                 "Longest path in bounces (-1: unlimited; default: the scene file's, else -1)");
     app.add_option("--rr-depth", o.rr_depth, "Bounces before Russian roulette starts")->capture_default_str();
     app.add_flag("-q,--quiet", o.quiet, "No progress line and no summary");
 }
 
 int run_render_command(const RenderCommandOptions& o) {
-    const EstimatorInfo* est_info = find_estimator(o.algorithm);
-    if (!est_info) throw UsageError(fmt::format("unknown algorithm '{}'. Valid algorithms: {}", o.algorithm, estimator_names()));
-    std::vector<SceneJob> jobs = resolve_scenes(o.scene);
+    if (o.algorithm_given && !find_estimator(o.algorithm))
+        throw UsageError(fmt::format("unknown algorithm '{}'. Valid algorithms: {}", o.algorithm, estimator_names()));
+    SceneDefines defines;
+    for (const std::string& d : o.defines) {
+        const size_t eq = d.find('=');
+        if (eq == std::string::npos || eq == 0)
+            throw UsageError(fmt::format("invalid -D '{}': expected name=value", d));
+        defines[d.substr(0, eq)] = d.substr(eq + 1);
+    }
+    std::vector<SceneJob> jobs = resolve_scenes(o.scene, defines);
+    // Each job's estimator: --algorithm, else the scene file's integrator, else pt-mis.
+    std::vector<const EstimatorInfo*> job_estimators;
+    for (const SceneJob& job : jobs) {
+        const std::string name = o.algorithm_given ? o.algorithm : job.desc.algorithm.value_or(o.algorithm);
+        job_estimators.push_back(find_estimator(name));
+        if (!job_estimators.back()) throw UsageError(fmt::format("unknown algorithm '{}'. Valid algorithms: {}", name, estimator_names()));
+    }
 
     int width = 0, height = 0;
     if (!o.resolution.empty() && !parse_resolution(o.resolution, width, height))
@@ -141,7 +178,7 @@ int run_render_command(const RenderCommandOptions& o) {
         for (const std::string& p : patterns) {
             std::string path;
             try {
-                path = expand_output(p, jobs[j], est_info->name);
+                path = expand_output(p, jobs[j], job_estimators[j]->name);
             } catch (const fmt::format_error& e) {
                 throw UsageError(fmt::format("invalid output pattern '{}': {} (placeholders: {{scene}}, {{index}}, {{algorithm}})", p, e.what()));
             }
@@ -163,20 +200,22 @@ int run_render_command(const RenderCommandOptions& o) {
     if (o.threads > 0) thread_limit.emplace(tbb::global_control::max_allowed_parallelism, size_t(o.threads));
     const int threads = int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
 
-    EstimatorOptions est_opt;
-    est_opt.max_depth = o.max_depth;
-    est_opt.rr_depth = o.rr_depth;
-    const std::unique_ptr<Estimator> estimator = est_info->make(est_opt);
     const bool show_progress = !o.quiet && isatty(STDERR_FILENO);
 
     InterruptGuard interrupt;
     for (size_t j = 0; j < jobs.size(); ++j) {
         const SceneJob& job = jobs[j];
+        const EstimatorInfo* est_info = job_estimators[j];
+        EstimatorOptions est_opt;
+        est_opt.max_depth = o.max_depth_given ? o.max_depth : job.desc.max_depth.value_or(o.max_depth);
+        est_opt.rr_depth = o.rr_depth;
+        const std::unique_ptr<Estimator> estimator = est_info->make(est_opt);
         const std::unique_ptr<Scene> scene = Scene::build(job.desc);
         RenderSettings rs;
         rs.width = width;
         rs.height = height;
-        rs.spp = o.spp_given ? o.spp : (o.time_limit > 0 ? 0 : kDefaultSpp);
+        // --spp, else (without --time) the scene file's sample_count, else 64.
+        rs.spp = o.spp_given ? o.spp : (o.time_limit > 0 ? 0 : job.desc.spp.value_or(kDefaultSpp));
         rs.time_limit = o.time_limit;
         rs.seed = o.seed;
         rs.sampler = o.sampler == "sobol" ? SamplerKind::Sobol : SamplerKind::Independent;

@@ -10,7 +10,8 @@ namespace pathlab {
 
 struct RenderCommandOptions {
     std::string scene = "all";
-    std::string algorithm = "pt-mis";
+    std::string algorithm = "pt-mis";  // a scene file's <integrator> is used unless given
+    bool algorithm_given = false;
     int spp = 0;
     bool spp_given = false;  // otherwise 64, or unlimited when --time is given
     double time_limit = 0;
@@ -22,6 +23,8 @@ struct RenderCommandOptions {
     float exposure = 0;
     std::string stats_path;
     int max_depth = -1;
+    bool max_depth_given = false;
+    std::vector<std::string> defines;  // -D name=value, for scene files
     int rr_depth = 3;
     bool quiet = false;
 };

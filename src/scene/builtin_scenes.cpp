@@ -59,8 +59,10 @@ SceneDescription make_course_scene(const BuiltinSceneInfo& info, LightKind light
     SceneDescription d;
     d.name = info.name;
     d.width = d.height = 512;
-    d.camera = Camera::look_along({-0.0439815f, -4.12529f, 0.222539f}, {0.00688625f, 0.998505f, -0.0542161f},
-                                  {3.73896e-4f, 0.0542148f, 0.998529f}, 45.0f, FovAxis::EachAxis);
+    // The course gives the forward direction (0.00688625, 0.998505, -0.0542161); the target is
+    // position + forward rounded to float, so scene files (which use look-at) reproduce it exactly.
+    d.camera = Camera::look_at({-0.0439815f, -4.12529f, 0.222539f}, {-0.0370952487f, -3.1267848f, 0.168322891f},
+                               {3.73896e-4f, 0.0542148f, 0.998529f}, 45.0f, FovAxis::EachAxis);
     d.materials = course_materials(glossy);
 
     d.meshes.push_back(make_mesh("floor", kBox, {{0, 4, 5}, {5, 1, 0}}, kFloor));

@@ -21,6 +21,10 @@ struct Camera {
     float fov_degrees = 45;
     FovAxis fov_axis = FovAxis::EachAxis;
 
+    // Looks from `origin` towards `target` (forward = normalize(target - origin)).
+    static Camera look_at(const Vec3f& origin, const Vec3f& target, const Vec3f& up_hint, float fov_degrees, FovAxis axis) {
+        return look_along(origin, target - origin, up_hint, fov_degrees, axis);
+    }
     // Builds right = normalize(forward x up_hint), up = right x forward.
     static Camera look_along(const Vec3f& position, const Vec3f& forward, const Vec3f& up_hint, float fov_degrees,
                              FovAxis axis) {

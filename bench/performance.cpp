@@ -59,15 +59,28 @@ struct Throughput {
     double msamples = 0, mrays = 0;
 };
 
-Throughput measure_throughput(const Scene& scene, const std::string& algorithm, const PerfOptions& o, int threads) {
-    std::vector<double> s, r;
+Throughput timed_render(const Scene& scene, const std::string& algorithm, int size, double seconds, int threads,
+                        uint64_t seed) {
+    const RenderResult r = with_threads(threads, [&] { return run(scene, algorithm, size, 0, seconds, seed); });
+    return {double(r.stats.samples) / r.stats.seconds * 1e-6, double(r.stats.rays) / r.stats.seconds * 1e-6};
+}
+
+// One-thread and N-thread throughput measured back to back, `repeats` times: medians of each,
+// and the median of the per-pair ratios (robust to load that comes and goes between pairs).
+struct Scaling {
+    Throughput one, many;
+    double ratio = 0;
+};
+
+Scaling measure_scaling(const Scene& scene, const std::string& algorithm, const PerfOptions& o, int threads) {
+    std::vector<double> s1, r1, sn, rn, ratio;
     for (int k = 0; k < o.repeats; ++k) {
-        const RenderResult res =
-            with_threads(threads, [&] { return run(scene, algorithm, o.size, 0, o.seconds, 10 + uint64_t(k)); });
-        s.push_back(double(res.stats.samples) / res.stats.seconds * 1e-6);
-        r.push_back(double(res.stats.rays) / res.stats.seconds * 1e-6);
+        const Throughput a = timed_render(scene, algorithm, o.size, o.seconds, 1, 10 + uint64_t(k));
+        const Throughput b = timed_render(scene, algorithm, o.size, o.seconds, threads, 10 + uint64_t(k));
+        s1.push_back(a.msamples), r1.push_back(a.mrays), sn.push_back(b.msamples), rn.push_back(b.mrays);
+        ratio.push_back(b.msamples / a.msamples);
     }
-    return {median(s), median(r)};
+    return {{median(s1), median(r1)}, {median(sn), median(rn)}, median(ratio)};
 }
 
 // ---- 2. raw Embree throughput -----------------------------------------------------------
@@ -118,15 +131,11 @@ double raw_mrays(const Scene& scene, const std::vector<Ray>& rays, int threads, 
             },
             std::plus<size_t>());
     };
-    std::vector<double> rates;
-    for (int k = 0; k < 5; ++k) {
-        const auto t0 = Clock::now();
-        const size_t hits = with_threads(threads, trace);
-        const double s = seconds_since(t0);
-        if (hits == 0) throw std::runtime_error("no ray hit the scene: the raw benchmark is broken");
-        rates.push_back(double(rays.size()) / s * 1e-6);
-    }
-    return median(rates);
+    const auto t0 = Clock::now();
+    const size_t hits = with_threads(threads, trace);
+    const double s = seconds_since(t0);
+    if (hits == 0) throw std::runtime_error("no ray hit the scene: the raw benchmark is broken");
+    return double(rays.size()) / s * 1e-6;
 }
 
 // ---- 3. scene growth ---------------------------------------------------------------------
@@ -178,12 +187,10 @@ void performance_suite(const PerfOptions& o) {
     for (int index : o.scenes) {
         const auto scene = Scene::build(make_builtin_scene(index));
         const std::string name = fmt::format("{} {}", index, builtin_scenes()[size_t(index)].name);
-        double pt_mis_mrays = 0;
         for (const EstimatorInfo& e : estimators()) {
-            const Throughput one = measure_throughput(*scene, e.name, o, 1);
-            const Throughput many = measure_throughput(*scene, e.name, o, max_threads);
-            const double scaling = many.msamples / one.msamples;
-            if (e.name == "pt-mis") pt_mis_mrays = many.mrays;
+            const Scaling sc = measure_scaling(*scene, e.name, o, max_threads);
+            const Throughput &one = sc.one, &many = sc.many;
+            const double scaling = sc.ratio;
             fmt::print("| {} | {} | {:.3f} | {:.3f} | {:.2f}x | {:.2f} | {:.2f} |\n", name, e.name, one.msamples,
                        many.msamples, scaling, many.mrays, many.mrays / many.msamples);
             std::fflush(stdout);
@@ -196,27 +203,36 @@ void performance_suite(const PerfOptions& o) {
                                             {"mrays_per_s_1_thread", one.mrays},
                                             {"mrays_per_s", many.mrays}});
         }
+        // Embree alone, pathlab's intersect() and a pt-mis render, back to back, 5 times; the
+        // fraction is the median of the per-round ratios pt-mis / Embree.
         const std::vector<Ray> rays = incoherent_rays(*scene, o.raw_rays);
-        nlohmann::json b = {{"scene", name}, {"rays", o.raw_rays}};
-        for (int t : {1, max_threads}) {
-            b[fmt::format("embree_mrays_{}_thread", t)] = raw_mrays(*scene, rays, t, false);
-            b[fmt::format("pathlab_intersect_mrays_{}_thread", t)] = raw_mrays(*scene, rays, t, true);
+        nlohmann::json b = {{"scene", name}, {"rays", o.raw_rays}, {"threads", max_threads}};
+        std::vector<double> e1, en, pn, pt, fraction;
+        for (int k = 0; k < 5; ++k) {
+            e1.push_back(raw_mrays(*scene, rays, 1, false));
+            en.push_back(raw_mrays(*scene, rays, max_threads, false));
+            pn.push_back(raw_mrays(*scene, rays, max_threads, true));
+            pt.push_back(timed_render(*scene, "pt-mis", o.size, o.seconds, max_threads, 30 + uint64_t(k)).mrays);
+            fraction.push_back(pt.back() / en.back());
         }
-        b["pt_mis_mrays"] = pt_mis_mrays;
-        b["pt_mis_fraction_of_embree"] = pt_mis_mrays / b[fmt::format("embree_mrays_{}_thread", max_threads)].get<double>();
+        b["embree_mrays_1_thread"] = median(e1);
+        b["embree_mrays"] = median(en);
+        b["pathlab_intersect_mrays"] = median(pn);
+        b["pt_mis_mrays"] = median(pt);
+        b["pt_mis_fraction_of_embree"] = median(fraction);
         bounds.emplace_back(index, b);
         report["embree_bound"].push_back(b);
         save(report, o.json);
     }
-    fmt::print("\n## Embree's raw throughput: incoherent closest-hit rays ({} rays, median of 5)\n\n", o.raw_rays);
+    fmt::print("\n## Embree's raw throughput: incoherent closest-hit rays ({} rays), against pathlab (medians of 5 rounds)\n\n",
+               o.raw_rays);
     fmt::print("| scene | Embree Mrays/s 1 thr | Embree Mrays/s {0} thr | pathlab intersect() Mrays/s {0} thr | pt-mis Mrays/s {0} thr | pt-mis / Embree |\n",
                max_threads);
     fmt::print("|---|---|---|---|---|---|\n");
     for (const auto& [index, b] : bounds)
         fmt::print("| {} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {:.0f}% |\n", b["scene"].get<std::string>(),
-                   b["embree_mrays_1_thread"].get<double>(),
-                   b[fmt::format("embree_mrays_{}_thread", max_threads)].get<double>(),
-                   b[fmt::format("pathlab_intersect_mrays_{}_thread", max_threads)].get<double>(),
+                   b["embree_mrays_1_thread"].get<double>(), b["embree_mrays"].get<double>(),
+                   b["pathlab_intersect_mrays"].get<double>(),
                    b["pt_mis_mrays"].get<double>(), 100 * b["pt_mis_fraction_of_embree"].get<double>());
 
     // 3: scene growth.
@@ -224,7 +240,15 @@ void performance_suite(const PerfOptions& o) {
                max_threads);
     fmt::print("| triangles added | BVH build (ms) | us per sample | relative to plain box | rays/sample | peak RSS (MiB) |\n");
     fmt::print("|---|---|---|---|---|---|\n");
-    double base_cost = 0;
+    // Each size is timed in rounds against the plain box (back to back); the relative cost is
+    // the median of the per-round ratios.
+    const auto plain_box = Scene::build(make_builtin_scene(3));
+    const auto us_per_sample = [&](const Scene& scene, uint64_t seed, double* rays_per_sample) {
+        const RenderResult r =
+            with_threads(max_threads, [&] { return run(scene, "pt-mis", o.growth_size, 0, o.seconds, seed); });
+        if (rays_per_sample) *rays_per_sample = double(r.stats.rays) / double(r.stats.samples);
+        return r.stats.seconds / double(r.stats.samples) * 1e6;
+    };
     for (size_t n : o.mesh_sizes) {
         SceneDescription d = make_builtin_scene(3);
         if (n > 0) {
@@ -235,26 +259,27 @@ void performance_suite(const PerfOptions& o) {
         std::vector<double> builds;
         std::unique_ptr<Scene> scene;
         for (int k = 0; k < 3; ++k) {
+            scene.reset();
             const auto t0 = Clock::now();
             scene = with_threads(max_threads, [&] { return Scene::build(d); });
             builds.push_back(seconds_since(t0) * 1e3);
         }
-        std::vector<double> cost, rps;
+        std::vector<double> cost, relative, rps;
         for (int k = 0; k < o.repeats; ++k) {
-            const RenderResult r = with_threads(
-                max_threads, [&] { return run(*scene, "pt-mis", o.growth_size, 0, o.seconds, 20 + uint64_t(k)); });
-            cost.push_back(r.stats.seconds / double(r.stats.samples) * 1e6);
-            rps.push_back(double(r.stats.rays) / double(r.stats.samples));
+            double r = 0;
+            const double base = us_per_sample(*plain_box, 20 + uint64_t(k), nullptr);
+            cost.push_back(us_per_sample(*scene, 20 + uint64_t(k), &r));
+            relative.push_back(cost.back() / base);
+            rps.push_back(r);
         }
         const double us = median(cost);
-        if (n == 0) base_cost = us;
-        fmt::print("| {} | {:.1f} | {:.3f} | {:.2f}x | {:.2f} | {:.0f} |\n", triangles, median(builds), us, us / base_cost,
-                   median(rps), peak_rss_mib());
+        fmt::print("| {} | {:.1f} | {:.3f} | {:.2f}x | {:.2f} | {:.0f} |\n", triangles, median(builds), us,
+                   median(relative), median(rps), peak_rss_mib());
         std::fflush(stdout);
         report["growth"].push_back({{"triangles_added", triangles},
                                     {"bvh_build_ms", median(builds)},
                                     {"us_per_sample", us},
-                                    {"relative_cost", us / base_cost},
+                                    {"relative_cost", median(relative)},
                                     {"rays_per_sample", median(rps)},
                                     {"peak_rss_mib", peak_rss_mib()}});
         save(report, o.json);

@@ -161,3 +161,58 @@ TEST_F(Cli, InterruptedRenderWritesWhatItHasCorrectlyNormalised) {
 
 }  // namespace
 }  // namespace pathlab::test
+
+namespace pathlab::test {
+namespace {
+
+// A small scene file whose settings the command line may override.
+std::string write_scene(const std::string& file, const std::string& integrator = "direct") {
+    std::ofstream(file) << "<scene version=\"3.0.0\">\n"
+                           "  <default name=\"r\" value=\"0.5\"/>\n"
+                           "  <integrator type=\"" << integrator << "\"/>\n"
+                           "  <sensor type=\"perspective\"><transform name=\"to_world\"><lookat origin=\"0,-3,0\" target=\"0,0,0\" up=\"0,0,1\"/></transform>\n"
+                           "    <film type=\"hdrfilm\"><integer name=\"width\" value=\"20\"/><integer name=\"height\" value=\"10\"/></film>\n"
+                           "    <sampler type=\"independent\"><integer name=\"sample_count\" value=\"3\"/></sampler></sensor>\n"
+                           "  <shape type=\"sphere\"><float name=\"radius\" value=\"$r\"/></shape>\n"
+                           "  <emitter type=\"constant\"/>\n"
+                           "</scene>\n";
+    return file;
+}
+
+TEST_F(Cli, SceneFileSettingsApplyUnlessTheCommandLineGivesThem) {
+    const std::string scene = write_scene(path("ball.xml"));
+    CliResult r = run({"--scene", scene, "-q", "-o", path("{scene}-{algorithm}.pfm"), "--stats", path("a.json")});
+    ASSERT_EQ(r.code, 0) << r.err;
+    nlohmann::json j = nlohmann::json::parse(std::ifstream(path("a.json")));
+    EXPECT_EQ(j["algorithm"], "direct-mis");  // <integrator type="direct">
+    EXPECT_EQ(j["spp"], 3);
+    EXPECT_EQ(j["resolution"], nlohmann::json::array({20, 10}));
+    EXPECT_TRUE(fs::exists(path("ball-direct-mis.pfm")));
+
+    r = run({"--scene", scene, "-q", "-a", "pt-mis", "--spp", "2", "--resolution", "8x4", "-D", "r=0.25", "-o",
+             path("b.pfm"), "--stats", path("b.json")});
+    ASSERT_EQ(r.code, 0) << r.err;
+    j = nlohmann::json::parse(std::ifstream(path("b.json")));
+    EXPECT_EQ(j["algorithm"], "pt-mis");
+    EXPECT_EQ(j["spp"], 2);
+    EXPECT_EQ(j["resolution"], nlohmann::json::array({8, 4}));
+}
+
+TEST_F(Cli, SceneFileErrorsGiveFileLineColumnAndExitCode2) {
+    std::ofstream(path("bad.xml")) << "<scene version=\"3.0.0\">\n  <shape type=\"torus\"/>\n</scene>\n";
+    CliResult r = run({"--scene", path("bad.xml"), "-o", path("x.exr")});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_TRUE(contains(r.err, path("bad.xml") + ":2:3: error: unsupported shape type 'torus'")) << r.err;
+    r = run({"--scene", path("missing.xml"), "-o", path("x.exr")});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_TRUE(contains(r.err, "missing.xml: error: cannot open the scene file")) << r.err;
+    r = run({"--scene", write_scene(path("ok.xml")), "-D", "novalue", "-o", path("x.exr")});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_TRUE(contains(r.err, "expected name=value")) << r.err;
+    r = run({"--scene", write_scene(path("odd.xml"), "volpath"), "-o", path("x.exr")});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_TRUE(contains(r.err, "unsupported integrator type 'volpath'")) << r.err;
+}
+
+}  // namespace
+}  // namespace pathlab::test

@@ -65,11 +65,18 @@ std::unique_ptr<Scene> Scene::build(const SceneDescription& desc) {
     }
 
     Vec3f lo(kInf), hi(-kInf);
+    s->face_normals_.reserve(desc.meshes.size());  // stable addresses for the records
     for (size_t i = 0; i < desc.meshes.size(); ++i) {
         const MeshDesc& m = desc.meshes[i];
         const uint32_t id = s->accel_.add_mesh(m);
         if (id >= s->geometry_.size()) s->geometry_.resize(id + 1);
-        GeometryRecord rec{false, uint32_t(i), -1};
+        std::vector<Vec3f> normals(m.triangles.size());
+        for (size_t t = 0; t < m.triangles.size(); ++t) {
+            const auto& tri = m.triangles[t];
+            normals[t] = normalize(cross(m.positions[tri[1]] - m.positions[tri[0]], m.positions[tri[2]] - m.positions[tri[0]]));
+        }
+        s->face_normals_.push_back(std::move(normals));
+        GeometryRecord rec{false, uint32_t(i), -1, &s->desc_.meshes[i], s->face_normals_.back().data()};
         if (!is_black(m.emission)) {
             rec.first_light = int32_t(s->lights_.size());
             for (const auto& t : m.triangles)
@@ -146,12 +153,12 @@ bool Scene::intersect(const Ray& ray, Intersection& hit) const {
         hit.material = sp.material;
         hit.light = rec.first_light;
     } else {
-        const MeshDesc& m = desc_.meshes[rec.index];
+        const MeshDesc& m = *rec.mesh;
         const auto& tri = m.triangles[raw.prim_id];
         const Vec3f &p0 = m.positions[tri[0]], &p1 = m.positions[tri[1]], &p2 = m.positions[tri[2]];
         const float b1 = raw.u, b2 = raw.v, b0 = 1 - b1 - b2;
         hit.p = p0 * b0 + p1 * b1 + p2 * b2;
-        hit.ng = normalize(cross(p1 - p0, p2 - p0));
+        hit.ng = rec.face_normals[raw.prim_id];
         hit.ns = hit.ng;
         if (!m.normals.empty()) {
             const Vec3f n = m.normals[tri[0]] * b0 + m.normals[tri[1]] * b1 + m.normals[tri[2]] * b2;

@@ -74,6 +74,8 @@ private:
         bool is_sphere = false;
         uint32_t index = 0;        // into desc_.meshes or desc_.spheres
         int32_t first_light = -1;  // area light of triangle k is first_light + k
+        const MeshDesc* mesh = nullptr;       // triangles: the mesh, and its unit face normals
+        const Vec3f* face_normals = nullptr;  // (computed once, not per hit)
     };
 
     SceneDescription desc_;
@@ -82,6 +84,7 @@ private:
     int width_ = 512, height_ = 512;
     Accel accel_;
     std::vector<GeometryRecord> geometry_;  // by Embree geometry id
+    std::vector<std::vector<Vec3f>> face_normals_;  // per mesh, per triangle
     std::vector<Material> materials_;
     std::vector<Light> lights_;
     std::vector<float> pmf_, cdf_;

@@ -218,7 +218,8 @@ private:
             const pugi::xml_node* n = find(name, {"integer"});
             if (!n) return fallback;
             const double v = l_.parse_number(*n, l_.attr(*n, "value"));
-            if (v != std::floor(v) || std::abs(v) > 1e9) l_.fail(*n, fmt::format("parameter '{}' must be an integer", name));
+            if (v != std::floor(v) || std::abs(v) > 1e9)
+                l_.fail(*n, fmt::format("parameter '{}' must be an integer of at most 1e9 in magnitude, got {}", name, l_.attr(*n, "value")));
             return int(v);
         }
         bool get_bool(const std::string& name, bool fallback) {
@@ -458,6 +459,8 @@ private:
             std::vector<pugi::xml_node> inner = plugin_children(n);
             if (inner.size() != 1 || std::string(inner[0].name()) != "bsdf")
                 fail(n, "<bsdf type=\"twosided\"> wraps exactly one nested <bsdf>");
+            if (std::string(inner[0].attribute("type").value()) == "twosided")  // also bounds the recursion
+                fail(inner[0], "a twosided BSDF cannot wrap another twosided BSDF");
             Properties(*this, n).check_all_used({});
             Material m = read_bsdf(inner[0]);
             if (m.is_dielectric()) fail(inner[0], "a dielectric cannot be wrapped in twosided (both of its sides already matter)");
@@ -675,6 +678,9 @@ SceneDescription load_scene_text(const std::string& text, const std::string& fil
 }
 
 SceneDescription load_scene_file(const std::string& path, const SceneDefines& defines) {
+    std::error_code ec;
+    if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
+        throw SceneFileError(path, 0, 0, "not a regular file");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw SceneFileError(path, 0, 0, fmt::format("cannot open the scene file: {}", std::strerror(errno)));
     std::ostringstream text;

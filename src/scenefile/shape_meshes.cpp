@@ -1,5 +1,7 @@
 #include "scenefile/shape_meshes.hpp"
 
+#include <filesystem>
+
 #include <tiny_obj_loader.h>
 
 #include <cmath>
@@ -45,6 +47,10 @@ MeshDesc load_obj_mesh(const std::string& path) {
     config.triangulate = true;
     config.vertex_color = false;
     config.mtl_search_path = "";
+    // Devices and directories would hang or confuse the parser (/dev/zero never ends).
+    std::error_code ec;
+    if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
+        throw MeshLoadError(fmt::format("cannot read mesh '{}': not a regular file", path));
     tinyobj::ObjReader reader;
     if (!reader.ParseFromFile(path, config)) {
         std::string why = reader.Error();

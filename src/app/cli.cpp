@@ -53,6 +53,8 @@ int run_cli(int argc, const char* const* argv) {
     CLI::App* reference_cmd = add_reference_command(app, reference_opt);
     CheckOptions check_opt;
     CLI::App* check_cmd = add_check_command(app, check_opt);
+    ReportOptions report_opt;
+    CLI::App* report_cmd = add_report_command(app, report_opt);
 
     try {
         app.parse(argc, argv);
@@ -87,6 +89,7 @@ int run_cli(int argc, const char* const* argv) {
         if (*compare_cmd) return run_compare_command(compare_opt);
         if (*reference_cmd) return run_reference_command(reference_opt);
         if (*check_cmd) return run_check_command(check_opt);
+        if (*report_cmd) return run_report_command(report_opt);
         return run_render_command(render_opt);
     } catch (const UsageError& e) {
         fmt::print(stderr, "pathlab: {}\n", e.what());

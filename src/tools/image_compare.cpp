@@ -78,3 +78,25 @@ bool image_metric(const ImageDifference& d, const std::string& name, double& val
 }
 
 }  // namespace pathlab
+
+namespace pathlab {
+
+double rmse_against_reference(const Image& image, const Image& reference, const Image& reference_se) {
+    if (image.width() != reference.width() || image.height() != reference.height())
+        throw ImageSizeMismatch(fmt::format("images differ in size: {}x{} and {}x{}", image.width(), image.height(),
+                                            reference.width(), reference.height()));
+    const bool noisy = reference_se.pixel_count() == reference.pixel_count();
+    double sum_sq = 0, noise = 0;
+    long n = 0;
+    for (size_t i = 0; i < image.pixel_count(); ++i)
+        for (int c = 0; c < 3; ++c) {
+            const double a = image[i][c], b = reference[i][c];
+            if (!std::isfinite(a) || !std::isfinite(b)) continue;
+            sum_sq += (a - b) * (a - b);
+            if (noisy) noise += double(reference_se[i][c]) * reference_se[i][c];
+            ++n;
+        }
+    return n ? std::sqrt(std::max(0.0, (sum_sq - noise) / double(n))) : 0.0;
+}
+
+}  // namespace pathlab

@@ -3,6 +3,7 @@
 // Chromium is installed, that it loads in a browser without console errors), and bad input.
 #include <gtest/gtest.h>
 
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -239,7 +240,7 @@ ReferenceFile course_png(int scene) {
 TEST(ToolsCheck, CoursePngVerdictPassesANoisyCorrectRender) {
     const RenderResult r = render_scene(make_builtin_scene(7), "direct-light", 512, 512, 16, 1234);
     const SceneVerdict v = judge_render(r.film.mean(), r.film.standard_error(), course_png(7));
-    EXPECT_EQ(v.verdict, Verdict::Ok) << v.detail;
+    EXPECT_STREQ(verdict_name(v.verdict), "OK") << v.detail;
 }
 
 TEST(ToolsCheck, CoursePngVerdictFailsWithoutTheReceiverCosine) {
@@ -249,7 +250,7 @@ TEST(ToolsCheck, CoursePngVerdictFailsWithoutTheReceiverCosine) {
     rs.seed = 1234;
     const RenderResult r = render(*scene, DirectLightWithoutCosine(), rs);
     const SceneVerdict v = judge_render(r.film.mean(), r.film.standard_error(), course_png(0));
-    EXPECT_EQ(v.verdict, Verdict::Fail) << v.detail;
+    EXPECT_STREQ(verdict_name(v.verdict), "FAIL") << v.detail;
 }
 
 TEST(ToolsCheck, ZeroVarianceMeansExactAgreementIsRequired) {
@@ -512,6 +513,22 @@ TEST_F(ToolsReport, LoadsInChromiumWithoutConsoleErrors) {
     EXPECT_TRUE(contains(dom, "zoomed at pixel (10, 5)"));
     std::istringstream lines(log);
     for (std::string line; std::getline(lines, line);) EXPECT_FALSE(contains(line, ":CONSOLE")) << line;
+}
+
+// Ctrl-C during a report: the renders so far are kept and the page is still written (exit 130).
+TEST_F(Tools, InterruptedReportStillWritesThePage) {
+    const std::string cmd = fmt::format(
+        "timeout --preserve-status -s INT 2 {} report --scene 2 --algorithms direct-light,direct-mis --spp 100000000 "
+        "--resolution 32x24 --reference-spp 64 -q -o {} 2> {}",
+        PATHLAB_BINARY, path("r.html"), path("err.txt"));
+    const int status = std::system(cmd.c_str());
+    ASSERT_TRUE(WIFEXITED(status)) << read_text(path("err.txt"));
+    EXPECT_EQ(WEXITSTATUS(status), 130) << read_text(path("err.txt"));
+    const std::string html = read_text(path("r.html"));
+    EXPECT_TRUE(contains(html, "Interrupted: direct-light stopped after")) << html.substr(0, 2000);
+    EXPECT_TRUE(contains(html, "Interrupted: direct-mis was not rendered."));
+    for (const std::string& s : image_sources(html))
+        if (s.rfind("data:", 0) != 0) EXPECT_TRUE(fs::exists(path(s))) << s;
 }
 
 TEST_F(Tools, ReportUsageErrors) {

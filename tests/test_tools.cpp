@@ -358,6 +358,12 @@ TEST_F(Tools, ReferenceThenCheckReportsOkMissingAndBlackByDesign) {
     EXPECT_EQ(r.code, 1);
     EXPECT_TRUE(contains(r.out, "ERROR")) << r.out;
     EXPECT_TRUE(contains(r.out, "12x10")) << r.out;
+
+    // An unreadable reference: an error naming the file, without rendering.
+    std::ofstream(path("refs/6-env-diffuse.exr")) << "not an EXR";
+    r = run({"check", "-a", "1", "--references", path("refs"), "--scene", "6", "--spp", "4"});
+    EXPECT_EQ(r.code, 1);
+    EXPECT_TRUE(std::regex_search(r.out, std::regex("6 env-diffuse +ERROR +6-env-diffuse.exr +.*6-env-diffuse.exr: cannot read"))) << r.out;
 }
 
 TEST_F(Tools, CheckUsageErrors) {

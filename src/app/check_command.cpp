@@ -39,18 +39,15 @@ std::map<int, uint64_t> reference_seeds(const std::string& dir) {
     return seeds;
 }
 
-// The size of a reference image (its resolution is the render's unless --resolution says otherwise).
-std::optional<std::pair<int, int>> reference_size(const ReferenceFile& ref) {
-    try {
-        if (ref.kind == ReferenceKind::Course8bit) {
-            const Image8 img = read_png8(ref.path);
-            return std::pair{img.width, img.height};
-        }
-        const Image img = read_image(ref.path);
-        return std::pair{img.width(), img.height()};
-    } catch (const ImageIoError&) {
-        return std::nullopt;  // judge_render reports the reason
+// The size of a reference image (its resolution is the render's unless --resolution says
+// otherwise). Throws ImageIoError naming the file when it cannot be read.
+std::pair<int, int> reference_size(const ReferenceFile& ref) {
+    if (ref.kind == ReferenceKind::Course8bit) {
+        const Image8 img = read_png8(ref.path);
+        return {img.width, img.height};
     }
+    const Image img = read_image(ref.path);
+    return {img.width(), img.height()};
 }
 
 }  // namespace
@@ -121,17 +118,26 @@ int run_check_command(const CheckOptions& o) {
         double seconds = 0;
         std::string tried;
         const std::optional<ReferenceFile> ref = find_reference(o.references, index, mapping, &tried);
+        std::optional<std::pair<int, int>> size;
+        std::string unreadable;
+        if (ref) {
+            reference_name = fs::path(ref->path).filename().string();
+            try {
+                size = reference_size(*ref);
+            } catch (const ImageIoError& e) {
+                unreadable = e.what();
+            }
+        }
         if (info->blind_to_delta_lights && !scene->has_hittable_emitters()) {
             v = {Verdict::BlackByDesign, fmt::format("{} cannot sample point lights, the only lights here", info->name)};
         } else if (!ref) {
             v = {Verdict::Missing, "no reference: looked for " + tried};
+        } else if (!size) {
+            v = {Verdict::Error, unreadable};  // not worth a render
         } else {
-            reference_name = fs::path(ref->path).filename().string();
             RenderSettings rs;
-            rs.width = width;
-            rs.height = height;
-            if (width == 0)
-                if (const auto size = reference_size(*ref)) std::tie(rs.width, rs.height) = *size;
+            rs.width = width > 0 ? width : size->first;
+            rs.height = height > 0 ? height : size->second;
             rs.spp = o.spp;
             rs.seed = o.seed;
             const auto it = ref_seeds.find(index);

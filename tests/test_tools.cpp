@@ -509,7 +509,7 @@ TEST_F(ToolsReport, LoadsInChromiumWithoutConsoleErrors) {
     if (!fs::exists(chromium)) GTEST_SKIP() << chromium << " is not installed (scripts/install-deps.sh installs it)";
     make_report();
     const std::string cmd = fmt::format(
-        "timeout 120 {} --headless --no-sandbox --disable-gpu --user-data-dir={} --enable-logging=stderr --v=0 "
+        "timeout 120 {} --headless --no-sandbox --disable-gpu --disable-dev-shm-usage --user-data-dir={} --enable-logging=stderr --v=0 "
         "--dump-dom 'file://{}#exposure=2&zoom=8&pixel=10,5' > {} 2> {}",
         chromium, path("profile"), path("out/report.html"), path("dom.html"), path("log.txt"));
     ASSERT_EQ(std::system(cmd.c_str()), 0) << read_text(path("log.txt"));

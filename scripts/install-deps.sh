@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs every Debian package pathlab needs to build and test.
-# Usage: scripts/install-deps.sh [--browser]   (--browser adds Chromium for the report's browser test)
+# Usage: scripts/install-deps.sh
+# Chromium is installed for the test that opens `pathlab report`'s HTML in a headless browser
+# (the test is skipped where /usr/bin/chromium is absent).
 set -euo pipefail
 
 packages=(
@@ -8,10 +10,8 @@ packages=(
   libembree-dev libtbb-dev libopenexr-dev libstb-dev
   libcli11-dev libfmt-dev nlohmann-json3-dev libpugixml-dev libtinyobjloader-dev
   libgtest-dev libbenchmark-dev
+  chromium
 )
-if [[ "${1:-}" == "--browser" ]]; then
-  packages+=(chromium)
-fi
 
 missing=()
 for p in "${packages[@]}"; do

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "core/image_io.hpp"
+#include "biased_estimators.hpp"
 #include "render/direct_lighting.hpp"
 #include "render_helpers.hpp"
 #include "tools/course_reference.hpp"
@@ -57,24 +58,6 @@ TEST(CourseReferenceCheck, FailsWithAnAreaLightThreePercentTooBright) {
     const BlockComparison cmp = compare(d, 4, kSpp[4]);
     EXPECT_FALSE(cmp.passes()) << cmp.describe();
 }
-
-// direct-light with the receiver's cos(theta) dropped (a classic student bug).
-class DirectLightWithoutCosine final : public Estimator {
-public:
-    Rgb radiance(const Scene& scene, const Ray& ray, Sampler& sampler) const override {
-        Intersection hit;
-        if (!scene.intersect(ray, hit)) return scene.escaped_radiance();
-        const Rgb Le = emitted_radiance(scene, hit, -ray.d);
-        const ShadingPoint sp = make_shading_point(scene, hit, ray.d);
-        const LightChoice choice = scene.choose_light(sampler.next1d());
-        const auto ls = sample_light(scene.lights()[size_t(choice.index)], sp.p, sampler.next2d());
-        if (sp.material->is_black() || !ls || dot(ls->wi, sp.ng) <= 0) return Le;
-        const Ray shadow = std::isinf(ls->distance) ? spawn_ray(sp.p, sp.ng, ls->wi)
-                                                    : spawn_segment(sp.p, sp.ng, ls->point, ls->normal);
-        if (scene.occluded(shadow)) return Le;
-        return Le + sp.material->eval(sp.wi, sp.frame.to_local(ls->wi)) * ls->Le / (choice.pmf * ls->pdfW);
-    }
-};
 
 TEST(CourseReferenceCheck, FailsWithoutTheReceiverCosine) {
     const auto scene = Scene::build(make_builtin_scene(0));

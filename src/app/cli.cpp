@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "app/render_command.hpp"
+#include "app/tool_commands.hpp"
 #include "app/usage_error.hpp"
 #include "render/estimator.hpp"
 #include "scene/builtin_scenes.hpp"
@@ -46,6 +47,14 @@ int run_cli(int argc, const char* const* argv) {
     add_render_options(app, render_opt);
     CLI::App* scenes_cmd = app.add_subcommand("scenes", "List the built-in scenes, one per line");
     CLI::App* algorithms_cmd = app.add_subcommand("algorithms", "List the estimators (--algorithm values)");
+    CompareOptions compare_opt;
+    CLI::App* compare_cmd = add_compare_command(app, compare_opt);
+    ReferenceOptions reference_opt;
+    CLI::App* reference_cmd = add_reference_command(app, reference_opt);
+    CheckOptions check_opt;
+    CLI::App* check_cmd = add_check_command(app, check_opt);
+    ReportOptions report_opt;
+    CLI::App* report_cmd = add_report_command(app, report_opt);
 
     try {
         app.parse(argc, argv);
@@ -56,7 +65,12 @@ int run_cli(int argc, const char* const* argv) {
     } catch (const CLI::Success& e) {
         return app.exit(e);
     } catch (const CLI::ExtrasError& e) {
-        fmt::print(stderr, "pathlab: {}\nValid options: {}\n(see pathlab --help)\n", e.what(), valid_options(app));
+        // Name the options of the subcommand that was given, if any.
+        const std::vector<CLI::App*> given = app.get_subcommands();
+        const CLI::App& scope = given.empty() ? app : *given.front();
+        fmt::print(stderr, "pathlab: {}\nValid options{}: {}\n(see pathlab {}--help)\n", e.what(),
+                   given.empty() ? "" : " of " + scope.get_name(), valid_options(scope),
+                   given.empty() ? "" : scope.get_name() + " ");
         return 2;
     } catch (const CLI::ParseError& e) {
         fmt::print(stderr, "pathlab: {}\n(see pathlab --help)\n", e.what());
@@ -72,6 +86,10 @@ int run_cli(int argc, const char* const* argv) {
             print_algorithms();
             return 0;
         }
+        if (*compare_cmd) return run_compare_command(compare_opt);
+        if (*reference_cmd) return run_reference_command(reference_opt);
+        if (*check_cmd) return run_check_command(check_opt);
+        if (*report_cmd) return run_report_command(report_opt);
         return run_render_command(render_opt);
     } catch (const UsageError& e) {
         fmt::print(stderr, "pathlab: {}\n", e.what());

@@ -16,19 +16,27 @@ double encode_levels(double linear) { return 255.0 * std::pow(std::clamp(linear,
 // difference of the encoding between m -/+ se, which is the slope times se where the
 // encoding is smooth and stays finite next to black, where its slope is unbounded. The
 // reference's level t bounds the interval from below so a black render block still gets a
-// finite error when the reference is not black.
+// finite error when the reference is not black. A render block whose mean is past white
+// (noise next to an emitter) is centred on the reference's level instead, where the
+// encoding is not yet flat, so that it does not get a zero error.
 double se_levels(double m, double t, double se) {
     if (!(se > 0)) return 0;
-    return 0.5 * (encode_levels(std::max(m, t) + se) - encode_levels(std::max(0.0, std::max(m, t) - se)));
+    const double centre = std::max(m, t) < 1.0 ? std::max(m, t) : t;
+    return 0.5 * (encode_levels(centre + se) - encode_levels(std::max(0.0, centre - se)));
 }
 }  // namespace
 
 std::string BlockComparison::describe() const {
     return fmt::format("{} blocks ({} pixels): mean |diff| {:.3f}, max |diff| {:.2f}, mean signed diff {:+.3f} grey "
-                       "levels{}",
+                       "levels{}{}",
                        blocks, pixels_compared, mean_abs_diff, max_abs_diff, mean_signed_diff,
-                       z_limit > 0 ? fmt::format("; {} block-channels beyond 1 level + {:.2f} SE (worst {:.2f} SE)",
-                                                 blocks_beyond_noise, z_limit, worst_excess)
+                       mean_noise_levels > 0 ? fmt::format(" (noise explains {:.3f})", mean_noise_levels) : "",
+                       z_limit > 0 ? fmt::format("; {} block-channels beyond 1 level + {:.2f} SE{} (worst {:.2f} SE)",
+                                                 blocks_beyond_noise, z_limit,
+                                                 unresolved_block_channels
+                                                     ? fmt::format(", {} of them unresolved", unresolved_block_channels)
+                                                     : "",
+                                                 worst_excess)
                                    : "");
 }
 
@@ -58,7 +66,12 @@ BlockComparison compare_with_course_reference(const Image& render, const Image8&
     BlockComparison out;
     double sum_abs = 0, sum_signed = 0;
     long terms = 0;
-    std::vector<std::pair<double, double>> block_errors;  // |diff| and its standard error, grey levels
+    struct BlockError {
+        double abs_diff, se;  // grey levels
+        double reference;     // the reference's linear block mean
+    };
+    std::vector<BlockError> block_errors;
+    double reference_sum = 0;
     for (int by = 0; by < ref.height; by += block)
         for (int bx = 0; bx < ref.width; bx += block) {
             double mine[3] = {0, 0, 0}, theirs[3] = {0, 0, 0}, var[3] = {0, 0, 0};
@@ -83,18 +96,24 @@ BlockComparison compare_with_course_reference(const Image& render, const Image8&
                 sum_signed += d;
                 out.max_abs_diff = std::max(out.max_abs_diff, std::abs(d));
                 ++terms;
-                if (have_se) block_errors.push_back({std::abs(d), se_levels(m, t, std::sqrt(var[c]) / count)});
+                reference_sum += t;
+                if (have_se) block_errors.push_back({std::abs(d), se_levels(m, t, std::sqrt(var[c]) / count), t});
             }
         }
     if (have_se && !block_errors.empty()) {
         out.block_channels = int(block_errors.size());
         out.z_limit = normal_quantile_two_sided(1e-3 / double(block_errors.size()));
-        for (const auto& [abs_diff, se] : block_errors) {
-            const double excess = abs_diff - 1.0;
+        double noise = 0;
+        for (const BlockError& b : block_errors) noise += b.se;
+        out.mean_noise_levels = std::sqrt(2.0 / M_PI) * noise / double(block_errors.size());
+        const double negligible = kUnresolvedNegligibleFraction * reference_sum / double(block_errors.size());
+        for (const BlockError& b : block_errors) {
+            const double excess = b.abs_diff - 1.0;
             if (excess <= 0) continue;
-            const double z = se > 0 ? excess / se : INFINITY;
+            const double z = b.se > 0 ? excess / b.se : INFINITY;
             out.worst_excess = std::max(out.worst_excess, z);
             if (z > out.z_limit) ++out.blocks_beyond_noise;
+            if (!(b.se > 0) && b.reference < negligible) ++out.unresolved_block_channels;
         }
     }
     if (terms) {

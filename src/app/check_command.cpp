@@ -1,0 +1,173 @@
+// `pathlab check --algorithm X --references DIR`: the course's grader, with noise accounted for.
+#include <tbb/global_control.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <optional>
+
+#include <nlohmann/json.hpp>
+
+#include <fmt/format.h>
+
+#include "app/interrupt.hpp"
+#include "app/tool_commands.hpp"
+#include "app/usage_error.hpp"
+#include "core/image_io.hpp"
+#include "render/renderer.hpp"
+#include "scene/builtin_scenes.hpp"
+#include "tools/check.hpp"
+#include "tools/reference_set.hpp"
+
+namespace pathlab {
+namespace fs = std::filesystem;
+namespace {
+
+// Seeds of the references, from a manifest.json written by `pathlab reference` (if any).
+std::map<int, uint64_t> reference_seeds(const std::string& dir) {
+    std::map<int, uint64_t> seeds;
+    const fs::path path = fs::path(dir) / "manifest.json";
+    if (!fs::exists(path)) return seeds;
+    try {
+        const nlohmann::json j = nlohmann::json::parse(std::ifstream(path));
+        for (const nlohmann::json& e : j.at("scenes"))
+            if (e.contains("index") && e.contains("seed")) seeds[e["index"].get<int>()] = e["seed"].get<uint64_t>();
+    } catch (const nlohmann::json::exception&) {
+    }
+    return seeds;
+}
+
+// The size of a reference image (its resolution is the render's unless --resolution says
+// otherwise). Throws ImageIoError naming the file when it cannot be read.
+std::pair<int, int> reference_size(const ReferenceFile& ref) {
+    if (ref.kind == ReferenceKind::Course8bit) {
+        const Image8 img = read_png8(ref.path);
+        return {img.width, img.height};
+    }
+    const Image img = read_image(ref.path);
+    return {img.width(), img.height()};
+}
+
+}  // namespace
+
+CLI::App* add_check_command(CLI::App& app, CheckOptions& o) {
+    CLI::App* cmd = app.add_subcommand(
+        "check", "Render the built-in scenes with an estimator and judge each against a reference: OK/FAIL/MISSING/BLACK-BY-DESIGN");
+    cmd->add_option("-a,--algorithm", o.algorithm, "Estimator to check (name or course alias, see `pathlab algorithms`)")->required();
+    cmd->add_option("--references", o.references,
+                    "Directory of references: .exr/.pfm/.hdr (e.g. from `pathlab reference`) or the course's 8-bit .png "
+                    "(names: {index}-{scene}, {index}, {scene} or the course acronym; see README)")
+        ->required();
+    cmd->add_option("--mapping", o.mapping, "File of 'scene = file' lines when the references are named otherwise");
+    cmd->add_option("-s,--scene", o.scenes, "Scenes: 'all' or a comma-separated list of indices or names")->capture_default_str();
+    cmd->add_option("--spp", o.spp, "Samples per pixel")->capture_default_str();
+    cmd->add_option("--resolution", o.resolution, "Image size WxH (default: the reference's)");
+    cmd->add_option("--seed", o.seed, "Random seed (if a reference has the same one, the next is used)")->capture_default_str();
+    cmd->add_option("--max-depth", o.max_depth, "Longest path in bounces (-1: unlimited)")->capture_default_str();
+    cmd->add_option("--threads", o.threads, "Worker threads (default: all cores)");
+    cmd->add_option("--json", o.json_path, "Also write the verdicts as JSON to this file");
+    cmd->add_flag("-q,--quiet", o.quiet, "Only the per-scene verdicts");
+    return cmd;
+}
+
+int run_check_command(const CheckOptions& o) {
+    const EstimatorInfo* info = find_estimator(o.algorithm);
+    if (!info) throw UsageError(fmt::format("unknown algorithm '{}'. Valid algorithms: {}", o.algorithm, estimator_names()));
+    if (!fs::is_directory(o.references)) throw UsageError(fmt::format("--references {}: no such directory", o.references));
+    std::map<int, std::string> mapping;
+    if (!o.mapping.empty()) {
+        try {
+            mapping = read_reference_mapping(o.mapping);
+        } catch (const ReferenceMappingError& e) {
+            throw UsageError(e.what());
+        }
+    }
+    const std::vector<int> scenes = parse_builtin_scene_list(o.scenes);
+    int width = 0, height = 0;
+    parse_resolution_option(o.resolution, width, height);
+    if (o.spp <= 0) throw UsageError(fmt::format("--spp must be a positive number of samples, got {}", o.spp));
+    if (o.max_depth < -1 || o.max_depth == 0) throw UsageError("--max-depth must be positive, or -1 for unlimited");
+    if (o.threads < 0) throw UsageError("--threads must be positive");
+    if (!o.json_path.empty()) {
+        try {
+            write_text_file(o.json_path, "{}\n");
+        } catch (const std::exception& e) {
+            throw UsageError(fmt::format("--json {}: {}", o.json_path, e.what()));
+        }
+    }
+
+    std::optional<tbb::global_control> thread_limit;
+    if (o.threads > 0) thread_limit.emplace(tbb::global_control::max_allowed_parallelism, size_t(o.threads));
+    const bool show_progress = !o.quiet && isatty(STDERR_FILENO);
+    const std::map<int, uint64_t> ref_seeds = reference_seeds(o.references);
+    EstimatorOptions est_opt;
+    est_opt.max_depth = o.max_depth;
+    const auto estimator = info->make(est_opt);
+
+    fmt::print("check {} at {} spp against {}\n", info->name, o.spp, o.references);
+    InterruptGuard interrupt;
+    int failed = 0, compared = 0;
+    nlohmann::json results = nlohmann::json::array();
+    for (const int index : scenes) {
+        const BuiltinSceneInfo& s = builtin_scenes()[size_t(index)];
+        const auto scene = Scene::build(make_builtin_scene(index));
+        SceneVerdict v;
+        std::string reference_name = "-";
+        double seconds = 0;
+        std::string tried;
+        const std::optional<ReferenceFile> ref = find_reference(o.references, index, mapping, &tried);
+        std::optional<std::pair<int, int>> size;
+        std::string unreadable;
+        if (ref) {
+            reference_name = fs::path(ref->path).filename().string();
+            try {
+                size = reference_size(*ref);
+            } catch (const ImageIoError& e) {
+                unreadable = e.what();
+            }
+        }
+        if (info->blind_to_delta_lights && !scene->has_hittable_emitters()) {
+            v = {Verdict::BlackByDesign, fmt::format("{} cannot sample point lights, the only lights here", info->name)};
+        } else if (!ref) {
+            v = {Verdict::Missing, "no reference: looked for " + tried};
+        } else if (!size) {
+            v = {Verdict::Error, unreadable};  // not worth a render
+        } else {
+            RenderSettings rs;
+            rs.width = width > 0 ? width : size->first;
+            rs.height = height > 0 ? height : size->second;
+            rs.spp = o.spp;
+            rs.seed = o.seed;
+            const auto it = ref_seeds.find(index);
+            if (it != ref_seeds.end() && it->second == o.seed) ++rs.seed;  // independent of the reference's samples
+            rs.progress = show_progress;
+            rs.cancel = &InterruptGuard::flag();
+            const RenderResult r = render(*scene, *estimator, rs);
+            seconds = r.stats.seconds;
+            if (r.stats.interrupted) {
+                fmt::print(stderr, "pathlab: interrupted\n");
+                return 130;
+            }
+            v = judge_render(r.film.mean(), r.film.standard_error(), *ref);
+            if (v.verdict == Verdict::Ok || v.verdict == Verdict::Fail) ++compared;
+        }
+        if (v.verdict == Verdict::Fail || v.verdict == Verdict::Error) ++failed;
+        fmt::print("{} {:<16} {:<16} {:<22} {}\n", s.index, s.name, verdict_name(v.verdict), reference_name, v.detail);
+        std::fflush(stdout);
+        results.push_back({{"index", s.index}, {"scene", s.name}, {"verdict", verdict_name(v.verdict)},
+                           {"reference", ref ? ref->path : ""}, {"detail", v.detail}, {"seconds", seconds}});
+    }
+    const bool ok = failed == 0 && compared > 0;
+    if (!o.quiet)
+        fmt::print("{}: {} compared, {} failed{}\n", ok ? "PASSED" : "FAILED", compared, failed,
+                   compared == 0 ? " (no scene had a reference)" : "");
+    if (!o.json_path.empty())
+        write_text_file(o.json_path, nlohmann::json{{"pathlab_version", PATHLAB_VERSION}, {"algorithm", info->name},
+                                                    {"spp", o.spp}, {"references", o.references}, {"scenes", results},
+                                                    {"passed", ok}}.dump(2) + "\n");
+    return ok ? 0 : 1;
+}
+
+}  // namespace pathlab

@@ -1,0 +1,116 @@
+#include <cmath>
+
+#include <nlohmann/json.hpp>
+
+#include <fmt/format.h>
+
+#include "app/tool_commands.hpp"
+#include "app/usage_error.hpp"
+#include "core/image_io.hpp"
+#include "tools/false_colour.hpp"
+#include "tools/image_compare.hpp"
+
+namespace pathlab {
+namespace {
+
+Image read_input(const std::string& path) {
+    try {
+        return read_image(path);
+    } catch (const ImageIoError& e) {
+        throw UsageError(e.what());  // names the file
+    }
+}
+
+nlohmann::json statistics_json(const ChannelStatistics& s) {
+    return {{"mean_diff", s.mean_diff}, {"mae", s.mae}, {"rmse", s.rmse}, {"relmse", s.relmse}, {"max_abs_diff", s.max_abs_diff}};
+}
+
+void print_table(const CompareOptions& o, const ImageDifference& d) {
+    fmt::print("A: {}\nB: {} (reference)\n{}x{} pixels\n", o.a, o.b, d.width, d.height);
+    fmt::print("{:<22}{:>13}{:>13}{:>13}{:>13}\n", "", "R", "G", "B", "all");
+    const auto row = [&](const char* name, auto get) {
+        fmt::print("{:<22}{:>13.6g}{:>13.6g}{:>13.6g}{:>13.6g}\n", name, get(d.channel[0]), get(d.channel[1]),
+                   get(d.channel[2]), get(d.all));
+    };
+    row("mean diff (A - B)", [](const ChannelStatistics& s) { return s.mean_diff; });
+    row("mean |A - B|", [](const ChannelStatistics& s) { return s.mae; });
+    row("RMSE", [](const ChannelStatistics& s) { return s.rmse; });
+    row("relMSE", [](const ChannelStatistics& s) { return s.relmse; });
+    row("max |A - B|", [](const ChannelStatistics& s) { return s.max_abs_diff; });
+    fmt::print("NaN/Inf pixel-channels: A {} NaN, {} Inf; B {} NaN, {} Inf{}\n", d.nan_a, d.inf_a, d.nan_b, d.inf_b,
+               d.non_finite() ? " (left out of the statistics)" : "");
+}
+
+}  // namespace
+
+CLI::App* add_compare_command(CLI::App& app, CompareOptions& o) {
+    CLI::App* cmd = app.add_subcommand("compare", "Statistics of the difference of two images A and B (.exr/.hdr/.pfm, any mix)");
+    cmd->add_option("A", o.a, "Image A (e.g. your render)")->required();
+    cmd->add_option("B", o.b, "Image B (the reference)")->required();
+    cmd->add_option_function<double>("--threshold", [&o](const double& v) { o.threshold = v, o.threshold_given = true; },
+                                     "Exit with code 1 when the --metric exceeds this (or an image has NaN/Inf)");
+    cmd->add_option("--metric", o.metric,
+                    fmt::format("Statistic for --threshold: {} (mean: the largest per-channel |mean difference|, the grader's measure)",
+                                kImageMetricNames))
+        ->capture_default_str();
+    cmd->add_option("--diff", o.diff_path, "Write a false-colour PNG of the signed luminance difference A - B (blue: A darker, red: A brighter)");
+    cmd->add_option("--diff-scale", o.diff_scale, "Difference shown at full colour in --diff (default: the 99th percentile of |difference|)");
+    cmd->add_flag("--json", o.json, "Print the results as JSON");
+    return cmd;
+}
+
+int run_compare_command(const CompareOptions& o) {
+    double unused = 0;
+    if (!image_metric(ImageDifference{}, o.metric, unused))
+        throw UsageError(fmt::format("unknown --metric '{}'. Valid metrics: {}", o.metric, kImageMetricNames));
+    if (o.threshold_given && !(o.threshold >= 0)) throw UsageError("--threshold must be zero or positive");
+    if (o.diff_scale < 0 || !std::isfinite(o.diff_scale)) throw UsageError("--diff-scale must be positive");
+    if (!o.diff_path.empty()) {
+        try {
+            if (image_format_for(o.diff_path) != ImageFormat::Png)
+                throw UsageError(fmt::format("--diff {}: the difference picture is written as .png", o.diff_path));
+            check_writable_image_path(o.diff_path);
+        } catch (const ImageIoError& e) {
+            throw UsageError(e.what());
+        }
+    }
+    const Image a = read_input(o.a), b = read_input(o.b);
+    ImageDifference d;
+    try {
+        d = compare_images(a, b);
+    } catch (const ImageSizeMismatch&) {
+        throw UsageError(fmt::format("{} is {}x{} but {} is {}x{}: images of different sizes cannot be compared", o.a,
+                                     a.width(), a.height(), o.b, b.width(), b.height()));
+    }
+    double value = 0;
+    image_metric(d, o.metric, value);
+    const bool pass = !o.threshold_given || (value <= o.threshold && d.non_finite() == 0);
+
+    double scale = 0;
+    if (!o.diff_path.empty()) {
+        scale = o.diff_scale > 0 ? o.diff_scale : difference_scale(a, b);
+        write_png8(false_colour_difference(a, b, scale), o.diff_path);
+    }
+
+    if (o.json) {
+        nlohmann::json j = {{"a", o.a}, {"b", o.b}, {"width", d.width}, {"height", d.height},
+                            {"channels", nlohmann::json::array()}, {"all", statistics_json(d.all)},
+                            {"compared", d.compared},
+                            {"nan", {{"a", d.nan_a}, {"b", d.nan_b}}}, {"inf", {{"a", d.inf_a}, {"b", d.inf_b}}}};
+        for (const ChannelStatistics& c : d.channel) j["channels"].push_back(statistics_json(c));
+        if (o.threshold_given) j["threshold"] = {{"metric", o.metric}, {"value", value}, {"limit", o.threshold}, {"pass", pass}};
+        if (!o.diff_path.empty()) j["diff"] = {{"path", o.diff_path}, {"scale", scale}};
+        fmt::print("{}\n", j.dump(2));
+    } else {
+        print_table(o, d);
+        if (!o.diff_path.empty())
+            fmt::print("{}: luminance difference A - B, blue -{:.4g} .. grey 0 .. red +{:.4g} (green: NaN/Inf)\n", o.diff_path,
+                       scale, scale);
+        if (o.threshold_given)
+            fmt::print("{}: {} = {:.6g} {} threshold {:.6g}{}\n", pass ? "PASS" : "FAIL", o.metric, value,
+                       value <= o.threshold ? "<=" : ">", o.threshold, d.non_finite() ? ", but NaN/Inf present" : "");
+    }
+    return pass ? 0 : 1;
+}
+
+}  // namespace pathlab

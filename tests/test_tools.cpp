@@ -533,8 +533,11 @@ TEST_F(Tools, InterruptedReportStillWritesThePage) {
     const std::string html = read_text(path("r.html"));
     EXPECT_TRUE(contains(html, "Interrupted: direct-light stopped after")) << html.substr(0, 2000);
     EXPECT_TRUE(contains(html, "Interrupted: direct-mis was not rendered."));
-    for (const std::string& s : image_sources(html))
-        if (s.rfind("data:", 0) != 0) EXPECT_TRUE(fs::exists(path(s))) << s;
+    for (const std::string& s : image_sources(html)) {
+        if (s.rfind("data:", 0) != 0) {
+            EXPECT_TRUE(fs::exists(path(s))) << s;
+        }
+    }
 }
 
 TEST_F(Tools, ReportUsageErrors) {

@@ -136,7 +136,7 @@ TEST(SceneFile, MaterialsAndLights) {
     const Material& white = d.materials[d.meshes[0].material];
     EXPECT_TRUE(white.two_sided);
     EXPECT_EQ(std::get<PhongMaterial>(white.model).diffuse, Rgb(0.1f, 0.2f, 0.3f));
-    EXPECT_TRUE(std::holds_alternative<MirrorMaterial>(d.materials[d.meshes[1].material].model));
+    EXPECT_TRUE(std::holds_alternative<ConductorMaterial>(d.materials[d.meshes[1].material].model));
     EXPECT_FALSE(d.materials[d.meshes[1].material].two_sided);
     EXPECT_EQ(d.meshes[1].emission, Rgb(4.0f));
     EXPECT_EQ(std::get<DielectricMaterial>(d.materials[d.spheres[0].material].model).int_ior, 1.33f);

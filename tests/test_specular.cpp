@@ -41,7 +41,7 @@ TEST(Dielectric, SamplesObeySnellsLawAndSumToOne) {
 }
 
 TEST(Mirror, ReflectsAboutTheNormal) {
-    const MirrorMaterial m{Rgb(0.9f)};
+    const ConductorMaterial m{Rgb(0.0f), Rgb(1.0f), Rgb(0.9f)};  // material="none" scaled by 0.9
     const Vec3f wi = normalize(Vec3f(0.3f, -0.4f, 0.8f));
     const auto s = m.sample(wi, {0.5f, 0.5f});
     ASSERT_TRUE(s);

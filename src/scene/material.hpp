@@ -12,12 +12,14 @@
 #include <optional>
 #include <variant>
 
+#include "scene/conductor.hpp"
+#include "scene/dielectric.hpp"
 #include "scene/phong.hpp"
-#include "scene/specular.hpp"
+#include "scene/roughconductor.hpp"
 
 namespace pathlab {
 
-using MaterialModel = std::variant<PhongMaterial, MirrorMaterial, DielectricMaterial>;
+using MaterialModel = std::variant<PhongMaterial, ConductorMaterial, DielectricMaterial, RoughConductorMaterial>;
 
 struct Material {
     MaterialModel model;
@@ -54,15 +56,29 @@ struct Material {
             return pathlab::is_black(p->diffuse) && pathlab::is_black(p->specular);
         return false;
     }
-    // True when every lobe is a Dirac delta: light sampling cannot contribute there.
-    bool is_delta() const { return !std::holds_alternative<PhongMaterial>(model); }
+    // True when every lobe is a Dirac delta: light sampling cannot contribute there (eval()
+    // is zero everywhere). Materials that mix delta and non-delta lobes (plastic) are not.
+    bool is_delta() const {
+        return std::holds_alternative<ConductorMaterial>(model) || std::holds_alternative<DielectricMaterial>(model);
+    }
+    // True for materials that transmit (both sides matter: never flipped, never twosided).
     bool is_dielectric() const { return std::holds_alternative<DielectricMaterial>(model); }
 };
 
 inline Material make_phong(const Rgb& diffuse, const Rgb& specular = Rgb(0.0f), float exponent = 1) {
     return Material{PhongMaterial{diffuse, specular, exponent}};
 }
-inline Material make_mirror(const Rgb& reflectance = Rgb(1.0f)) { return Material{MirrorMaterial{reflectance}}; }
+// A perfect mirror (conductor with material="none") scaled by `reflectance`.
+inline Material make_mirror(const Rgb& reflectance = Rgb(1.0f)) {
+    return Material{ConductorMaterial{Rgb(0.0f), Rgb(1.0f), reflectance}};
+}
+inline Material make_conductor(const ComplexIor& ior, const Rgb& reflectance = Rgb(1.0f)) {
+    return Material{ConductorMaterial{ior.eta, ior.k, reflectance}};
+}
+inline Material make_rough_conductor(const MicrofacetDistribution& d, const ComplexIor& ior = {Rgb(0.0f), Rgb(1.0f)},
+                                     const Rgb& reflectance = Rgb(1.0f)) {
+    return Material{RoughConductorMaterial{d, ior.eta, ior.k, reflectance}};
+}
 inline Material make_dielectric(float int_ior, float ext_ior = 1.000277f) {
     return Material{DielectricMaterial{int_ior, ext_ior}, false};
 }

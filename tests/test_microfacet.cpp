@@ -6,6 +6,8 @@
 
 #include <functional>
 
+#include <fmt/format.h>
+
 #include "chi2.hpp"
 #include "scene/material.hpp"
 
@@ -125,6 +127,9 @@ struct BsdfCase {
     float theta_in;   // incoming angle, degrees
     float alpha;      // for the histogram's resolution and the name
     bool from_below = false;  // incoming from inside (dielectrics)
+    // Dielectrics are tested one lobe at a time, each histogram centred on its lobe (the
+    // other lobe's samples count as rejected): +1 reflection, -1 transmission, 0 both.
+    int side = 0;
 };
 
 Vec3f case_wi(const BsdfCase& c) {
@@ -143,8 +148,35 @@ std::vector<BsdfCase> sampling_cases() {
         for (float theta : {0.0f, 45.0f, 85.0f}) {
             out.push_back({"roughconductor_ggx_" + tag(a, theta), make_rough_conductor(ggx(a), gold), theta, a});
         }
-    for (float theta : {0.0f, 60.0f})
+    for (float theta : {0.0f, 60.0f}) {
         out.push_back({"roughconductor_ggx_aniso_" + tag(0.05f, theta), make_rough_conductor(ggx(0.05f, 0.4f)), theta, 0.05f});
+        for (float a : {0.1f, 0.5f})
+            out.push_back({"roughconductor_beckmann_" + tag(a, theta), make_rough_conductor(beckmann(a), gold), theta, a});
+    }
+    // Rough glass from outside at every roughness, from inside below and beyond the critical
+    // angle (41.6 degrees), anisotropic, and Beckmann.
+    const auto both_lobes = [&](const std::string& name, const Material& m, float theta, float a, bool below = false) {
+        out.push_back({name + "_reflection", m, theta, a, below, +1});
+        out.push_back({name + "_transmission", m, theta, a, below, -1});
+    };
+    for (float a : {0.01f, 0.1f, 0.5f, 1.0f})
+        for (float theta : {0.0f, 45.0f, 85.0f})
+            both_lobes("roughdielectric_ggx_" + tag(a, theta), make_rough_dielectric(ggx(a), 1.5f, 1.0f), theta, a);
+    for (float a : {0.1f, 0.5f})
+        for (float theta : {30.0f, 60.0f})
+            both_lobes("roughdielectric_ggx_inside_" + tag(a, theta), make_rough_dielectric(ggx(a), 1.5f, 1.0f), theta, a, true);
+    both_lobes("roughdielectric_ggx_aniso_" + tag(0.05f, 45), make_rough_dielectric(ggx(0.05f, 0.3f), 1.5f, 1.0f), 45, 0.05f);
+    for (float a : {0.1f, 0.5f}) {
+        both_lobes("roughdielectric_beckmann_" + tag(a, 45), make_rough_dielectric(beckmann(a), 1.5f, 1.0f), 45, a);
+        both_lobes("roughdielectric_beckmann_inside_" + tag(a, 30), make_rough_dielectric(beckmann(a), 1.5f, 1.0f), 30, a, true);
+    }
+    // Plastic: the diffuse part (its delta coating counts as rejected mass) and rough plastic.
+    for (float theta : {0.0f, 45.0f, 85.0f}) {
+        out.push_back({"plastic_" + tag(1, theta), make_plastic(Rgb(0.5f, 0.3f, 0.2f)), theta, 1.0f});
+        for (float a : {0.01f, 0.1f, 0.5f, 1.0f})
+            out.push_back({"roughplastic_ggx_" + tag(a, theta), make_rough_plastic(ggx(a), Rgb(0.5f, 0.3f, 0.2f)), theta, a});
+    }
+    out.push_back({"roughplastic_beckmann_" + tag(0.1f, 45), make_rough_plastic(beckmann(0.1f), Rgb(0.5f)), 45, 0.1f});
     return out;
 }
 
@@ -154,15 +186,29 @@ TEST_P(BsdfSampling, MatchesItsPdfAndEval) {
     const BsdfCase& c = GetParam();
     const Material& m = c.material;
     const Vec3f wi = case_wi(c);
-    long pdf_mismatches = 0, eval_mismatches = 0, samples = 0;
+    long pdf_mismatches = 0, eval_mismatches = 0, samples = 0, delta_samples = 0;
     Chi2Options opt;
     opt.samples = 500'000;
     opt.theta_power = c.alpha < 0.05f ? 3.0 : (c.alpha < 0.3f ? 2.0 : 1.0);
-    const Vec3f axis(-wi.x, -wi.y, wi.z);  // the mirror direction: centre of the reflection lobe
+    // Centre of the lobe: the mirror direction, or the direction of smooth refraction (the
+    // normal's other side beyond the critical angle).
+    Vec3f axis(-wi.x, -wi.y, wi.z);
+    const auto wrong_side = [&](const Vec3f& wo) { return c.side != 0 && (wo.z * wi.z > 0) != (c.side > 0); };
+    if (c.side < 0) {
+        const auto* d = std::get_if<RoughDielectricMaterial>(&m.model);
+        const float eta_i = wi.z > 0 ? d->ext_ior : d->int_ior, eta_o = wi.z > 0 ? d->int_ior : d->ext_ior;
+        const float r2 = (eta_i / eta_o) * (eta_i / eta_o) * (1 - wi.z * wi.z);
+        axis = r2 < 1 ? normalize(Vec3f(-wi.x * eta_i / eta_o, -wi.y * eta_i / eta_o, std::copysign(std::sqrt(1 - r2), -wi.z)))
+                      : Vec3f(0, 0, -std::copysign(1.0f, wi.z));
+    }
     const auto r = chi2_directions(
         [&](Vec2f u) -> std::optional<Vec3f> {
             const auto s = m.sample(wi, u);
-            if (!s) return std::nullopt;
+            if (!s || wrong_side(s->wo)) return std::nullopt;
+            if (s->delta) {  // plastic's coating: outside pdf()'s support, counted with the rejections
+                ++delta_samples;
+                return std::nullopt;
+            }
             ++samples;
             const float p = m.pdf(wi, s->wo);
             const Rgb f = m.eval(wi, s->wo);
@@ -170,12 +216,19 @@ TEST_P(BsdfSampling, MatchesItsPdfAndEval) {
             if (!(max_component(abs(s->f - f)) <= 1e-5f * max_component(f))) ++eval_mismatches;
             return s->wo;
         },
-        [&](const Vec3f& wo) { return m.pdf(wi, wo); }, axis, opt);
+        [&](const Vec3f& wo) { return wrong_side(wo) ? 0.0f : m.pdf(wi, wo); }, axis, opt);
     EXPECT_GT(r.p_value, kAlpha) << r.describe();
     EXPECT_EQ(pdf_mismatches, 0) << "of " << samples;
     EXPECT_EQ(eval_mismatches, 0) << "of " << samples;
     // pdf() integrates to 1 once the mass of rejected samples (below the horizon) is added.
     EXPECT_NEAR(r.pdf_integral + r.rejected_fraction, 1.0, 5e-3) << r.describe();
+    if (const auto* plastic = std::get_if<PlasticMaterial>(&m.model)) {
+        // The coating's reflection is chosen with its probability P_s: a binomial count.
+        const double ps = plastic->coat.specular_probability(plastic->coat.fresnel(wi.z)), n = opt.samples;
+        EXPECT_NEAR(delta_samples, n * ps, 5 * std::sqrt(n * ps * (1 - ps)));
+    } else {
+        EXPECT_EQ(delta_samples, 0);
+    }
 }
 INSTANTIATE_TEST_SUITE_P(Microfacet, BsdfSampling, ::testing::ValuesIn(sampling_cases()),
                          [](const auto& info) { return info.param.name; });
@@ -282,6 +335,164 @@ TEST(RoughConductor, IsBlackFromBehindAndBelow) {
     EXPECT_EQ(m.eval(normalize(down), up), Rgb(0.0f));
     EXPECT_FALSE(m.sample(normalize(down), {0.3f, 0.6f}));
     EXPECT_FALSE(m.is_delta());
+}
+
+// ---- rough dielectric -----------------------------------------------------------------------------
+
+// Reflectance R and transmittance T of a rough interface for light arriving along wi, by
+// quadrature over microfacet normals (only eval() is used). T is the energy (radiance times
+// eta^2) transmitted: the eval() of refraction carries the radiance factor (eta_i / eta_o)^2.
+std::pair<double, double> interface_by_quadrature(const Material& m, Vec3f wi, float eta_i, float eta_o, double a) {
+    const bool below = wi.z < 0;
+    const auto flip = [&](Vec3f w) { return below ? Vec3f(w.x, w.y, -w.z) : w; };
+    const Vec3f w = flip(wi);  // above the surface
+    const double R = integrate_normals(
+        [&](const Vec3f& h) {
+            const float c = dot(w, h);
+            const Vec3f wo = reflect(w, h);
+            if (c <= 0 || wo.z <= 0) return 0.0;
+            return double(m.eval(wi, flip(wo)).x) * wo.z * 4 * c;
+        },
+        a, 700, 700);
+    const double T = integrate_normals(
+        [&](const Vec3f& h) {
+            const double c = dot(w, h), r = double(eta_i) / eta_o, k = 1 - r * r * (1 - c * c);
+            if (c <= 0 || k < 0) return 0.0;
+            const Vec3f wo = normalize(-w * float(r) + h * float(r * c - std::sqrt(k)));
+            if (wo.z >= 0) return 0.0;
+            const double co = dot(wo, h), den = eta_i * c + eta_o * co;
+            const double jacobian = den * den / (double(eta_o) * eta_o * std::abs(co));  // d omega_o / d omega_h (Walter 2007, eq. 17)
+            return double(m.eval(wi, flip(wo)).x) * std::abs(wo.z) * jacobian * (double(eta_o) * eta_o / (eta_i * eta_i));
+        },
+        a, 700, 700);
+    return {R, T};
+}
+
+// Energy balance of rough glass: sampled reflectance and transmittance (energy) against the
+// quadrature of eval(); R + T <= 1 (single scattering loses what shadowing-masking removes);
+// nearly smooth glass splits like the smooth Fresnel equations, total internal reflection
+// included.
+TEST(RoughDielectric, ReflectionAndTransmissionConserveEnergy) {
+    const float n = 1.5f;
+    struct Incidence {
+        float theta;
+        bool inside;
+    };
+    for (bool use_ggx : {true, false})
+        for (Incidence in : {Incidence{0, false}, {45, false}, {80, false}, {20, true}, {60, true}})
+            for (float a : {0.01f, 0.1f, 0.5f, 1.0f}) {
+                const Material m = make_rough_dielectric(use_ggx ? ggx(a) : beckmann(a), n, 1.0f);
+                Vec3f wi = incoming(in.theta);
+                if (in.inside) wi.z = -wi.z;
+                const float eta_i = in.inside ? n : 1.0f, eta_o = in.inside ? 1.0f : n;
+                const auto [R, T] = interface_by_quadrature(m, wi, eta_i, eta_o, a);
+                const auto part = [&](bool transmitted) {
+                    return sampled_albedo(m, wi, 200'000, [&](const BsdfSample& s) {
+                        const bool t = (s.wo.z > 0) != (wi.z > 0);
+                        return t != transmitted ? 0.0 : (t ? double(eta_o) * eta_o / (eta_i * eta_i) : 1.0);
+                    });
+                };
+                const Estimate r = part(false), t = part(true);
+                const std::string what = fmt::format("{} alpha {} theta {}{}: R {:.5f} +- {:.5f} (quadrature {:.5f}), "
+                                                     "T {:.5f} +- {:.5f} (quadrature {:.5f})",
+                                                     use_ggx ? "ggx" : "beckmann", a, in.theta, in.inside ? " inside" : "",
+                                                     r.mean, r.se, R, t.mean, t.se, T);
+                EXPECT_NEAR(r.mean, R, 4 * r.se + 1e-3) << what;
+                EXPECT_NEAR(t.mean, T, 4 * t.se + 1e-3) << what;
+                EXPECT_LE(R + T, 1.0 + 1e-3) << what;
+                // Nearly smooth glass splits like smooth glass (away from grazing angles,
+                // where even 0.01 rad of facet tilt moves the steep Fresnel term).
+                if (a == 0.01f && in.theta <= 60) {
+                    const float F = fresnel_dielectric(std::abs(wi.z), eta_o / eta_i);
+                    EXPECT_NEAR(R, F, 1e-3) << what;
+                    EXPECT_NEAR(T, 1 - F, 1e-3) << what;
+                }
+            }
+}
+
+// Radiance across an interface: f(wi, wo) / eta_i^2 = f(wo, wi) / eta_o^2 (Veach 1997, 5.2),
+// which reduces to plain reciprocity for reflection.
+TEST(RoughDielectric, ObeysTheGeneralisedReciprocity) {
+    Sampler rng(4, 0, 0);
+    const float n = 1.5f;
+    for (const auto& d : {ggx(0.2f), ggx(0.05f, 0.5f), beckmann(0.3f)}) {
+        const Material m = make_rough_dielectric(d, n, 1.0f);
+        long nonzero = 0;
+        for (int i = 0; i < 20000; ++i) {
+            const Vec3f a = square_to_uniform_sphere(rng.next2d()), b = square_to_uniform_sphere(rng.next2d());
+            const float ea = a.z > 0 ? 1.0f : n, eb = b.z > 0 ? 1.0f : n;
+            const float fab = m.eval(a, b).x / (ea * ea), fba = m.eval(b, a).x / (eb * eb);
+            ASSERT_NEAR(fab, fba, 1e-4f * std::max(fab, fba) + 1e-30f) << a.z << " " << b.z;
+            nonzero += fab > 0;
+        }
+        EXPECT_GT(nonzero, 1000);
+    }
+}
+
+// ---- plastic ----------------------------------------------------------------------------------------
+
+// Diffuse albedo of the coated base (plastic.hpp), in closed form from Fdr:
+// rho' (1 - F(cos_i)) (1 - Fdr_ext) / eta^2 = rho' (1 - F(cos_i)) (1 - Fdr_int).
+double coated_diffuse_albedo(float rho, float cos_i, float eta, bool nonlinear) {
+    const double fdr_int = fresnel_diffuse_reflectance(1 / eta);
+    const double rho_eff = nonlinear ? rho / (1 - rho * fdr_int) : rho / (1 - fdr_int);
+    return rho_eff * (1 - fresnel_dielectric(cos_i, eta)) * (1 - fdr_int);
+}
+
+TEST(Plastic, AlbedoIsTheCoatingsReflectionPlusTheTransmittedDiffuse) {
+    for (bool nonlinear : {false, true})
+        for (float rho : {1.0f, 0.5f})
+            for (float theta : {0.0f, 45.0f, 80.0f, 89.0f}) {
+                const float eta = 1.49f / 1.000277f;
+                const Material m = make_plastic(Rgb(rho), Rgb(1.0f), 1.49f, 1.000277f, nonlinear);
+                const Vec3f wi = incoming(theta);
+                const Estimate e = sampled_albedo(m, wi);
+                const double expected = fresnel_dielectric(wi.z, eta) + coated_diffuse_albedo(rho, wi.z, eta, nonlinear);
+                EXPECT_NEAR(e.mean, expected, 4 * e.se + 1e-6) << "rho " << rho << " theta " << theta << " nonlinear " << nonlinear;
+                // A white linear plastic is a white furnace: nothing is lost.
+                if (rho == 1 && !nonlinear) { EXPECT_NEAR(expected, 1.0, 1e-4) << theta; }
+            }
+}
+
+TEST(RoughPlastic, AlbedoIsTheRoughCoatingPlusTheTransmittedDiffuseAndAtMostOne) {
+    for (bool use_ggx : {true, false})
+        for (float a : {0.01f, 0.1f, 0.5f, 1.0f})
+            for (float theta : {0.0f, 45.0f, 80.0f, 89.0f}) {
+                const auto d = use_ggx ? ggx(a) : beckmann(a);
+                const float eta = 1.49f / 1.000277f;
+                const Material white = make_rough_plastic(d, Rgb(1.0f));
+                const Material coating = make_rough_plastic(d, Rgb(0.0f));  // the rough coating alone
+                const Vec3f wi = incoming(theta);
+                const Estimate e = sampled_albedo(white, wi);
+                const double expected = reflection_albedo_by_quadrature(coating, wi, a) + coated_diffuse_albedo(1, wi.z, eta, false);
+                const std::string what = fmt::format("{} alpha {} theta {}: sampled {:.5f} +- {:.5f}, expected {:.5f}",
+                                                     use_ggx ? "ggx" : "beckmann", a, theta, e.mean, e.se, expected);
+                EXPECT_NEAR(e.mean, expected, 4 * e.se + 1e-3) << what;
+                EXPECT_LE(expected, 1.0 + 1e-3) << what;
+            }
+}
+
+TEST(Plastic, SmoothAndRoughAreReciprocal) {
+    Sampler rng(5, 0, 0);
+    for (const Material& m : {make_plastic(Rgb(0.3f, 0.5f, 0.7f)), make_plastic(Rgb(0.8f), Rgb(0.5f), 1.6f, 1.0f, true),
+                              make_rough_plastic(ggx(0.2f), Rgb(0.3f, 0.5f, 0.7f)), make_rough_plastic(beckmann(0.4f), Rgb(0.6f))}) {
+        for (int i = 0; i < 10000; ++i) {
+            const Vec3f a = square_to_uniform_hemisphere(rng.next2d()), b = square_to_uniform_hemisphere(rng.next2d());
+            const Rgb fab = m.eval(a, b), fba = m.eval(b, a);
+            ASSERT_LE(max_component(abs(fab - fba)), 1e-5f * max_component(fab));
+        }
+    }
+}
+
+TEST(Materials, DeltaClassification) {
+    EXPECT_TRUE(make_mirror().is_delta());
+    EXPECT_TRUE(make_conductor(*named_conductor("Au")).is_delta());
+    EXPECT_TRUE(make_dielectric(1.5f).is_delta());
+    EXPECT_FALSE(make_plastic(Rgb(0.5f)).is_delta());  // a delta coating over a diffuse base
+    EXPECT_FALSE(make_rough_plastic(ggx(0.1f), Rgb(0.5f)).is_delta());
+    EXPECT_FALSE(make_rough_dielectric(ggx(0.1f), 1.5f).is_delta());
+    EXPECT_TRUE(make_rough_dielectric(ggx(0.1f), 1.5f).is_dielectric());
+    EXPECT_FALSE(make_rough_dielectric(ggx(0.1f), 1.5f).two_sided);
 }
 
 // Test of the test: a GGX visible-normal pdf without its G1(wi) factor must be rejected by

@@ -15,11 +15,16 @@
 #include "scene/conductor.hpp"
 #include "scene/dielectric.hpp"
 #include "scene/phong.hpp"
+#include "scene/plastic.hpp"
 #include "scene/roughconductor.hpp"
+#include "scene/roughdielectric.hpp"
+#include "scene/roughplastic.hpp"
 
 namespace pathlab {
 
-using MaterialModel = std::variant<PhongMaterial, ConductorMaterial, DielectricMaterial, RoughConductorMaterial>;
+// One BSDF per header (parameters and defaults documented at the top of each).
+using MaterialModel = std::variant<PhongMaterial, ConductorMaterial, DielectricMaterial, RoughConductorMaterial,
+                                   RoughDielectricMaterial, PlasticMaterial, RoughPlasticMaterial>;
 
 struct Material {
     MaterialModel model;
@@ -62,7 +67,9 @@ struct Material {
         return std::holds_alternative<ConductorMaterial>(model) || std::holds_alternative<DielectricMaterial>(model);
     }
     // True for materials that transmit (both sides matter: never flipped, never twosided).
-    bool is_dielectric() const { return std::holds_alternative<DielectricMaterial>(model); }
+    bool is_dielectric() const {
+        return std::holds_alternative<DielectricMaterial>(model) || std::holds_alternative<RoughDielectricMaterial>(model);
+    }
 };
 
 inline Material make_phong(const Rgb& diffuse, const Rgb& specular = Rgb(0.0f), float exponent = 1) {
@@ -81,6 +88,17 @@ inline Material make_rough_conductor(const MicrofacetDistribution& d, const Comp
 }
 inline Material make_dielectric(float int_ior, float ext_ior = 1.000277f) {
     return Material{DielectricMaterial{int_ior, ext_ior}, false};
+}
+inline Material make_rough_dielectric(const MicrofacetDistribution& d, float int_ior, float ext_ior = 1.000277f) {
+    return Material{RoughDielectricMaterial{d, int_ior, ext_ior}, false};
+}
+inline Material make_plastic(const Rgb& diffuse, const Rgb& specular = Rgb(1.0f), float int_ior = 1.49f,
+                             float ext_ior = 1.000277f, bool nonlinear = false) {
+    return Material{PlasticMaterial{CoatedDiffuse(diffuse, specular, int_ior, ext_ior, nonlinear)}};
+}
+inline Material make_rough_plastic(const MicrofacetDistribution& d, const Rgb& diffuse, const Rgb& specular = Rgb(1.0f),
+                                   float int_ior = 1.49f, float ext_ior = 1.000277f, bool nonlinear = false) {
+    return Material{RoughPlasticMaterial{d, CoatedDiffuse(diffuse, specular, int_ior, ext_ior, nonlinear)}};
 }
 
 }  // namespace pathlab

@@ -34,11 +34,13 @@ const std::set<std::string> kPropertyTags = {"float", "integer", "boolean", "str
                                              "spectrum", "point", "vector", "transform"};
 
 // Refractive indices by name (a few of Mitsuba's, at 589 nm).
-const char* const kBsdfTypes = "diffuse, phong, conductor, roughconductor, dielectric, twosided";
+const char* const kBsdfTypes =
+    "diffuse, phong, conductor, roughconductor, dielectric, roughdielectric, plastic, roughplastic, twosided";
 
 const std::map<std::string, float> kNamedIors = {
     {"vacuum", 1.0f},       {"air", 1.000277f},    {"water", 1.3330f},   {"fused quartz", 1.458f},
     {"pyrex", 1.470f},      {"acrylic glass", 1.49f}, {"bk7", 1.5046f},  {"diamond", 2.419f},
+    {"polypropylene", 1.49f},
 };
 
 class Loader {
@@ -463,7 +465,8 @@ private:
                 fail(n, "<bsdf type=\"twosided\"> wraps exactly one nested <bsdf>");
             Properties(*this, n).check_all_used({});
             Material m = read_bsdf(inner[0]);
-            if (m.is_dielectric()) fail(inner[0], "a dielectric cannot be wrapped in twosided (both of its sides already matter)");
+            if (m.is_dielectric())
+                fail(inner[0], fmt::format("a {} cannot be wrapped in twosided (both of its sides already matter)", attr(inner[0], "type")));
             m.two_sided = true;
             return m;
         }
@@ -494,6 +497,28 @@ private:
             const float ext_ior = ior(p, alias(p, "ext_ior", "extIOR"), 1.000277f);
             m = make_dielectric(int_ior, ext_ior);
             p.check_all_used({"int_ior", "ext_ior"});
+        } else if (type == "roughdielectric") {
+            const MicrofacetDistribution d = microfacet(p, n);
+            const float int_ior = ior(p, alias(p, "int_ior", "intIOR"), 1.5046f);
+            const float ext_ior = ior(p, alias(p, "ext_ior", "extIOR"), 1.000277f);
+            if (int_ior == ext_ior) fail(n, "int_ior and ext_ior are equal: the interface would be invisible");
+            m = make_rough_dielectric(d, int_ior, ext_ior);
+            p.check_all_used({"distribution", "alpha", "alpha_u", "alpha_v", "int_ior", "ext_ior", "sample_visible"});
+        } else if (type == "plastic" || type == "roughplastic") {
+            const bool rough = type == "roughplastic";
+            const MicrofacetDistribution d = rough ? microfacet(p, n, /*anisotropic=*/false) : MicrofacetDistribution();
+            const Rgb kd = p.get_rgb(alias(p, "diffuse_reflectance", "diffuseReflectance"), Rgb(0.5f));
+            const Rgb ks = p.get_rgb(alias(p, "specular_reflectance", "specularReflectance"), Rgb(1.0f));
+            const float int_ior = ior(p, alias(p, "int_ior", "intIOR"), 1.49f);
+            const float ext_ior = ior(p, alias(p, "ext_ior", "extIOR"), 1.000277f);
+            if (int_ior == ext_ior) fail(n, "int_ior and ext_ior are equal: the coating would be invisible");
+            const bool nonlinear = p.get_bool("nonlinear", false);
+            m = rough ? make_rough_plastic(d, kd, ks, int_ior, ext_ior, nonlinear) : make_plastic(kd, ks, int_ior, ext_ior, nonlinear);
+            if (rough)
+                p.check_all_used({"distribution", "alpha", "diffuse_reflectance", "specular_reflectance", "int_ior", "ext_ior",
+                                  "nonlinear", "sample_visible"});
+            else
+                p.check_all_used({"diffuse_reflectance", "specular_reflectance", "int_ior", "ext_ior", "nonlinear"});
         } else {
             fail(n, fmt::format("unsupported bsdf type '{}'; supported: {}", type, kBsdfTypes));
         }

@@ -61,6 +61,8 @@ std::vector<DistributionCase> distributions() {
     return out;
 }
 
+void PrintTo(const DistributionCase& c, std::ostream* os) { *os << c.name; }
+
 class Distribution : public ::testing::TestWithParam<DistributionCase> {};
 
 // integral of D(h) cos(theta_h) = 1: the microfacets project onto the macro surface exactly.
@@ -131,6 +133,8 @@ struct BsdfCase {
     // other lobe's samples count as rejected): +1 reflection, -1 transmission, 0 both.
     int side = 0;
 };
+
+void PrintTo(const BsdfCase& c, std::ostream* os) { *os << c.name; }
 
 Vec3f case_wi(const BsdfCase& c) {
     Vec3f wi = incoming(c.theta_in);

@@ -157,6 +157,9 @@ std::vector<BsdfCase> sampling_cases() {
         for (float a : {0.1f, 0.5f})
             out.push_back({"roughconductor_beckmann_" + tag(a, theta), make_rough_conductor(beckmann(a), gold), theta, a});
     }
+    for (float a : {0.01f, 1.0f})
+        out.push_back({"roughconductor_beckmann_" + tag(a, 85), make_rough_conductor(beckmann(a), gold), 85, a});
+    out.push_back({"roughconductor_beckmann_aniso_" + tag(0.4f, 60), make_rough_conductor(beckmann(0.4f, 0.05f)), 60, 0.05f});
     // Rough glass from outside at every roughness, from inside below and beyond the critical
     // angle (41.6 degrees), anisotropic, and Beckmann.
     const auto both_lobes = [&](const std::string& name, const Material& m, float theta, float a, bool below = false) {
@@ -237,14 +240,15 @@ TEST_P(BsdfSampling, MatchesItsPdfAndEval) {
 INSTANTIATE_TEST_SUITE_P(Microfacet, BsdfSampling, ::testing::ValuesIn(sampling_cases()),
                          [](const auto& info) { return info.param.name; });
 
-// For GGX the visible-normal sampler's weight f cos / pdf of a rough conductor is exactly
+// With visible-normal sampling the weight f cos / pdf of a rough conductor is exactly
 // F(wi.h) G2 / G1(wi): D and the 1 / (4 wi.h) Jacobian cancel (Heitz 2018).
-TEST(RoughConductor, GgxSampleWeightIsFresnelTimesG2OverG1) {
+TEST(RoughConductor, SampleWeightIsFresnelTimesG2OverG1) {
     const ComplexIor cu = *named_conductor("Cu");
     Sampler rng(21, 0, 0);
+    for (bool use_ggx : {true, false})
     for (float a : {0.05f, 0.3f, 1.0f})
         for (float theta : {0.0f, 40.0f, 80.0f}) {
-            const RoughConductorMaterial m{ggx(a, a * 0.6f), cu.eta, cu.k, Rgb(1.0f)};
+            const RoughConductorMaterial m{use_ggx ? ggx(a, a * 0.6f) : beckmann(a, a * 0.6f), cu.eta, cu.k, Rgb(1.0f)};
             const Vec3f wi = incoming(theta);
             for (int i = 0; i < 2000; ++i) {
                 const auto s = m.sample(wi, rng.next2d());

@@ -9,13 +9,13 @@
 //   material              string  a metal by name: none, Au, Ag, Cu, Al, Cr        default none
 //   eta, k                rgb     complex index of refraction, instead of material default 0, 1
 //   specular_reflectance  rgb     R, scales the reflectance (not physical)         default 1
-//   sample_visible        boolean accepted for compatibility; GGX always samples visible normals
+//   sample_visible        boolean accepted for compatibility; visible normals are always sampled
 // material="none" (eta = 0, k = 1) has F = 1: only shadowing-masking loses energy (the
 // single-scattering loss of the microfacet model). One-sided unless wrapped in twosided.
 //
-// Sampling: a microfacet normal h from microfacet.hpp (visible normals for GGX), wo the
+// Sampling: a microfacet normal h visible from wi (microfacet.hpp), wo the
 // mirror of wi about h; directions below the surface are rejected (no sample). The density
-// of wo is pdf_h(h) / (4 wi.h); the weight f cos / pdf is R F G2 / G1(wi) for GGX.
+// of wo is pdf_h(h) / (4 wi.h); the weight f cos / pdf is R F G2 / G1(wi).
 #pragma once
 
 #include <optional>

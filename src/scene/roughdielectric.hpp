@@ -12,13 +12,13 @@
 //   alpha_u, alpha_v  float           anisotropic roughness (instead of alpha)
 //   int_ior           float or string interior index of refraction, or a name          default bk7 (1.5046)
 //   ext_ior           float or string exterior index of refraction                     default air (1.000277)
-//   sample_visible    boolean         accepted for compatibility; GGX always samples visible normals
+//   sample_visible    boolean         accepted for compatibility; visible normals are always sampled
 // Like dielectric, it cannot be wrapped in twosided: both of its sides matter.
 //
 // Radiance convention (as dielectric.hpp): light flows from wo to wi, and radiance keeps
 // L / eta^2 invariant, hence eta_i^2 in the refraction term; the BSDF satisfies
 // f(wi, wo) / eta_i^2 = f(wo, wi) / eta_o^2, and a refracted sample's weight is
-// (1 - F) (eta_i / eta_o)^2 G2 / G1(wi) / P(refraction) for GGX.
+// (1 - F) (eta_i / eta_o)^2 G2 / G1(wi) / P(refraction).
 //
 // Sampling: reflection is chosen with probability P_R = F(|cos_i|) (the Fresnel term of the
 // macro surface, kept within [0.05, 0.95] so that neither lobe is starved), refraction with

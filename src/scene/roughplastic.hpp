@@ -16,7 +16,7 @@
 //   int_ior               float or string  coating index, or a name                 default polypropylene (1.49)
 //   ext_ior               float or string  exterior index                           default air (1.000277)
 //   nonlinear             boolean          see plastic.hpp                          default false
-//   sample_visible        boolean          accepted; GGX always samples visible normals
+//   sample_visible        boolean          accepted; visible normals are always sampled
 // One-sided unless wrapped in twosided.
 //
 // Sampling: the coating's lobe with probability P_s (as plastic.hpp, from the macro Fresnel

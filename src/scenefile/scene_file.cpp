@@ -552,7 +552,7 @@ private:
             if (p.has(name) && !(a >= 0 && a <= 10)) fail(p.node(name), fmt::format("{} must be between 0 and 10, got {}", name, a));
             return a;
         };
-        p.get_bool(alias(p, "sample_visible", "sampleVisible"), true);  // GGX always samples visible normals
+        p.get_bool(alias(p, "sample_visible", "sampleVisible"), true);  // visible normals are always sampled
         if (uv) return MicrofacetDistribution(type, roughness(au_name), roughness(av_name));
         const float a = roughness("alpha");
         return MicrofacetDistribution(type, a, a);

@@ -516,6 +516,47 @@ TEST(Materials, DeltaClassification) {
     EXPECT_FALSE(make_rough_dielectric(ggx(0.1f), 1.5f).two_sided);
 }
 
+// Every material at extreme roughness (the clamp 1e-4, and 10), anisotropy, and directions
+// up to exactly grazing: values, pdfs and weights are finite and non-negative, samples unit.
+TEST(Materials, StayFiniteAtExtremes) {
+    std::vector<Material> materials;
+    for (float a : {0.0f, 1e-4f, 0.01f, 1.0f, 10.0f})
+        for (const auto& d : {ggx(a), beckmann(a), ggx(a, 0.5f), beckmann(0.5f, a)}) {
+            materials.push_back(make_rough_conductor(d, *named_conductor("Cr")));
+            materials.push_back(make_rough_dielectric(d, 1.5f, 1.0f));
+            materials.push_back(make_rough_dielectric(d, 1.0f, 1.33f));
+            materials.push_back(make_rough_plastic(d, Rgb(0.5f), Rgb(1.0f), 1.5f, 1.0f, true));
+        }
+    materials.push_back(make_plastic(Rgb(0.5f)));
+    materials.push_back(make_conductor(*named_conductor("Al")));
+    Sampler rng(8, 0, 0);
+    const auto direction = [&]() {
+        Vec3f w = square_to_uniform_sphere(rng.next2d());
+        const float r = rng.next1d();
+        if (r < 0.1f) w.z = 0;                  // exactly grazing
+        else if (r < 0.2f) w.z *= 1e-6f;        // nearly grazing
+        else if (r < 0.25f) w = Vec3f(0, 0, w.z > 0 ? 1.0f : -1.0f);  // exactly normal
+        return normalize(w);
+    };
+    long samples = 0;
+    for (const Material& m : materials)
+        for (int i = 0; i < 3000; ++i) {
+            const Vec3f wi = direction(), wo = direction();
+            float p = 0;
+            const Rgb f = m.eval_and_pdf(wi, wo, p);
+            ASSERT_TRUE(is_finite(f) && min_component(f) >= 0) << f.x << " " << f.y << " " << f.z;
+            ASSERT_TRUE(std::isfinite(p) && p >= 0) << p;
+            if (const auto s = m.sample(wi, rng.next2d())) {
+                ++samples;
+                ASSERT_NEAR(length(s->wo), 1.0f, 1e-4f);
+                ASSERT_TRUE(is_finite(s->f) && min_component(s->f) >= 0);
+                ASSERT_TRUE(std::isfinite(s->pdfW) && s->pdfW > 0) << s->pdfW;
+                ASSERT_TRUE(is_finite(s->f * (std::abs(s->wo.z) / s->pdfW)));
+            }
+        }
+    EXPECT_GT(samples, 100000);
+}
+
 // Test of the test: a GGX visible-normal pdf without its G1(wi) factor must be rejected by
 // the chi-square test (at grazing incidence, where G1 differs most from 1).
 TEST(RoughConductor, ChiSquareRejectsAVisibleNormalPdfWithoutG1) {

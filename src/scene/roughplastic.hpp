@@ -115,7 +115,7 @@ private:
     // E(mu): albedo of the coating's reflection (R_s = 1) for light arriving at cosine mu, by
     // the midpoint rule over microfacet normals with theta_h = atan(a tan(pi t / 2)), t
     // uniform, which puts the nodes where D has its mass.
-    double coating_albedo(double mu, int n = 96) const {
+    double coating_albedo(double mu, int n = 64) const {
         const Vec3f wi(float(std::sqrt(1 - mu * mu)), 0.0f, float(mu));
         const double a = std::sqrt(double(distribution.alpha_u) * distribution.alpha_v);
         double sum = 0;

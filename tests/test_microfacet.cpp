@@ -227,6 +227,7 @@ TEST_P(BsdfSampling, MatchesItsPdfAndEval) {
             return s->wo;
         },
         [&](const Vec3f& wo) { return wrong_side(wo) ? 0.0f : m.pdf(wi, wo); }, axis, opt);
+    ::testing::Test::RecordProperty("chi2", r.describe());
     EXPECT_GT(r.p_value, kAlpha) << r.describe();
     EXPECT_EQ(pdf_mismatches, 0) << "of " << samples;
     EXPECT_EQ(eval_mismatches, 0) << "of " << samples;

@@ -582,6 +582,7 @@ TEST(RoughConductor, ChiSquareRejectsAVisibleNormalPdfWithoutG1) {
             return p / m.distribution.G1(wi);
         },
         Vec3f(-wi.x, -wi.y, wi.z), Chi2Options{.samples = 500'000});
+    ::testing::Test::RecordProperty("chi2", r.describe());
     EXPECT_LT(r.p_value, kAlpha) << r.describe();
 }
 

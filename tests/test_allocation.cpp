@@ -17,9 +17,20 @@ TEST(Allocation, CounterSeesAllocations) {
     EXPECT_EQ(allocations_by_this_thread() - before, 1u);
 }
 
+// Scene 3 with its materials replaced by the microfacet and Fresnel ones, in turn.
+SceneDescription with_new_materials(SceneDescription d) {
+    const MicrofacetDistribution ggx(MicrofacetType::GGX, 0.2f, 0.2f), beckmann(MicrofacetType::Beckmann, 0.3f, 0.1f);
+    const Material choices[] = {make_rough_conductor(ggx, *named_conductor("Au")), make_plastic(Rgb(0.5f)),
+                                make_rough_plastic(beckmann, Rgb(0.4f)), make_rough_dielectric(ggx, 1.5f),
+                                make_conductor(*named_conductor("Cu")), make_rough_conductor(beckmann)};
+    for (size_t i = 0; i < d.materials.size(); ++i)
+        if (!d.materials[i].is_black()) d.materials[i] = choices[i % std::size(choices)];
+    return d;
+}
+
 TEST(Allocation, NoEstimatorAllocatesPerSample) {
-    for (int index : {0, 3, 5, 7}) {
-        const auto scene = Scene::build(make_builtin_scene(index));
+    for (int index : {0, 3, 5, 7, -1}) {
+        const auto scene = Scene::build(index < 0 ? with_new_materials(make_builtin_scene(3)) : make_builtin_scene(index));
         const CameraRays camera(scene->camera(), 64, 64);
         for (const EstimatorInfo& info : estimators()) {
             const auto estimator = info.make({});

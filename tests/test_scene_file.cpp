@@ -136,13 +136,104 @@ TEST(SceneFile, MaterialsAndLights) {
     const Material& white = d.materials[d.meshes[0].material];
     EXPECT_TRUE(white.two_sided);
     EXPECT_EQ(std::get<PhongMaterial>(white.model).diffuse, Rgb(0.1f, 0.2f, 0.3f));
-    EXPECT_TRUE(std::holds_alternative<MirrorMaterial>(d.materials[d.meshes[1].material].model));
+    EXPECT_TRUE(std::holds_alternative<ConductorMaterial>(d.materials[d.meshes[1].material].model));
     EXPECT_FALSE(d.materials[d.meshes[1].material].two_sided);
     EXPECT_EQ(d.meshes[1].emission, Rgb(4.0f));
     EXPECT_EQ(std::get<DielectricMaterial>(d.materials[d.spheres[0].material].model).int_ior, 1.33f);
     ASSERT_EQ(d.lights.size(), 2u);
     EXPECT_EQ(std::get<PointLight>(d.lights[0]).position, Vec3f(1, 2, 3));
     EXPECT_EQ(std::get<DirectionalLight>(d.lights[1]).direction, Vec3f(0, 0, -1));
+}
+
+TEST(SceneFile, MicrofacetAndFresnelMaterials) {
+    const SceneDescription d = load(R"(<scene version="3.0.0">
+        <shape type="sphere"><bsdf type="roughconductor"/></shape>
+        <shape type="sphere"><bsdf type="roughconductor"><string name="distribution" value="ggx"/>
+            <float name="alpha_u" value="0.05"/><float name="alpha_v" value="0.3"/><string name="material" value="Au"/>
+            <rgb name="specular_reflectance" value="0.9"/><boolean name="sample_visible" value="true"/></bsdf></shape>
+        <shape type="sphere"><bsdf type="twosided"><bsdf type="roughconductor"><float name="alphaU" value="0.2"/>
+            <float name="alphaV" value="0.1"/><rgb name="specularReflectance" value="0.5"/></bsdf></bsdf></shape>
+        <shape type="sphere"><bsdf type="conductor"><rgb name="eta" value="0.2, 0.9, 1.1"/><rgb name="k" value="3.9, 2.4, 2.1"/></bsdf></shape>
+        <shape type="sphere"><bsdf type="conductor"><string name="material" value="Cu"/></bsdf></shape>
+        <shape type="sphere"><bsdf type="roughdielectric"><string name="distribution" value="ggx"/><float name="alpha" value="0.3"/>
+            <string name="intIOR" value="water"/><float name="extIOR" value="1"/></bsdf></shape>
+        <shape type="sphere"><bsdf type="plastic"/></shape>
+        <shape type="sphere"><bsdf type="roughplastic"><string name="distribution" value="ggx"/><float name="alpha" value="0.25"/>
+            <rgb name="diffuseReflectance" value="0.1, 0.2, 0.3"/><float name="int_ior" value="1.6"/>
+            <boolean name="nonlinear" value="true"/></bsdf></shape>
+        </scene>)");
+    ASSERT_EQ(d.spheres.size(), 8u);
+    const auto model = [&](size_t i) -> const MaterialModel& { return d.materials[d.spheres[i].material].model; };
+    const auto& rc0 = std::get<RoughConductorMaterial>(model(0));  // Mitsuba's defaults: beckmann, 0.1, none
+    EXPECT_EQ(rc0.distribution.type, MicrofacetType::Beckmann);
+    EXPECT_EQ(rc0.distribution.alpha_u, 0.1f);
+    EXPECT_EQ(rc0.distribution.alpha_v, 0.1f);
+    EXPECT_EQ(rc0.eta, Rgb(0.0f));
+    EXPECT_EQ(rc0.k, Rgb(1.0f));
+    EXPECT_FALSE(d.materials[d.spheres[0].material].two_sided);
+    const auto& rc1 = std::get<RoughConductorMaterial>(model(1));
+    EXPECT_EQ(rc1.distribution.type, MicrofacetType::GGX);
+    EXPECT_EQ(rc1.distribution.alpha_u, 0.05f);
+    EXPECT_EQ(rc1.distribution.alpha_v, 0.3f);
+    EXPECT_EQ(rc1.eta, named_conductor("Au")->eta);
+    EXPECT_EQ(rc1.specular_reflectance, Rgb(0.9f));
+    const auto& rc2 = std::get<RoughConductorMaterial>(model(2));  // camelCase spellings
+    EXPECT_EQ(rc2.distribution.alpha_u, 0.2f);
+    EXPECT_EQ(rc2.distribution.alpha_v, 0.1f);
+    EXPECT_EQ(rc2.specular_reflectance, Rgb(0.5f));
+    EXPECT_TRUE(d.materials[d.spheres[2].material].two_sided);
+    EXPECT_EQ(std::get<ConductorMaterial>(model(3)).eta, Rgb(0.2f, 0.9f, 1.1f));
+    EXPECT_EQ(std::get<ConductorMaterial>(model(3)).k, Rgb(3.9f, 2.4f, 2.1f));
+    EXPECT_EQ(std::get<ConductorMaterial>(model(4)).k, named_conductor("Cu")->k);
+    const auto& rd = std::get<RoughDielectricMaterial>(model(5));
+    EXPECT_EQ(rd.int_ior, 1.333f);
+    EXPECT_EQ(rd.ext_ior, 1.0f);
+    EXPECT_EQ(rd.distribution.alpha_u, 0.3f);
+    const auto& pl = std::get<PlasticMaterial>(model(6)).coat;  // defaults: polypropylene in air, linear
+    EXPECT_EQ(pl.diffuse_reflectance, Rgb(0.5f));
+    EXPECT_EQ(pl.specular_reflectance, Rgb(1.0f));
+    EXPECT_FLOAT_EQ(pl.eta, 1.49f / 1.000277f);
+    EXPECT_FALSE(pl.nonlinear);
+    const auto& rp = std::get<RoughPlasticMaterial>(model(7));
+    EXPECT_EQ(rp.distribution.type, MicrofacetType::GGX);
+    EXPECT_EQ(rp.distribution.alpha_u, 0.25f);
+    EXPECT_EQ(rp.coat.diffuse_reflectance, Rgb(0.1f, 0.2f, 0.3f));
+    EXPECT_FLOAT_EQ(rp.coat.eta, 1.6f / 1.000277f);
+    EXPECT_TRUE(rp.coat.nonlinear);
+}
+
+TEST(SceneFileErrors, MicrofacetAndFresnelParameters) {
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {R"(<bsdf type="roughconductor"><string name="material" value="Unobtainium"/></bsdf>)",
+         "unknown conductor material 'Unobtainium'; known: none, Au, Ag, Cu, Al, Cr"},
+        {R"(<bsdf type="conductor"><string name="material" value="Au"/><rgb name="eta" value="1"/></bsdf>)",
+         "either material or eta and k"},
+        {R"(<bsdf type="roughconductor"><float name="alpha" value="0.1"/><float name="alpha_u" value="0.1"/>
+            <float name="alpha_v" value="0.1"/></bsdf>)", "either alpha or alpha_u and alpha_v"},
+        {R"(<bsdf type="roughconductor"><float name="alpha_u" value="0.1"/></bsdf>)", "needs both alpha_u and alpha_v"},
+        {R"(<bsdf type="roughplastic"><float name="alpha_u" value="0.1"/><float name="alpha_v" value="0.2"/></bsdf>)",
+         "is isotropic: give alpha"},
+        {R"(<bsdf type="roughdielectric"><string name="distribution" value="phong"/></bsdf>)",
+         "unsupported distribution 'phong'; supported: beckmann, ggx"},
+        {R"(<bsdf type="roughconductor"><float name="alpha" value="-0.1"/></bsdf>)", "alpha must be between 0 and 10"},
+        {R"(<bsdf type="plastic"><rgb name="specular_reflectance" value="1"/><rgb name="specularReflectance" value="1"/></bsdf>)",
+         "'specular_reflectance' and 'specularReflectance' are the same parameter"},
+        {R"(<bsdf type="twosided"><bsdf type="roughdielectric"/></bsdf>)", "a roughdielectric cannot be wrapped in twosided"},
+        {R"(<bsdf type="roughplastic"><float name="alpha_x" value="0.1"/></bsdf>)",
+         "unsupported parameter 'alpha_x' for <bsdf type=\"roughplastic\">; supported: distribution, alpha"},
+        {R"(<bsdf type="roughdielectric"><float name="int_ior" value="1.3"/><float name="ext_ior" value="1.3"/></bsdf>)",
+         "are equal"},
+    };
+    for (const auto& [bsdf, message] : cases) {
+        const std::string text = "<scene version=\"3\">\n<shape type=\"sphere\">" + bsdf + "</shape></scene>";
+        try {
+            load_scene_text(text, "bad.xml", ".");
+            ADD_FAILURE() << "no error for " << bsdf;
+        } catch (const SceneFileError& e) {
+            EXPECT_EQ(e.line, 2) << e.what();
+            EXPECT_NE(e.message.find(message), std::string::npos) << e.what();
+        }
+    }
 }
 
 // ---- the 8 course scenes as files ------------------------------------------------------------
@@ -218,8 +309,9 @@ TEST(SceneFileErrors, NameFileLineColumnAndTheProblem) {
         {"<scene version=\"3\"><shape type=\"sphere\">\n <float name=\"radiu\" value=\"1\"/></shape></scene>", 2, 2,
          "unsupported parameter 'radiu' for <shape type=\"sphere\">; supported: center, radius"},
         {"<scene version=\"3\"><shape type=\"sphere\"><ref id=\"nope\"/></shape></scene>", 1, 41, "no <bsdf> with id 'nope'"},
-        {"<scene version=\"3\"><bsdf type=\"plastic\" id=\"p\"/><shape type=\"sphere\"/></scene>", 1, 20,
-         "unsupported bsdf type 'plastic'"},
+        {"<scene version=\"3\"><bsdf type=\"blendbsdf\" id=\"p\"/><shape type=\"sphere\"/></scene>", 1, 20,
+         "unsupported bsdf type 'blendbsdf'; supported: diffuse, phong, conductor, roughconductor, dielectric, "
+         "roughdielectric, plastic, roughplastic, twosided"},
         {"<scene version=\"3\"><integrator type=\"volpath\"/><shape type=\"sphere\"/></scene>", 1, 20,
          "unsupported integrator type 'volpath'"},
         {"<scene version=\"3\"><shape type=\"sphere\"><float name=\"radius\" value=\"$r\"/></shape></scene>", 1, 41,

@@ -40,8 +40,45 @@ TEST(Dielectric, SamplesObeySnellsLawAndSumToOne) {
     }
 }
 
+// Snell's window: seen from inside water (n = 1.333), the whole sky above is squeezed into a
+// cone of half-angle asin(1 / n) = 48.6 degrees around the normal; beyond it, light from
+// inside is totally reflected.
+TEST(Dielectric, SnellsWindowAndTotalInternalReflection) {
+    const float n = 1.333f, critical = std::asin(1 / n);
+    const DielectricMaterial water{n, 1.0f};
+    Sampler rng(6, 0, 0);
+    float widest = 0;
+    for (int i = 0; i < 20000; ++i) {
+        const Vec3f wi = square_to_uniform_hemisphere(rng.next2d());  // sky directions
+        if (wi.z < 1e-3f) continue;                                   // F would round to 1
+        const auto s = water.sample(wi, {0x1.fffffep-1f, 0.5f});      // u.x > F: refraction
+        ASSERT_TRUE(s);
+        ASSERT_LT(s->wo.z, 0);
+        const float theta_t = std::acos(-s->wo.z);
+        ASSERT_LE(theta_t, critical + 1e-4f);
+        widest = std::max(widest, theta_t);
+    }
+    EXPECT_GT(widest, critical - 0.02f);  // the window is filled to its rim
+    // From inside, outside the window: every sample reflects, whatever u.
+    for (float theta : {49.0f, 60.0f, 89.0f}) {
+        const float t = theta * kPi / 180;
+        const Vec3f wi(std::sin(t), 0, -std::cos(t));
+        for (float u : {0.0f, 0.5f, 0.999f}) {
+            const auto s = water.sample(wi, {u, 0.5f});
+            ASSERT_TRUE(s);
+            EXPECT_LT(s->wo.z, 0) << theta;  // stays inside
+            EXPECT_NEAR(s->f.x * std::abs(s->wo.z) / s->pdfW, 1.0f, 1e-6f) << theta;
+        }
+    }
+    // Just inside the window, some light leaves.
+    const float t = 48.0f * kPi / 180;
+    const auto s = water.sample(Vec3f(std::sin(t), 0, -std::cos(t)), {0.999f, 0.5f});
+    ASSERT_TRUE(s);
+    EXPECT_GT(s->wo.z, 0);
+}
+
 TEST(Mirror, ReflectsAboutTheNormal) {
-    const MirrorMaterial m{Rgb(0.9f)};
+    const ConductorMaterial m{Rgb(0.0f), Rgb(1.0f), Rgb(0.9f)};  // material="none" scaled by 0.9
     const Vec3f wi = normalize(Vec3f(0.3f, -0.4f, 0.8f));
     const auto s = m.sample(wi, {0.5f, 0.5f});
     ASSERT_TRUE(s);

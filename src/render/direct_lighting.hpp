@@ -19,7 +19,9 @@ inline Rgb estimate_light_sample(const Scene& scene, const ShadingPoint& sp, Sam
     const Vec2f u = sampler.next2d();
     if (choice.index < 0) return Rgb(0.0f);
     const auto ls = sample_light(scene.lights()[size_t(choice.index)], sp.p, u);
-    if (!ls || is_black(ls->Le) || dot(ls->wi, sp.ng) <= 0) return Rgb(0.0f);
+    if (!ls || is_black(ls->Le)) return Rgb(0.0f);
+    // Lights behind the surface reach it only through a transmitting material (rough glass).
+    if (dot(ls->wi, sp.ng) <= 0 && !sp.material->is_dielectric()) return Rgb(0.0f);
     const Vec3f wo = sp.frame.to_local(ls->wi);
     float pdf_bsdf;
     const Rgb f = sp.material->eval_and_pdf(sp.wi, wo, pdf_bsdf);

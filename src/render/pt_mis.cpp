@@ -31,13 +31,15 @@ public:
             // Paths of bounces + 1 bounces ending on a light: the MIS pair.
             L += beta * estimate_light_sample(scene, sp, sampler, /*mis=*/true);
             const auto s = sp.material->sample(sp.wi, sampler.next2d());
-            if (!s) break;
             EmitterHit found;
-            L += beta * estimate_bsdf_sample_mis(scene, sp, *s, found);
+            if (s) L += beta * estimate_bsdf_sample_mis(scene, sp, *s, found);
             if (!rules_.may_bounce(bounces + 1)) break;
 
             // Continue the path: with the same BSDF sample (pt-mis) or a fresh one (pt-mis3).
-            BsdfSample next = *s;
+            // The fresh one is independent of the first: a rejected MIS sample (a direction
+            // below the surface, total internal reflection on a microfacet) must not end it.
+            if (!three_rays_ && !s) break;
+            BsdfSample next = s ? *s : BsdfSample{};
             if (three_rays_) {
                 const auto c = sp.material->sample(sp.wi, sampler.next2d());
                 if (!c) break;

@@ -12,12 +12,19 @@
 #include <optional>
 #include <variant>
 
+#include "scene/conductor.hpp"
+#include "scene/dielectric.hpp"
 #include "scene/phong.hpp"
-#include "scene/specular.hpp"
+#include "scene/plastic.hpp"
+#include "scene/roughconductor.hpp"
+#include "scene/roughdielectric.hpp"
+#include "scene/roughplastic.hpp"
 
 namespace pathlab {
 
-using MaterialModel = std::variant<PhongMaterial, MirrorMaterial, DielectricMaterial>;
+// One BSDF per header (parameters and defaults documented at the top of each).
+using MaterialModel = std::variant<PhongMaterial, ConductorMaterial, DielectricMaterial, RoughConductorMaterial,
+                                   RoughDielectricMaterial, PlasticMaterial, RoughPlasticMaterial>;
 
 struct Material {
     MaterialModel model;
@@ -54,17 +61,44 @@ struct Material {
             return pathlab::is_black(p->diffuse) && pathlab::is_black(p->specular);
         return false;
     }
-    // True when every lobe is a Dirac delta: light sampling cannot contribute there.
-    bool is_delta() const { return !std::holds_alternative<PhongMaterial>(model); }
-    bool is_dielectric() const { return std::holds_alternative<DielectricMaterial>(model); }
+    // True when every lobe is a Dirac delta: light sampling cannot contribute there (eval()
+    // is zero everywhere). Materials that mix delta and non-delta lobes (plastic) are not.
+    bool is_delta() const {
+        return std::holds_alternative<ConductorMaterial>(model) || std::holds_alternative<DielectricMaterial>(model);
+    }
+    // True for materials that transmit (both sides matter: never flipped, never twosided).
+    bool is_dielectric() const {
+        return std::holds_alternative<DielectricMaterial>(model) || std::holds_alternative<RoughDielectricMaterial>(model);
+    }
 };
 
 inline Material make_phong(const Rgb& diffuse, const Rgb& specular = Rgb(0.0f), float exponent = 1) {
     return Material{PhongMaterial{diffuse, specular, exponent}};
 }
-inline Material make_mirror(const Rgb& reflectance = Rgb(1.0f)) { return Material{MirrorMaterial{reflectance}}; }
+// A perfect mirror (conductor with material="none") scaled by `reflectance`.
+inline Material make_mirror(const Rgb& reflectance = Rgb(1.0f)) {
+    return Material{ConductorMaterial{Rgb(0.0f), Rgb(1.0f), reflectance}};
+}
+inline Material make_conductor(const ComplexIor& ior, const Rgb& reflectance = Rgb(1.0f)) {
+    return Material{ConductorMaterial{ior.eta, ior.k, reflectance}};
+}
+inline Material make_rough_conductor(const MicrofacetDistribution& d, const ComplexIor& ior = {Rgb(0.0f), Rgb(1.0f)},
+                                     const Rgb& reflectance = Rgb(1.0f)) {
+    return Material{RoughConductorMaterial{d, ior.eta, ior.k, reflectance}};
+}
 inline Material make_dielectric(float int_ior, float ext_ior = 1.000277f) {
     return Material{DielectricMaterial{int_ior, ext_ior}, false};
+}
+inline Material make_rough_dielectric(const MicrofacetDistribution& d, float int_ior, float ext_ior = 1.000277f) {
+    return Material{RoughDielectricMaterial{d, int_ior, ext_ior}, false};
+}
+inline Material make_plastic(const Rgb& diffuse, const Rgb& specular = Rgb(1.0f), float int_ior = 1.49f,
+                             float ext_ior = 1.000277f, bool nonlinear = false) {
+    return Material{PlasticMaterial{CoatedDiffuse(diffuse, specular, int_ior, ext_ior, nonlinear)}};
+}
+inline Material make_rough_plastic(const MicrofacetDistribution& d, const Rgb& diffuse, const Rgb& specular = Rgb(1.0f),
+                                   float int_ior = 1.49f, float ext_ior = 1.000277f, bool nonlinear = false) {
+    return Material{RoughPlasticMaterial{d, CoatedDiffuse(diffuse, specular, int_ior, ext_ior, nonlinear)}};
 }
 
 }  // namespace pathlab

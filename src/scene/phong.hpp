@@ -16,18 +16,9 @@
 #include "core/frame.hpp"
 #include "core/sampling.hpp"
 #include "core/vec.hpp"
+#include "scene/bsdf_sample.hpp"
 
 namespace pathlab {
-
-// One sampled direction of a BSDF. `f` is the BSDF value (no cosine), `pdfW` the solid-angle
-// density of `wo`. For a delta lobe (`delta`), `f` and `pdfW` are both the coefficient of the
-// Dirac delta so that f / pdfW is the weight; eval() and pdf() are zero for such directions.
-struct BsdfSample {
-    Vec3f wo;
-    Rgb f;
-    float pdfW = 0;
-    bool delta = false;
-};
 
 struct PhongMaterial {
     Rgb diffuse{0.0f};   // rho_d

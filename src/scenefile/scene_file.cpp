@@ -34,9 +34,13 @@ const std::set<std::string> kPropertyTags = {"float", "integer", "boolean", "str
                                              "spectrum", "point", "vector", "transform"};
 
 // Refractive indices by name (a few of Mitsuba's, at 589 nm).
+const char* const kBsdfTypes =
+    "diffuse, phong, conductor, roughconductor, dielectric, roughdielectric, plastic, roughplastic, twosided";
+
 const std::map<std::string, float> kNamedIors = {
     {"vacuum", 1.0f},       {"air", 1.000277f},    {"water", 1.3330f},   {"fused quartz", 1.458f},
     {"pyrex", 1.470f},      {"acrylic glass", 1.49f}, {"bk7", 1.5046f},  {"diamond", 2.419f},
+    {"polypropylene", 1.49f},
 };
 
 class Loader {
@@ -201,6 +205,7 @@ private:
             }
         }
         bool has(const std::string& name) const { return props_.count(name) > 0; }
+        const pugi::xml_node& node(const std::string& name) const { return props_.at(name).node; }
         const pugi::xml_node* find(const std::string& name, std::initializer_list<const char*> tags) {
             const auto it = props_.find(name);
             if (it == props_.end()) return nullptr;
@@ -463,7 +468,8 @@ private:
                 fail(inner[0], "a twosided BSDF cannot wrap another twosided BSDF");
             Properties(*this, n).check_all_used({});
             Material m = read_bsdf(inner[0]);
-            if (m.is_dielectric()) fail(inner[0], "a dielectric cannot be wrapped in twosided (both of its sides already matter)");
+            if (m.is_dielectric())
+                fail(inner[0], fmt::format("a {} cannot be wrapped in twosided (both of its sides already matter)", attr(inner[0], "type")));
             m.two_sided = true;
             return m;
         }
@@ -474,29 +480,101 @@ private:
             m = make_phong(p.get_rgb("reflectance", Rgb(0.5f)));
             p.check_all_used({"reflectance"});
         } else if (type == "phong") {
-            const Rgb kd = p.get_rgb("diffuse_reflectance", Rgb(0.5f)), ks = p.get_rgb("specular_reflectance", Rgb(0.2f));
+            const Rgb kd = p.get_rgb(alias(p, "diffuse_reflectance", "diffuseReflectance"), Rgb(0.5f));
+            const Rgb ks = p.get_rgb(alias(p, "specular_reflectance", "specularReflectance"), Rgb(0.2f));
             const float exponent = p.get_float("exponent", 30.0f);
             if (!(exponent >= 0)) fail(n, "the Phong exponent must not be negative");
             m = make_phong(kd, ks, exponent);
             p.check_all_used({"diffuse_reflectance", "specular_reflectance", "exponent"});
         } else if (type == "conductor") {
-            if (const auto mat = p.get_string("material"); mat && *mat != "none")
-                fail(*p.find("material", {"string"}),
-                     fmt::format("conductor material '{}' is not supported: pathlab's conductor is a perfect mirror "
-                                 "(material=\"none\")", *mat));
-            m = make_mirror(p.get_rgb("specular_reflectance", Rgb(1.0f)));
-            p.check_all_used({"material", "specular_reflectance"});
+            m = make_conductor(conductor_ior(p, n), p.get_rgb(alias(p, "specular_reflectance", "specularReflectance"), Rgb(1.0f)));
+            p.check_all_used({"material", "eta", "k", "specular_reflectance"});
+        } else if (type == "roughconductor") {
+            const MicrofacetDistribution d = microfacet(p, n);
+            m = make_rough_conductor(d, conductor_ior(p, n),
+                                     p.get_rgb(alias(p, "specular_reflectance", "specularReflectance"), Rgb(1.0f)));
+            p.check_all_used({"distribution", "alpha", "alpha_u", "alpha_v", "material", "eta", "k", "specular_reflectance",
+                              "sample_visible"});
         } else if (type == "dielectric") {
-            const float int_ior = ior(p, "int_ior", 1.5046f), ext_ior = ior(p, "ext_ior", 1.000277f);
+            const float int_ior = ior(p, alias(p, "int_ior", "intIOR"), 1.5046f);
+            const float ext_ior = ior(p, alias(p, "ext_ior", "extIOR"), 1.000277f);
             m = make_dielectric(int_ior, ext_ior);
             p.check_all_used({"int_ior", "ext_ior"});
+        } else if (type == "roughdielectric") {
+            const MicrofacetDistribution d = microfacet(p, n);
+            const float int_ior = ior(p, alias(p, "int_ior", "intIOR"), 1.5046f);
+            const float ext_ior = ior(p, alias(p, "ext_ior", "extIOR"), 1.000277f);
+            if (int_ior == ext_ior) fail(n, "int_ior and ext_ior are equal: the interface would be invisible");
+            m = make_rough_dielectric(d, int_ior, ext_ior);
+            p.check_all_used({"distribution", "alpha", "alpha_u", "alpha_v", "int_ior", "ext_ior", "sample_visible"});
+        } else if (type == "plastic" || type == "roughplastic") {
+            const bool rough = type == "roughplastic";
+            const MicrofacetDistribution d = rough ? microfacet(p, n, /*anisotropic=*/false) : MicrofacetDistribution();
+            const Rgb kd = p.get_rgb(alias(p, "diffuse_reflectance", "diffuseReflectance"), Rgb(0.5f));
+            const Rgb ks = p.get_rgb(alias(p, "specular_reflectance", "specularReflectance"), Rgb(1.0f));
+            const float int_ior = ior(p, alias(p, "int_ior", "intIOR"), 1.49f);
+            const float ext_ior = ior(p, alias(p, "ext_ior", "extIOR"), 1.000277f);
+            if (int_ior == ext_ior) fail(n, "int_ior and ext_ior are equal: the coating would be invisible");
+            const bool nonlinear = p.get_bool("nonlinear", false);
+            m = rough ? make_rough_plastic(d, kd, ks, int_ior, ext_ior, nonlinear) : make_plastic(kd, ks, int_ior, ext_ior, nonlinear);
+            if (rough)
+                p.check_all_used({"distribution", "alpha", "diffuse_reflectance", "specular_reflectance", "int_ior", "ext_ior",
+                                  "nonlinear", "sample_visible"});
+            else
+                p.check_all_used({"diffuse_reflectance", "specular_reflectance", "int_ior", "ext_ior", "nonlinear"});
         } else {
-            fail(n, fmt::format("unsupported bsdf type '{}'; supported: diffuse, phong, conductor, dielectric, twosided", type));
+            fail(n, fmt::format("unsupported bsdf type '{}'; supported: {}", type, kBsdfTypes));
         }
         m.two_sided = false;  // as in Mitsuba: black from behind unless wrapped in twosided
         return m;
     }
-    float ior(Properties& p, const char* name, float fallback) const {
+    // Mitsuba 0.6 spelled some parameters in camelCase (specularReflectance, alphaU, intIOR):
+    // either spelling is accepted, not both.
+    std::string alias(const Properties& p, const char* name, const char* old_name) const {
+        if (!p.has(old_name)) return name;
+        if (p.has(name)) fail(p.node(old_name), fmt::format("'{}' and '{}' are the same parameter; give one", name, old_name));
+        return old_name;
+    }
+
+    // The microfacet distribution of a rough BSDF: distribution, alpha or alpha_u + alpha_v.
+    MicrofacetDistribution microfacet(Properties& p, const pugi::xml_node& n, bool anisotropic = true) {
+        MicrofacetType type = MicrofacetType::Beckmann;  // Mitsuba's default
+        if (const auto d = p.get_string("distribution")) {
+            if (*d == "ggx") type = MicrofacetType::GGX;
+            else if (*d != "beckmann")
+                fail(p.node("distribution"), fmt::format("unsupported distribution '{}'; supported: beckmann, ggx", *d));
+        }
+        const std::string au_name = alias(p, "alpha_u", "alphaU"), av_name = alias(p, "alpha_v", "alphaV");
+        const bool uv = p.has(au_name) || p.has(av_name);
+        if (uv && !anisotropic)
+            fail(p.node(p.has(au_name) ? au_name : av_name), fmt::format("<bsdf type=\"{}\"> is isotropic: give alpha", attr(n, "type")));
+        if (uv && p.has("alpha")) fail(p.node("alpha"), "give either alpha or alpha_u and alpha_v, not both");
+        if (uv && !(p.has(au_name) && p.has(av_name))) fail(n, "anisotropic roughness needs both alpha_u and alpha_v");
+        const auto roughness = [&](const std::string& name) {
+            const float a = p.get_float(name, 0.1f);
+            if (p.has(name) && !(a >= 0 && a <= 10)) fail(p.node(name), fmt::format("{} must be between 0 and 10, got {}", name, a));
+            return a;
+        };
+        p.get_bool(alias(p, "sample_visible", "sampleVisible"), true);  // visible normals are always sampled
+        if (uv) return MicrofacetDistribution(type, roughness(au_name), roughness(av_name));
+        const float a = roughness("alpha");
+        return MicrofacetDistribution(type, a, a);
+    }
+
+    // A conductor's complex index: material="name", or eta and k (Mitsuba's default: none).
+    ComplexIor conductor_ior(Properties& p, const pugi::xml_node&) {
+        const auto name = p.get_string("material");
+        const bool explicit_ior = p.has("eta") || p.has("k");
+        if (name && explicit_ior) fail(p.node("material"), "give either material or eta and k, not both");
+        if (name) {
+            const auto ior = named_conductor(*name);
+            if (!ior) fail(p.node("material"), fmt::format("unknown conductor material '{}'; known: {}", *name, kNamedConductors));
+            return *ior;
+        }
+        return ComplexIor{p.get_rgb("eta", Rgb(0.0f)), p.get_rgb("k", Rgb(1.0f))};
+    }
+
+    float ior(Properties& p, const std::string& name, float fallback) const {
         const pugi::xml_node* n = p.find(name, {"float", "string"});
         if (!n) return fallback;
         const std::string v = attr(*n, "value");

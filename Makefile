@@ -21,7 +21,7 @@ render: build
 test: build
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 
-# The performance suite (about 6 minutes): throughput, scaling, Embree's bound, scene growth,
+# The performance suite (about 5 minutes on a quiet 2-core machine): throughput, scaling, Embree's bound, scene growth,
 # memory, allocations and pt-mis efficiency; Markdown on stdout, JSON in out/bench/.
 bench: build
 	$(BUILD)/bench/pathlab_bench perf --json out/bench/performance.json

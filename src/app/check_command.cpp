@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 
 #include "app/interrupt.hpp"
+#include "app/command_arguments.hpp"
 #include "app/tool_commands.hpp"
 #include "app/usage_error.hpp"
 #include "core/image_io.hpp"
@@ -73,8 +74,7 @@ CLI::App* add_check_command(CLI::App& app, CheckOptions& o) {
 }
 
 int run_check_command(const CheckOptions& o) {
-    const EstimatorInfo* info = find_estimator(o.algorithm);
-    if (!info) throw UsageError(fmt::format("unknown algorithm '{}'. Valid algorithms: {}", o.algorithm, estimator_names()));
+    const EstimatorInfo* info = &estimator_or_usage_error(o.algorithm);
     if (!fs::is_directory(o.references)) throw UsageError(fmt::format("--references {}: no such directory", o.references));
     std::map<int, std::string> mapping;
     if (!o.mapping.empty()) {

@@ -14,6 +14,7 @@
 #include <fmt/format.h>
 
 #include "app/interrupt.hpp"
+#include "app/command_arguments.hpp"
 #include "app/tool_commands.hpp"
 #include "app/usage_error.hpp"
 #include "core/image_io.hpp"
@@ -67,8 +68,7 @@ CLI::App* add_reference_command(CLI::App& app, ReferenceOptions& o) {
 }
 
 int run_reference_command(const ReferenceOptions& o) {
-    const EstimatorInfo* info = find_estimator(o.algorithm);
-    if (!info) throw UsageError(fmt::format("unknown algorithm '{}'. Valid algorithms: {}", o.algorithm, estimator_names()));
+    const EstimatorInfo* info = &estimator_or_usage_error(o.algorithm);
     const std::vector<int> scenes = parse_builtin_scene_list(o.scenes);
     int width = 0, height = 0;
     parse_resolution_option(o.resolution, width, height);

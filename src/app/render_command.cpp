@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "app/command_arguments.hpp"
 #include "app/interrupt.hpp"
 #include "app/usage_error.hpp"
 #include "core/image_io.hpp"
@@ -28,11 +29,6 @@ struct SceneJob {
     SceneDescription desc;
 };
 
-std::string scene_list() {
-    std::string out;
-    for (const BuiltinSceneInfo& s : builtin_scenes()) out += fmt::format("\n  {} {}", s.index, s.name);
-    return out;
-}
 
 bool looks_like_scene_file(const std::string& key) {
     return key.size() > 4 && key.compare(key.size() - 4, 4, ".xml") == 0;
@@ -47,10 +43,7 @@ std::vector<SceneJob> resolve_scenes(const std::string& spec, const SceneDefines
         for (const BuiltinSceneInfo& s : builtin_scenes()) add_builtin(s.index);
         return jobs;
     }
-    size_t start = 0;
-    while (start <= spec.size()) {
-        const size_t comma = std::min(spec.find(',', start), spec.size());
-        const std::string key = spec.substr(start, comma - start);
+    for (const std::string& key : split_comma_list(spec)) {
         if (looks_like_scene_file(key)) {
             // Scene-file errors (file:line:column) are usage errors: exit code 2.
             try {
@@ -59,16 +52,9 @@ std::vector<SceneJob> resolve_scenes(const std::string& spec, const SceneDefines
             } catch (const SceneFileError& e) {
                 throw UsageError(e.what());
             }
-            start = comma + 1;
-            continue;
+        } else {
+            add_builtin(builtin_scene_or_usage_error(key, /*scene_files_allowed=*/true));
         }
-        const auto index = find_builtin_scene(key);
-        if (!index)
-            throw UsageError(fmt::format("unknown scene '{}'. Valid scenes (index or name, comma-separated, or 'all'), "
-                                         "or a scene file ending in .xml:{}",
-                                         key, scene_list()));
-        add_builtin(*index);
-        start = comma + 1;
     }
     return jobs;
 }
@@ -104,13 +90,6 @@ void write_stats(const std::string& path, const SceneJob& job, const std::string
 
 }  // namespace
 
-bool parse_resolution(const std::string& text, int& width, int& height) {
-    char x = 0;
-    char rest = 0;
-    if (std::sscanf(text.c_str(), "%d%c%d%c", &width, &x, &height, &rest) != 3 || (x != 'x' && x != 'X')) return false;
-    return width > 0 && height > 0 && width <= 1 << 15 && height <= 1 << 15;
-}
-
 void add_render_options(CLI::App& app, RenderCommandOptions& o) {
     app.add_option("-s,--scene", o.scene,
                    "Scene: course index 0-7, name (see `pathlab scenes`), a scene file (.xml), a comma-separated list, or 'all'")
@@ -141,8 +120,7 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
 }
 
 int run_render_command(const RenderCommandOptions& o) {
-    if (o.algorithm_given && !find_estimator(o.algorithm))
-        throw UsageError(fmt::format("unknown algorithm '{}'. Valid algorithms: {}", o.algorithm, estimator_names()));
+    if (o.algorithm_given) estimator_or_usage_error(o.algorithm);
     SceneDefines defines;
     for (const std::string& d : o.defines) {
         const size_t eq = d.find('=');
@@ -155,13 +133,11 @@ int run_render_command(const RenderCommandOptions& o) {
     std::vector<const EstimatorInfo*> job_estimators;
     for (const SceneJob& job : jobs) {
         const std::string name = o.algorithm_given ? o.algorithm : job.desc.algorithm.value_or(o.algorithm);
-        job_estimators.push_back(find_estimator(name));
-        if (!job_estimators.back()) throw UsageError(fmt::format("unknown algorithm '{}'. Valid algorithms: {}", name, estimator_names()));
+        job_estimators.push_back(&estimator_or_usage_error(name));
     }
 
     int width = 0, height = 0;
-    if (!o.resolution.empty() && !parse_resolution(o.resolution, width, height))
-        throw UsageError(fmt::format("invalid --resolution '{}': expected WxH with positive integers, e.g. 512x512", o.resolution));
+    parse_resolution_option(o.resolution, width, height);
     if (o.spp_given && o.spp <= 0) throw UsageError(fmt::format("--spp must be a positive number of samples, got {}", o.spp));
     if (o.time_limit < 0 || !std::isfinite(o.time_limit)) throw UsageError("--time must be a positive number of seconds");
     if (o.threads < 0) throw UsageError("--threads must be positive");

@@ -33,7 +33,4 @@ void add_render_options(CLI::App& app, RenderCommandOptions& opt);
 // Validates the options (exit code 2 on bad usage) and runs the renders.
 int run_render_command(const RenderCommandOptions& opt);
 
-// Parses "WxH"; returns false if malformed or not positive.
-bool parse_resolution(const std::string& text, int& width, int& height);
-
 }  // namespace pathlab

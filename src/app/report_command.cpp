@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "app/interrupt.hpp"
+#include "app/command_arguments.hpp"
 #include "app/tool_commands.hpp"
 #include "app/usage_error.hpp"
 #include "core/image_io.hpp"
@@ -68,8 +69,7 @@ int run_report_command(const ReportOptions& o) {
     const int scene_index = scene_list.front();
     std::vector<const EstimatorInfo*> infos;
     for (const std::string& a : o.algorithms) {
-        const EstimatorInfo* e = find_estimator(a);
-        if (!e) throw UsageError(fmt::format("unknown algorithm '{}'. Valid algorithms: {}", a, estimator_names()));
+        const EstimatorInfo* e = &estimator_or_usage_error(a);
         if (std::find(infos.begin(), infos.end(), e) != infos.end()) throw UsageError(fmt::format("algorithm '{}' is listed twice", a));
         infos.push_back(e);
     }

@@ -74,8 +74,5 @@ struct ReportOptions {
 CLI::App* add_report_command(CLI::App& app, ReportOptions& o);
 int run_report_command(const ReportOptions& o);
 
-// Helpers shared by the subcommands.
-std::vector<int> parse_builtin_scene_list(const std::string& spec);  // "all" or "0,ceiling-glossy,..."
-void parse_resolution_option(const std::string& text, int& width, int& height);  // "" leaves 0x0
 
 }  // namespace pathlab

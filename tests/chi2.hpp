@@ -5,6 +5,7 @@
 // direction); rejections form one more cell whose expected count is N (1 - integral of pdf).
 #pragma once
 
+#include <cmath>
 #include <functional>
 #include <optional>
 #include <string>
@@ -61,5 +62,12 @@ double sidak_alpha(int tests, double family_alpha = 0.01);
 // (test_microfacet.cpp: 79 at present).
 constexpr int kSuiteChi2Tests = 64 + 96;
 inline double suite_chi2_alpha() { return sidak_alpha(kSuiteChi2Tests); }
+
+// A unit incoming direction theta degrees from the normal (+z), at an azimuth off the axes so
+// that anisotropic lobes are tested away from their symmetry planes.
+inline Vec3f incoming(float theta_degrees) {
+    const float t = theta_degrees * kPi / 180.0f;
+    return normalize(Vec3f(std::sin(t) * 0.8f, std::sin(t) * 0.6f, std::cos(t)));
+}
 
 }  // namespace pathlab::test

@@ -10,11 +10,6 @@ namespace {
 
 const double kAlpha = suite_chi2_alpha();
 
-Vec3f incoming(float theta_degrees) {
-    const float t = theta_degrees * kPi / 180.0f;
-    return normalize(Vec3f(std::sin(t) * 0.8f, std::sin(t) * 0.6f, std::cos(t)));
-}
-
 struct Case {
     float rho_d, rho_s, exponent, theta_in;
 };

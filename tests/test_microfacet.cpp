@@ -16,11 +16,6 @@ namespace {
 
 const double kAlpha = suite_chi2_alpha();
 
-Vec3f incoming(float theta_degrees) {
-    const float t = theta_degrees * kPi / 180.0f;
-    return normalize(Vec3f(std::sin(t) * 0.8f, std::sin(t) * 0.6f, std::cos(t)));
-}
-
 MicrofacetDistribution ggx(float au, float av = -1) { return {MicrofacetType::GGX, au, av < 0 ? au : av}; }
 MicrofacetDistribution beckmann(float au, float av = -1) { return {MicrofacetType::Beckmann, au, av < 0 ? au : av}; }
 

@@ -17,8 +17,8 @@
 
 #include <fmt/format.h>
 
-#include "app/cli.hpp"
 #include "biased_estimators.hpp"
+#include "cli_runner.hpp"
 #include "core/image_io.hpp"
 #include "render_helpers.hpp"
 #include "tools/check.hpp"
@@ -30,25 +30,6 @@
 namespace pathlab::test {
 namespace {
 namespace fs = std::filesystem;
-
-struct CliResult {
-    int code;
-    std::string out, err;
-};
-
-CliResult run(std::vector<std::string> args) {
-    args.insert(args.begin(), "pathlab");
-    std::vector<const char*> argv;
-    for (const std::string& a : args) argv.push_back(a.c_str());
-    testing::internal::CaptureStdout();
-    testing::internal::CaptureStderr();
-    const int code = run_cli(int(argv.size()), argv.data());
-    std::string out = testing::internal::GetCapturedStdout();
-    std::string err = testing::internal::GetCapturedStderr();
-    return {code, out, err};
-}
-
-bool contains(const std::string& s, const std::string& needle) { return s.find(needle) != std::string::npos; }
 
 std::string read_text(const std::string& path) {
     std::ifstream in(path);

@@ -40,17 +40,6 @@ std::map<int, uint64_t> reference_seeds(const std::string& dir) {
     return seeds;
 }
 
-// The size of a reference image (its resolution is the render's unless --resolution says
-// otherwise). Throws ImageIoError naming the file when it cannot be read.
-std::pair<int, int> reference_size(const ReferenceFile& ref) {
-    if (ref.kind == ReferenceKind::Course8bit) {
-        const Image8 img = read_png8(ref.path);
-        return {img.width, img.height};
-    }
-    const Image img = read_image(ref.path);
-    return {img.width(), img.height()};
-}
-
 }  // namespace
 
 CLI::App* add_check_command(CLI::App& app, CheckOptions& o) {
@@ -118,12 +107,14 @@ int run_check_command(const CheckOptions& o) {
         double seconds = 0;
         std::string tried;
         const std::optional<ReferenceFile> ref = find_reference(o.references, index, mapping, &tried);
-        std::optional<std::pair<int, int>> size;
+        // Read before rendering: an unreadable reference is not worth a render, and its size is
+        // the render's unless --resolution says otherwise.
+        std::optional<LoadedReference> loaded;
         std::string unreadable;
         if (ref) {
             reference_name = fs::path(ref->path).filename().string();
             try {
-                size = reference_size(*ref);
+                loaded = load_reference(*ref);
             } catch (const ImageIoError& e) {
                 unreadable = e.what();
             }
@@ -132,12 +123,12 @@ int run_check_command(const CheckOptions& o) {
             v = {Verdict::BlackByDesign, fmt::format("{} cannot sample point lights, the only lights here", info->name)};
         } else if (!ref) {
             v = {Verdict::Missing, "no reference: looked for " + tried};
-        } else if (!size) {
-            v = {Verdict::Error, unreadable};  // not worth a render
+        } else if (!loaded) {
+            v = {Verdict::Error, unreadable};
         } else {
             RenderSettings rs;
-            rs.width = width > 0 ? width : size->first;
-            rs.height = height > 0 ? height : size->second;
+            rs.width = width > 0 ? width : loaded->width();
+            rs.height = height > 0 ? height : loaded->height();
             rs.spp = o.spp;
             rs.seed = o.seed;
             const auto it = ref_seeds.find(index);
@@ -150,7 +141,7 @@ int run_check_command(const CheckOptions& o) {
                 fmt::print(stderr, "pathlab: interrupted\n");
                 return 130;
             }
-            v = judge_render(r.film.mean(), r.film.standard_error(), *ref);
+            v = judge_render(r.film.mean(), r.film.standard_error(), *loaded);
             if (v.verdict == Verdict::Ok || v.verdict == Verdict::Fail) ++compared;
         }
         if (v.verdict == Verdict::Fail || v.verdict == Verdict::Error) ++failed;

@@ -72,17 +72,35 @@ const char* verdict_name(Verdict v) {
     return "?";
 }
 
-SceneVerdict judge_render(const Image& mean, const Image& std_error, const ReferenceFile& reference) {
+LoadedReference load_reference(const ReferenceFile& reference) {
+    LoadedReference r;
+    r.kind = reference.kind;
+    if (reference.kind == ReferenceKind::Course8bit) {
+        r.course = read_png8(reference.path);
+    } else {
+        r.linear = read_image(reference.path);
+        if (!reference.stderr_path.empty()) r.linear_se = read_image(reference.stderr_path);
+    }
+    return r;
+}
+
+SceneVerdict judge_render(const Image& mean, const Image& std_error, const LoadedReference& reference) {
     try {
         if (reference.kind == ReferenceKind::Course8bit) {
-            const BlockComparison cmp = compare_with_course_reference(mean, read_png8(reference.path), std_error);
+            const BlockComparison cmp = compare_with_course_reference(mean, reference.course, std_error);
             return {cmp.passes_allowing_for_noise() ? Verdict::Ok : Verdict::Fail, cmp.describe()};
         }
-        const Image ref = read_image(reference.path);
-        const Image ref_se = reference.stderr_path.empty() ? Image() : read_image(reference.stderr_path);
-        const LinearCheck cmp = check_against_linear_reference(mean, std_error, ref, ref_se);
+        const LinearCheck cmp = check_against_linear_reference(mean, std_error, reference.linear, reference.linear_se);
         return {cmp.passes() ? Verdict::Ok : Verdict::Fail, cmp.describe()};
-    } catch (const std::exception& e) {  // unreadable file, size mismatch
+    } catch (const std::exception& e) {  // size mismatch
+        return {Verdict::Error, e.what()};
+    }
+}
+
+SceneVerdict judge_render(const Image& mean, const Image& std_error, const ReferenceFile& reference) {
+    try {
+        return judge_render(mean, std_error, load_reference(reference));
+    } catch (const std::exception& e) {  // unreadable file
         return {Verdict::Error, e.what()};
     }
 }

@@ -48,9 +48,21 @@ struct SceneVerdict {
     std::string detail;  // one line: the figures behind the verdict, or what went wrong
 };
 
-// Loads `reference` (and its standard errors) and judges the render (mean and per-pixel
-// standard errors) against it. Unreadable files and size mismatches give Verdict::Error with
-// the reason.
+// A reference read into memory: the course's 8-bit image, or a linear one with its standard
+// errors (empty when it has none).
+struct LoadedReference {
+    ReferenceKind kind = ReferenceKind::Linear;
+    Image8 course;
+    Image linear, linear_se;
+    int width() const { return kind == ReferenceKind::Course8bit ? course.width : linear.width(); }
+    int height() const { return kind == ReferenceKind::Course8bit ? course.height : linear.height(); }
+};
+// Throws ImageIoError naming the file that cannot be read.
+LoadedReference load_reference(const ReferenceFile& reference);
+
+// Judges the render (mean and per-pixel standard errors) against the reference. Size
+// mismatches (and, in the second form, unreadable files) give Verdict::Error with the reason.
+SceneVerdict judge_render(const Image& mean, const Image& std_error, const LoadedReference& reference);
 SceneVerdict judge_render(const Image& mean, const Image& std_error, const ReferenceFile& reference);
 
 }  // namespace pathlab

@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# Renders the golden images that tests/test_golden_images.cpp compares against, bit for bit.
+# They were made once, by the per-pixel estimator core at commit d26934e (before the
+# integrator architecture of issue 14), and must never be re-made to make a test pass: an
+# integrator refactoring that changes any of them has changed an estimator's result.
+# Usage (from the repository root, with that commit built): tests/data/golden/make.sh build/pathlab
+set -euo pipefail
+bin=${1:-build/pathlab}
+out=tests/data/golden
+algorithms=(eyelight direct-light direct-uniform direct-cosine direct-brdf direct-mis pt-naive pt-mis3 pt-mis)
+files=(example materials/plastic materials/roughconductor-beckmann materials/roughconductor materials/roughdielectric
+       materials/roughplastic materials/smooth)
+for a in "${algorithms[@]}"; do
+  for s in 0 1 2 3 4 5 6 7; do
+    "$bin" -q --scene "$s" -a "$a" --resolution 16x16 --spp 4 --seed 7 -o "$out/$s-$a.pfm"
+  done
+  for f in "${files[@]}"; do
+    "$bin" -q --scene "scenes/$f.xml" -a "$a" --resolution 16x12 --spp 4 --seed 7 -o "$out/$(basename "$f")-$a.pfm"
+  done
+done
+# The Sobol sampler, depth limits and Russian roulette settings.
+"$bin" -q --scene 3 -a pt-mis --sampler sobol --resolution 16x16 --spp 8 --seed 7 -o "$out/3-pt-mis-sobol.pfm"
+"$bin" -q --scene 5 -a pt-mis3 --max-depth 2 --rr-depth 0 --resolution 16x16 --spp 8 --seed 7 -o "$out/5-pt-mis3-depth2-rr0.pfm"
+"$bin" -q --scene scenes/materials/smooth.xml -a pt-naive --max-depth 5 --resolution 16x12 --spp 8 --seed 7 -o "$out/smooth-pt-naive-depth5.pfm"

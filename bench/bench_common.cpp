@@ -2,7 +2,7 @@
 
 #include <sys/resource.h>
 
-#include "render/estimator.hpp"
+#include "integrators/integrator.hpp"
 
 namespace pathlab::bench {
 

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "render/renderer.hpp"
+#include "job/renderer.hpp"
 
 namespace pathlab::bench {
 

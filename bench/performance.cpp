@@ -27,10 +27,10 @@
 #include <nlohmann/json.hpp>
 
 #include "bench_common.hpp"
-#include "core/rng.hpp"
+#include "samplers/sampler.hpp"
 #include "core/sampling.hpp"
 #include "instrument/allocation_counter.hpp"
-#include "render/estimator.hpp"
+#include "integrators/integrator.hpp"
 #include "scene/builtin_scenes.hpp"
 
 namespace pathlab::bench {

@@ -3,8 +3,8 @@
 
 #include <cmath>
 
-#include "render/direct_lighting.hpp"
-#include "render/estimator.hpp"
+#include "integrators/common/direct_lighting.hpp"
+#include "integrators/integrator.hpp"
 
 namespace pathlab::test {
 

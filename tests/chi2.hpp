@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "core/frame.hpp"
-#include "core/rng.hpp"
+#include "samplers/sampler.hpp"
 
 namespace pathlab::test {
 

@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "render/renderer.hpp"
+#include "job/renderer.hpp"
 #include "scene/builtin_scenes.hpp"
 
 namespace pathlab::test {

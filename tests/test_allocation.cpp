@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "instrument/allocation_counter.hpp"
-#include "render/renderer.hpp"
+#include "job/renderer.hpp"
 #include "scene/builtin_scenes.hpp"
 
 namespace pathlab {

@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "chi2.hpp"
-#include "scene/material.hpp"
+#include "bsdfs/material.hpp"
 
 namespace pathlab::test {
 namespace {

@@ -9,7 +9,7 @@
 #include <fmt/format.h>
 
 #include "cli_runner.hpp"
-#include "core/image_io.hpp"
+#include "image/image_io.hpp"
 
 namespace pathlab::test {
 namespace {

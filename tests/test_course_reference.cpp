@@ -2,11 +2,11 @@
 // (8-bit, gamma 2.2), judged as `pathlab check` judges them (tools/course_reference.hpp).
 #include <gtest/gtest.h>
 
-#include "core/image_io.hpp"
+#include "image/image_io.hpp"
 #include "biased_estimators.hpp"
-#include "render/direct_lighting.hpp"
+#include "integrators/common/direct_lighting.hpp"
 #include "render_helpers.hpp"
-#include "tools/course_reference.hpp"
+#include "judge/course_reference.hpp"
 
 namespace pathlab::test {
 namespace {

@@ -2,7 +2,7 @@
 // directly by the camera.
 #include <gtest/gtest.h>
 
-#include "core/image_statistics.hpp"
+#include "judge/image_statistics.hpp"
 #include "render_helpers.hpp"
 
 namespace pathlab::test {

@@ -2,8 +2,8 @@
 // against direct-mis (core/image_statistics.hpp), at a known false-alarm rate.
 #include <gtest/gtest.h>
 
-#include "core/image_statistics.hpp"
-#include "render/direct_lighting.hpp"
+#include "judge/image_statistics.hpp"
+#include "integrators/common/direct_lighting.hpp"
 #include "render_helpers.hpp"
 
 namespace pathlab::test {

@@ -4,8 +4,8 @@
 #include <filesystem>
 #include <fstream>
 
-#include "core/image_io.hpp"
-#include "core/rng.hpp"
+#include "image/image_io.hpp"
+#include "samplers/sampler.hpp"
 
 namespace pathlab::test {
 namespace {

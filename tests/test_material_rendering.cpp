@@ -5,7 +5,7 @@
 // (core/image_statistics.hpp) at a known false-alarm rate.
 #include <gtest/gtest.h>
 
-#include "core/image_statistics.hpp"
+#include "judge/image_statistics.hpp"
 #include "render_helpers.hpp"
 
 namespace pathlab::test {

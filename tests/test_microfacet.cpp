@@ -9,7 +9,7 @@
 #include <fmt/format.h>
 
 #include "chi2.hpp"
-#include "scene/material.hpp"
+#include "bsdfs/material.hpp"
 
 namespace pathlab::test {
 namespace {

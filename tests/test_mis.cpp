@@ -2,7 +2,7 @@
 // direction, so the balance-heuristic weights of a path sum to one.
 #include <gtest/gtest.h>
 
-#include "render/direct_lighting.hpp"
+#include "integrators/common/direct_lighting.hpp"
 #include "render_helpers.hpp"
 
 namespace pathlab::test {

@@ -2,7 +2,7 @@
 // at one bounce, agreement with each other, and unbiased Russian roulette.
 #include <gtest/gtest.h>
 
-#include "core/image_statistics.hpp"
+#include "judge/image_statistics.hpp"
 #include "render_helpers.hpp"
 
 namespace pathlab::test {

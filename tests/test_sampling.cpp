@@ -3,7 +3,7 @@
 
 #include "chi2.hpp"
 #include "core/sampling.hpp"
-#include "scene/light.hpp"
+#include "lights/light.hpp"
 
 namespace pathlab::test {
 namespace {

@@ -8,10 +8,10 @@
 
 #include <fmt/format.h>
 
-#include "core/image_statistics.hpp"
+#include "judge/image_statistics.hpp"
 #include "render_helpers.hpp"
 #include "scenefile/scene_file.hpp"
-#include "scenefile/transform.hpp"
+#include "core/transform.hpp"
 
 namespace pathlab {
 namespace {

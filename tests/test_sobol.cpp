@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "chi2.hpp"
-#include "core/image_statistics.hpp"
+#include "judge/image_statistics.hpp"
 #include "render_helpers.hpp"
 
 namespace pathlab {

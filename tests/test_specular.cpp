@@ -2,7 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "chi2.hpp"
-#include "core/image_statistics.hpp"
+#include "judge/image_statistics.hpp"
 #include "render_helpers.hpp"
 
 namespace pathlab::test {

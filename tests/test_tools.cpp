@@ -19,13 +19,13 @@
 
 #include "biased_estimators.hpp"
 #include "cli_runner.hpp"
-#include "core/image_io.hpp"
+#include "image/image_io.hpp"
 #include "render_helpers.hpp"
-#include "tools/check.hpp"
-#include "tools/false_colour.hpp"
-#include "tools/image_compare.hpp"
-#include "tools/reference_set.hpp"
-#include "tools/svg_plot.hpp"
+#include "judge/check.hpp"
+#include "judge/false_colour.hpp"
+#include "judge/image_compare.hpp"
+#include "judge/reference_set.hpp"
+#include "judge/svg_plot.hpp"
 
 namespace pathlab::test {
 namespace {

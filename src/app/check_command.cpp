@@ -16,11 +16,11 @@
 #include "app/command_arguments.hpp"
 #include "app/tool_commands.hpp"
 #include "app/usage_error.hpp"
-#include "core/image_io.hpp"
-#include "render/renderer.hpp"
+#include "image/image_io.hpp"
+#include "job/renderer.hpp"
 #include "scene/builtin_scenes.hpp"
-#include "tools/check.hpp"
-#include "tools/reference_set.hpp"
+#include "judge/check.hpp"
+#include "judge/reference_set.hpp"
 
 namespace pathlab {
 namespace fs = std::filesystem;

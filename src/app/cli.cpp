@@ -7,7 +7,7 @@
 #include "app/render_command.hpp"
 #include "app/tool_commands.hpp"
 #include "app/usage_error.hpp"
-#include "render/estimator.hpp"
+#include "integrators/integrator.hpp"
 #include "scene/builtin_scenes.hpp"
 
 namespace pathlab {

@@ -6,7 +6,7 @@
 #include <fmt/format.h>
 
 #include "app/usage_error.hpp"
-#include "render/estimator.hpp"
+#include "integrators/integrator.hpp"
 #include "scene/builtin_scenes.hpp"
 
 namespace pathlab {

@@ -6,9 +6,9 @@
 
 #include "app/tool_commands.hpp"
 #include "app/usage_error.hpp"
-#include "core/image_io.hpp"
-#include "tools/false_colour.hpp"
-#include "tools/image_compare.hpp"
+#include "image/image_io.hpp"
+#include "judge/false_colour.hpp"
+#include "judge/image_compare.hpp"
 
 namespace pathlab {
 namespace {

@@ -10,8 +10,8 @@
 #include "app/command_arguments.hpp"
 #include "app/interrupt.hpp"
 #include "app/usage_error.hpp"
-#include "core/image_io.hpp"
-#include "render/renderer.hpp"
+#include "image/image_io.hpp"
+#include "job/renderer.hpp"
 #include "scene/builtin_scenes.hpp"
 #include "scenefile/scene_file.hpp"
 

@@ -12,12 +12,12 @@
 #include "app/command_arguments.hpp"
 #include "app/tool_commands.hpp"
 #include "app/usage_error.hpp"
-#include "core/image_io.hpp"
-#include "render/renderer.hpp"
+#include "image/image_io.hpp"
+#include "job/renderer.hpp"
 #include "scene/builtin_scenes.hpp"
-#include "tools/html_report.hpp"
-#include "tools/image_compare.hpp"
-#include "tools/reference_set.hpp"
+#include "judge/html_report.hpp"
+#include "judge/image_compare.hpp"
+#include "judge/reference_set.hpp"
 
 namespace pathlab {
 namespace fs = std::filesystem;

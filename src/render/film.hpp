@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "core/image.hpp"
+#include "image/image.hpp"
 
 namespace pathlab {
 

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "scene/accel.hpp"
+#include "geometry/accel.hpp"
 #include "scene/scene_description.hpp"
 
 namespace pathlab {

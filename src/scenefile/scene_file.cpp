@@ -14,8 +14,8 @@
 
 #include <fmt/format.h>
 
-#include "render/estimator.hpp"
-#include "scenefile/shape_meshes.hpp"
+#include "integrators/integrator.hpp"
+#include "geometry/shape_meshes.hpp"
 
 namespace pathlab {
 

@@ -1,0 +1,104 @@
+// Materials (BSDFs). A closed set of types dispatched with std::visit in the hot loop.
+//
+// Conventions, stated once for every material:
+//  - Directions are unit vectors in the local shading frame (normal = +z), and both point
+//    away from the surface: `wi` towards where the path came from (the camera side), `wo`
+//    the other direction (towards a light, or the sampled continuation).
+//  - eval(wi, wo) returns the BSDF value f (no cosine factor).
+//  - pdf(wi, wo) and BsdfSample::pdfW are densities per unit solid angle of wo.
+//  - sample(wi, u) draws wo given two uniform numbers in [0,1).
+#pragma once
+
+#include <optional>
+#include <variant>
+
+#include "bsdfs/conductor.hpp"
+#include "bsdfs/dielectric.hpp"
+#include "bsdfs/phong.hpp"
+#include "bsdfs/plastic.hpp"
+#include "bsdfs/roughconductor.hpp"
+#include "bsdfs/roughdielectric.hpp"
+#include "bsdfs/roughplastic.hpp"
+
+namespace pathlab {
+
+// One BSDF per header (parameters and defaults documented at the top of each).
+using MaterialModel = std::variant<PhongMaterial, ConductorMaterial, DielectricMaterial, RoughConductorMaterial,
+                                   RoughDielectricMaterial, PlasticMaterial, RoughPlasticMaterial>;
+
+struct Material {
+    MaterialModel model;
+    // Two-sided materials shade the back of a surface like its front (the frame is flipped
+    // to face the incoming direction); one-sided ones are black from behind. A dielectric
+    // is neither: both of its sides are meaningful, and its frame is never flipped.
+    bool two_sided = true;
+
+    Rgb eval(const Vec3f& wi, const Vec3f& wo) const {
+        return std::visit([&](const auto& m) { return m.eval(wi, wo); }, model);
+    }
+    float pdf(const Vec3f& wi, const Vec3f& wo) const {
+        return std::visit([&](const auto& m) { return m.pdf(wi, wo); }, model);
+    }
+    // eval() and pdf() together, for models that can share work between them.
+    Rgb eval_and_pdf(const Vec3f& wi, const Vec3f& wo, float& pdf) const {
+        return std::visit(
+            [&](const auto& m) {
+                if constexpr (requires { m.eval_and_pdf(wi, wo, pdf); }) {
+                    return m.eval_and_pdf(wi, wo, pdf);
+                } else {
+                    pdf = m.pdf(wi, wo);
+                    return m.eval(wi, wo);
+                }
+            },
+            model);
+    }
+    std::optional<BsdfSample> sample(const Vec3f& wi, const Vec2f& u) const {
+        return std::visit([&](const auto& m) { return m.sample(wi, u); }, model);
+    }
+    // True when the material reflects nothing (pure emitters): estimators stop there.
+    bool is_black() const {
+        if (const auto* p = std::get_if<PhongMaterial>(&model))
+            return pathlab::is_black(p->diffuse) && pathlab::is_black(p->specular);
+        return false;
+    }
+    // True when every lobe is a Dirac delta: light sampling cannot contribute there (eval()
+    // is zero everywhere). Materials that mix delta and non-delta lobes (plastic) are not.
+    bool is_delta() const {
+        return std::holds_alternative<ConductorMaterial>(model) || std::holds_alternative<DielectricMaterial>(model);
+    }
+    // True for materials that transmit (both sides matter: never flipped, never twosided).
+    bool is_dielectric() const {
+        return std::holds_alternative<DielectricMaterial>(model) || std::holds_alternative<RoughDielectricMaterial>(model);
+    }
+};
+
+inline Material make_phong(const Rgb& diffuse, const Rgb& specular = Rgb(0.0f), float exponent = 1) {
+    return Material{PhongMaterial{diffuse, specular, exponent}};
+}
+// A perfect mirror (conductor with material="none") scaled by `reflectance`.
+inline Material make_mirror(const Rgb& reflectance = Rgb(1.0f)) {
+    return Material{ConductorMaterial{Rgb(0.0f), Rgb(1.0f), reflectance}};
+}
+inline Material make_conductor(const ComplexIor& ior, const Rgb& reflectance = Rgb(1.0f)) {
+    return Material{ConductorMaterial{ior.eta, ior.k, reflectance}};
+}
+inline Material make_rough_conductor(const MicrofacetDistribution& d, const ComplexIor& ior = {Rgb(0.0f), Rgb(1.0f)},
+                                     const Rgb& reflectance = Rgb(1.0f)) {
+    return Material{RoughConductorMaterial{d, ior.eta, ior.k, reflectance}};
+}
+inline Material make_dielectric(float int_ior, float ext_ior = 1.000277f) {
+    return Material{DielectricMaterial{int_ior, ext_ior}, false};
+}
+inline Material make_rough_dielectric(const MicrofacetDistribution& d, float int_ior, float ext_ior = 1.000277f) {
+    return Material{RoughDielectricMaterial{d, int_ior, ext_ior}, false};
+}
+inline Material make_plastic(const Rgb& diffuse, const Rgb& specular = Rgb(1.0f), float int_ior = 1.49f,
+                             float ext_ior = 1.000277f, bool nonlinear = false) {
+    return Material{PlasticMaterial{CoatedDiffuse(diffuse, specular, int_ior, ext_ior, nonlinear)}};
+}
+inline Material make_rough_plastic(const MicrofacetDistribution& d, const Rgb& diffuse, const Rgb& specular = Rgb(1.0f),
+                                   float int_ior = 1.49f, float ext_ior = 1.000277f, bool nonlinear = false) {
+    return Material{RoughPlasticMaterial{d, CoatedDiffuse(diffuse, specular, int_ior, ext_ior, nonlinear)}};
+}
+
+}  // namespace pathlab

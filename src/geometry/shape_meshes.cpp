@@ -1,0 +1,128 @@
+#include "geometry/shape_meshes.hpp"
+
+#include <filesystem>
+
+#include <tiny_obj_loader.h>
+
+#include <cmath>
+#include <map>
+
+#include <fmt/format.h>
+
+namespace pathlab {
+
+MeshDesc rectangle_mesh() {
+    MeshDesc m;
+    m.positions = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
+    m.triangles = {{0, 1, 2}, {2, 3, 0}};
+    return m;
+}
+
+MeshDesc cube_mesh() {
+    MeshDesc m;
+    for (int i = 0; i < 8; ++i) m.positions.push_back({i & 1 ? 1.0f : -1.0f, i & 2 ? 1.0f : -1.0f, i & 4 ? 1.0f : -1.0f});
+    // Two counter-clockwise (seen from outside) triangles per face.
+    m.triangles = {{0, 2, 3}, {3, 1, 0},   // z = -1
+                   {4, 5, 7}, {7, 6, 4},   // z = +1
+                   {0, 1, 5}, {5, 4, 0},   // y = -1
+                   {2, 6, 7}, {7, 3, 2},   // y = +1
+                   {0, 4, 6}, {6, 2, 0},   // x = -1
+                   {1, 3, 7}, {7, 5, 1}};  // x = +1
+    return m;
+}
+
+MeshDesc disk_mesh(int segments) {
+    MeshDesc m;
+    m.positions.push_back({0, 0, 0});
+    for (int i = 0; i < segments; ++i) {
+        const double phi = 2 * 3.14159265358979323846 * i / segments;
+        m.positions.push_back({float(std::cos(phi)), float(std::sin(phi)), 0});
+    }
+    for (int i = 0; i < segments; ++i) m.triangles.push_back({0, uint32_t(1 + i), uint32_t(1 + (i + 1) % segments)});
+    return m;
+}
+
+MeshDesc load_obj_mesh(const std::string& path) {
+    tinyobj::ObjReaderConfig config;
+    config.triangulate = true;
+    config.vertex_color = false;
+    config.mtl_search_path = "";
+    // Devices and directories would hang or confuse the parser (/dev/zero never ends).
+    std::error_code ec;
+    if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
+        throw MeshLoadError(fmt::format("cannot read mesh '{}': not a regular file", path));
+    tinyobj::ObjReader reader;
+    if (!reader.ParseFromFile(path, config)) {
+        std::string why = reader.Error();
+        while (!why.empty() && (why.back() == '\n' || why.back() == '\r')) why.pop_back();
+        throw MeshLoadError(fmt::format("cannot read mesh '{}': {}", path, why.empty() ? "unknown error" : why));
+    }
+    const tinyobj::attrib_t& a = reader.GetAttrib();
+    MeshDesc m;
+    m.name = path;
+    const size_t vertex_count = a.vertices.size() / 3;
+    bool all_normals = !a.normals.empty();
+    size_t faces = 0;
+    for (const tinyobj::shape_t& s : reader.GetShapes()) {
+        faces += s.mesh.num_face_vertices.size();
+        for (const tinyobj::index_t& i : s.mesh.indices) all_normals = all_normals && i.normal_index >= 0;
+    }
+    if (faces == 0) throw MeshLoadError(fmt::format("mesh '{}' has no faces", path));
+    for (size_t v = 0; v < vertex_count; ++v) {
+        const Vec3f p(a.vertices[3 * v], a.vertices[3 * v + 1], a.vertices[3 * v + 2]);
+        if (!is_finite(p)) throw MeshLoadError(fmt::format("mesh '{}': vertex {} is not finite", path, v + 1));
+    }
+
+    // Without normals the file's vertex list is used as it is; with them, one vertex per
+    // distinct (position, normal) pair.
+    std::map<std::pair<int, int>, uint32_t> remap;
+    const auto vertex = [&](const tinyobj::index_t& i) -> uint32_t {
+        if (i.vertex_index < 0 || size_t(i.vertex_index) >= vertex_count)
+            throw MeshLoadError(fmt::format("mesh '{}' refers to a vertex that does not exist", path));
+        if (!all_normals) return uint32_t(i.vertex_index);
+        const auto key = std::make_pair(i.vertex_index, i.normal_index);
+        const auto [it, added] = remap.emplace(key, uint32_t(m.positions.size()));
+        if (added) {
+            const size_t v = size_t(i.vertex_index), n = size_t(i.normal_index);
+            if (3 * n + 2 >= a.normals.size())
+                throw MeshLoadError(fmt::format("mesh '{}' refers to a normal that does not exist", path));
+            m.positions.push_back({a.vertices[3 * v], a.vertices[3 * v + 1], a.vertices[3 * v + 2]});
+            m.normals.push_back({a.normals[3 * n], a.normals[3 * n + 1], a.normals[3 * n + 2]});
+        }
+        return it->second;
+    };
+    if (!all_normals)
+        for (size_t v = 0; v < vertex_count; ++v) m.positions.push_back({a.vertices[3 * v], a.vertices[3 * v + 1], a.vertices[3 * v + 2]});
+    for (const tinyobj::shape_t& s : reader.GetShapes()) {
+        size_t offset = 0;
+        for (const unsigned char count : s.mesh.num_face_vertices) {
+            if (count == 3)
+                m.triangles.push_back({vertex(s.mesh.indices[offset]), vertex(s.mesh.indices[offset + 1]),
+                                       vertex(s.mesh.indices[offset + 2])});
+            offset += count;
+        }
+    }
+    if (m.triangles.empty()) throw MeshLoadError(fmt::format("mesh '{}' has no triangles", path));
+    for (const Vec3f& n : m.normals)
+        if (!is_finite(n)) throw MeshLoadError(fmt::format("mesh '{}' has a non-finite normal", path));
+    return m;
+}
+
+void transform_mesh(MeshDesc& mesh, const Transform& t) {
+    if (t.m == Transform().m) return;
+    for (Vec3f& p : mesh.positions) p = Vec3f(t.point(Vec3d(p)));
+    for (Vec3f& n : mesh.normals) {
+        const Vec3d tn = t.normal(Vec3d(n));
+        const double len = length(tn);
+        n = len > 0 ? Vec3f(tn / len) : Vec3f(0.0f);
+    }
+}
+
+void use_face_normals(MeshDesc& mesh) { mesh.normals.clear(); }
+
+void flip_mesh_normals(MeshDesc& mesh) {
+    for (auto& tri : mesh.triangles) std::swap(tri[1], tri[2]);
+    for (Vec3f& n : mesh.normals) n = -n;
+}
+
+}  // namespace pathlab

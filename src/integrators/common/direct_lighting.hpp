@@ -1,0 +1,79 @@
+// Direct lighting at a shading point, shared by every estimator: next-event estimation (light
+// sampling), tracing a sampled direction to the emitter it finds, and the BSDF-sampled half of
+// multiple importance sampling.
+#pragma once
+
+#include "samplers/sampler.hpp"
+#include "core/sampling.hpp"
+#include "integrators/common/shading.hpp"
+
+namespace pathlab {
+
+// One light chosen with probability proportional to power, one point or direction sampled on
+// it, one shadow ray. Returns f * Le * cos(theta) / (pmf * pdfW). With `mis`, the result is
+// weighted by the balance heuristic against BSDF sampling of the same direction (both
+// densities in solid angle, the light's including its selection probability); delta lights
+// cannot be found by BSDF sampling and keep weight 1.
+inline Rgb estimate_light_sample(const Scene& scene, const ShadingPoint& sp, Sampler& sampler, bool mis) {
+    const LightChoice choice = scene.choose_light(sampler.next1d());
+    const Vec2f u = sampler.next2d();
+    if (choice.index < 0) return Rgb(0.0f);
+    const auto ls = sample_light(scene.lights()[size_t(choice.index)], sp.p, u);
+    if (!ls || is_black(ls->Le)) return Rgb(0.0f);
+    // Lights behind the surface reach it only through a transmitting material (rough glass).
+    if (dot(ls->wi, sp.ng) <= 0 && !sp.material->is_dielectric()) return Rgb(0.0f);
+    const Vec3f wo = sp.frame.to_local(ls->wi);
+    float pdf_bsdf;
+    const Rgb f = sp.material->eval_and_pdf(sp.wi, wo, pdf_bsdf);
+    if (is_black(f)) return Rgb(0.0f);
+    const Ray shadow = std::isinf(ls->distance) ? spawn_ray(sp.p, sp.ng, ls->wi)
+                                                : spawn_segment(sp.p, sp.ng, ls->point, ls->normal);
+    if (scene.occluded(shadow)) return Rgb(0.0f);
+    const float pdf_light = choice.pmf * ls->pdfW;
+    const float weight = (mis && !ls->delta) ? balance_heuristic(pdf_light, pdf_bsdf) : 1.0f;
+    return f * ls->Le * (std::abs(wo.z) * weight / pdf_light);
+}
+
+// What a ray leaving a shading point finds: the surface it hits (if any), the radiance emitted
+// towards the shading point (a front-facing area light, or the environment if the ray
+// escapes), and the solid-angle density with which light sampling from `from` would have
+// produced this direction, including the light's selection probability. The BSDF-sampled
+// half of MIS weighs its emission with this density.
+struct EmitterHit {
+    bool hit = false;
+    Intersection isect;
+    Rgb Le{0.0f};
+    float pdf_light = 0;
+};
+
+inline EmitterHit trace_to_emitter(const Scene& scene, const Ray& ray, const Vec3f& from) {
+    EmitterHit e;
+    e.hit = scene.intersect(ray, e.isect);
+    if (!e.hit) {
+        const int env = scene.environment_light();
+        if (env >= 0) {
+            e.Le = scene.escaped_radiance();
+            e.pdf_light = scene.light_pmf(env) * std::get<EnvironmentLight>(scene.lights()[size_t(env)]).pdfW();
+        }
+        return e;
+    }
+    e.Le = emitted_radiance(scene, e.isect, -ray.d / length(ray.d));
+    if (!is_black(e.Le)) {
+        const Light& light = scene.lights()[size_t(e.isect.light)];
+        e.pdf_light = scene.light_pmf(e.isect.light) * surface_light_pdfW(light, from, e.isect.p, e.isect.ng);
+    }
+    return e;
+}
+
+// The BSDF-sampled half of MIS direct lighting: traces the sampled direction and returns the
+// emission it finds weighted by the balance heuristic against light sampling (weight 1 for a
+// delta BSDF sample, which light sampling cannot produce). `found` receives the hit, for path
+// tracers that continue from it.
+inline Rgb estimate_bsdf_sample_mis(const Scene& scene, const ShadingPoint& sp, const BsdfSample& s, EmitterHit& found) {
+    found = trace_to_emitter(scene, sp.spawn(s.wo), sp.p);
+    if (is_black(found.Le)) return Rgb(0.0f);
+    const float weight = s.delta ? 1.0f : balance_heuristic(s.pdfW, found.pdf_light);
+    return s.f * found.Le * (std::abs(s.wo.z) * weight / s.pdfW);
+}
+
+}  // namespace pathlab

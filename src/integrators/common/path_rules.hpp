@@ -1,0 +1,42 @@
+// When a path may go on: the depth limit and Russian roulette, shared by the path tracers.
+//
+// Depth counts bounces: a path camera -> x1 -> light has one bounce (direct illumination), so
+// max_depth = 1 gives direct lighting only. Russian roulette starts after rr_depth bounces
+// (never if rr_depth < 0): the path survives with probability q = clamp(max(beta), 0.05, 1)
+// and its throughput beta is divided by q, which keeps the estimator unbiased; the lower
+// bound keeps 1/q bounded. A hard cap of kMaxBounces guards against paths that never end
+// (albedos above 1, as the course's glossy spheres have); it truncates a vanishing tail.
+#pragma once
+
+#include <algorithm>
+
+#include "samplers/sampler.hpp"
+#include "integrators/integrator.hpp"
+
+namespace pathlab {
+
+inline constexpr int kMaxBounces = 1024;
+
+class PathRules {
+public:
+    explicit PathRules(const EstimatorOptions& o)
+        : max_depth_(o.max_depth < 0 ? kMaxBounces : std::min(o.max_depth, kMaxBounces)), rr_depth_(o.rr_depth) {}
+
+    // May a path that has made `bounces` bounces make one more?
+    bool may_bounce(int bounces) const { return bounces < max_depth_; }
+
+    // Called after bounce number `bounces` (1-based) updated beta; false ends the path.
+    bool survive_roulette(int bounces, Rgb& beta, Sampler& sampler) const {
+        if (rr_depth_ < 0 || bounces < rr_depth_) return true;
+        const float q = std::clamp(max_component(beta), 0.05f, 1.0f);
+        if (sampler.next1d() >= q) return false;
+        beta /= q;
+        return true;
+    }
+
+private:
+    int max_depth_;
+    int rr_depth_;
+};
+
+}  // namespace pathlab

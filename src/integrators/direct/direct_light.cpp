@@ -1,0 +1,27 @@
+// direct-light (course assignment 1): direct illumination by explicit light sampling.
+// At the first surface a camera ray hits: its own emission (if it is an area light, seen from
+// the front) plus one light sample (light chosen by power, see Scene::choose_light) with a
+// shadow ray. Rays that escape return the environment's radiance.
+#include "integrators/integrators.hpp"
+#include "integrators/common/direct_lighting.hpp"
+
+namespace pathlab {
+namespace {
+
+class DirectLight final : public Estimator {
+public:
+    Rgb radiance(const Scene& scene, const Ray& ray, Sampler& sampler) const override {
+        Intersection hit;
+        if (!scene.intersect(ray, hit)) return scene.escaped_radiance();
+        Rgb L = emitted_radiance(scene, hit, -ray.d);
+        const ShadingPoint sp = make_shading_point(scene, hit, ray.d);
+        if (sp.material->is_black()) return L;
+        return L + estimate_light_sample(scene, sp, sampler, /*mis=*/false);
+    }
+};
+
+}  // namespace
+
+std::unique_ptr<Estimator> make_direct_light(const EstimatorOptions&) { return std::make_unique<DirectLight>(); }
+
+}  // namespace pathlab

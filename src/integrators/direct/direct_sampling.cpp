@@ -1,0 +1,70 @@
+// Direct illumination by sampling directions at the first surface (course assignments 2A-2C):
+//   direct-uniform (2a): uniform hemisphere around the shading normal, pdfW = 1 / (2 pi)
+//   direct-cosine  (2b): cosine-weighted hemisphere, pdfW = cos(theta) / pi
+//   direct-brdf    (2c): the material's own sampling (Phong: lobe mixture, see phong.hpp)
+// The sampled ray adds f Le cos / pdfW if it hits the front of an area light or escapes to the
+// environment. A point light is never hit by a sampled direction, so these estimators are
+// black in scenes lit only by point lights (0, 1): correct, and why MIS exists.
+#include "integrators/integrators.hpp"
+#include "integrators/common/direct_lighting.hpp"
+
+namespace pathlab {
+namespace {
+
+enum class Strategy { UniformHemisphere, CosineHemisphere, Brdf };
+
+class DirectBySampling final : public Estimator {
+public:
+    explicit DirectBySampling(Strategy s) : strategy_(s) {}
+
+    Rgb radiance(const Scene& scene, const Ray& ray, Sampler& sampler) const override {
+        Intersection hit;
+        if (!scene.intersect(ray, hit)) return scene.escaped_radiance();
+        Rgb L = emitted_radiance(scene, hit, -ray.d);
+        const ShadingPoint sp = make_shading_point(scene, hit, ray.d);
+        if (sp.material->is_black()) return L;
+
+        const Vec2f u = sampler.next2d();
+        Vec3f wo;
+        Rgb f;
+        float pdfW = 0;
+        switch (strategy_) {
+            case Strategy::UniformHemisphere:
+                wo = square_to_uniform_hemisphere(u);
+                pdfW = uniform_hemisphere_pdf(wo);
+                f = sp.material->eval(sp.wi, wo);
+                break;
+            case Strategy::CosineHemisphere:
+                wo = square_to_cosine_hemisphere(u);
+                pdfW = cosine_hemisphere_pdf(wo);
+                f = sp.material->eval(sp.wi, wo);
+                break;
+            case Strategy::Brdf: {
+                const auto s = sp.material->sample(sp.wi, u);
+                if (!s) return L;
+                wo = s->wo, f = s->f, pdfW = s->pdfW;
+                break;
+            }
+        }
+        if (!(pdfW > 0) || is_black(f)) return L;
+        const EmitterHit e = trace_to_emitter(scene, sp.spawn(wo), sp.p);
+        return L + f * e.Le * (std::abs(wo.z) / pdfW);
+    }
+
+private:
+    Strategy strategy_;
+};
+
+}  // namespace
+
+std::unique_ptr<Estimator> make_direct_uniform(const EstimatorOptions&) {
+    return std::make_unique<DirectBySampling>(Strategy::UniformHemisphere);
+}
+std::unique_ptr<Estimator> make_direct_cosine(const EstimatorOptions&) {
+    return std::make_unique<DirectBySampling>(Strategy::CosineHemisphere);
+}
+std::unique_ptr<Estimator> make_direct_brdf(const EstimatorOptions&) {
+    return std::make_unique<DirectBySampling>(Strategy::Brdf);
+}
+
+}  // namespace pathlab

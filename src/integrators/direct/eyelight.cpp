@@ -1,0 +1,21 @@
+// eyelight: a debugging view. Each pixel shows |cos| between the camera ray and the surface
+// normal it hits (black where the ray escapes). No lights, no materials.
+#include "integrators/integrators.hpp"
+
+namespace pathlab {
+namespace {
+
+class EyeLight final : public Estimator {
+public:
+    Rgb radiance(const Scene& scene, const Ray& ray, Sampler&) const override {
+        Intersection hit;
+        if (!scene.intersect(ray, hit)) return Rgb(0.0f);
+        return Rgb(std::abs(dot(ray.d, hit.ns)));
+    }
+};
+
+}  // namespace
+
+std::unique_ptr<Estimator> make_eyelight(const EstimatorOptions&) { return std::make_unique<EyeLight>(); }
+
+}  // namespace pathlab

@@ -1,0 +1,68 @@
+// Path tracing with next-event estimation combined by MIS (course assignments 4B and 4C).
+// At every surface x_k the path adds, times its throughput, what direct-mis adds there: a
+// light sample and a BSDF sample, each weighted by the balance heuristic. Emission seen
+// directly by the camera is added once, at x_0.
+//
+//   pt-mis3 (4b): three rays per bounce. The MIS BSDF sample is one ray; a third, independent
+//     BSDF sample continues the path. The emission the continuation ray finds is not counted
+//     (it was already accounted for by the MIS pair at the previous vertex).
+//   pt-mis  (4c): two rays per bounce. The MIS BSDF sample both contributes its weighted
+//     emission and continues the path, so the surface it finds is the next vertex.
+#include "integrators/common/direct_lighting.hpp"
+#include "integrators/integrators.hpp"
+#include "integrators/common/path_rules.hpp"
+
+namespace pathlab {
+namespace {
+
+class PtMis final : public Estimator {
+public:
+    PtMis(const EstimatorOptions& o, bool separate_continuation) : rules_(o), three_rays_(separate_continuation) {}
+
+    Rgb radiance(const Scene& scene, const Ray& camera_ray, Sampler& sampler) const override {
+        Intersection hit;
+        if (!scene.intersect(camera_ray, hit)) return scene.escaped_radiance();
+        Vec3f dir = camera_ray.d;
+        Rgb L = emitted_radiance(scene, hit, -dir);
+        Rgb beta(1.0f);
+        for (int bounces = 0; rules_.may_bounce(bounces); ++bounces) {
+            const ShadingPoint sp = make_shading_point(scene, hit, dir);
+            if (sp.material->is_black()) break;
+            // Paths of bounces + 1 bounces ending on a light: the MIS pair.
+            L += beta * estimate_light_sample(scene, sp, sampler, /*mis=*/true);
+            const auto s = sp.material->sample(sp.wi, sampler.next2d());
+            EmitterHit found;
+            if (s) L += beta * estimate_bsdf_sample_mis(scene, sp, *s, found);
+            if (!rules_.may_bounce(bounces + 1)) break;
+
+            // Continue the path: with the same BSDF sample (pt-mis) or a fresh one (pt-mis3).
+            // The fresh one is independent of the first: a rejected MIS sample (a direction
+            // below the surface, total internal reflection on a microfacet) must not end it.
+            if (!three_rays_ && !s) break;
+            BsdfSample next = s ? *s : BsdfSample{};
+            if (three_rays_) {
+                const auto c = sp.material->sample(sp.wi, sampler.next2d());
+                if (!c) break;
+                next = *c;
+                found.hit = scene.intersect(sp.spawn(next.wo), found.isect);
+            }
+            if (!found.hit) break;  // escaped: the environment was counted by the MIS pair
+            beta *= next.f * (std::abs(next.wo.z) / next.pdfW);
+            if (!rules_.survive_roulette(bounces + 1, beta, sampler)) break;
+            hit = found.isect;
+            dir = sp.frame.to_world(next.wo);
+        }
+        return L;
+    }
+
+private:
+    PathRules rules_;
+    bool three_rays_;
+};
+
+}  // namespace
+
+std::unique_ptr<Estimator> make_pt_mis3(const EstimatorOptions& o) { return std::make_unique<PtMis>(o, true); }
+std::unique_ptr<Estimator> make_pt_mis(const EstimatorOptions& o) { return std::make_unique<PtMis>(o, false); }
+
+}  // namespace pathlab

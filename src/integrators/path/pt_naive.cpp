@@ -1,0 +1,42 @@
+// pt-naive (course assignment 4A): path tracing by BRDF importance sampling alone. At every
+// surface the path adds the emission it finds (front side of an area light) times its
+// throughput, samples the BRDF for the next direction, and multiplies the throughput by
+// f cos / pdf. An escaping path adds the environment. Point lights are never found, so the
+// point-light scenes (0, 1) are black, as the course says.
+#include "integrators/common/direct_lighting.hpp"
+#include "integrators/integrators.hpp"
+#include "integrators/common/path_rules.hpp"
+
+namespace pathlab {
+namespace {
+
+class PtNaive final : public Estimator {
+public:
+    explicit PtNaive(const EstimatorOptions& o) : rules_(o) {}
+
+    Rgb radiance(const Scene& scene, const Ray& camera_ray, Sampler& sampler) const override {
+        Rgb L(0.0f), beta(1.0f);
+        Ray ray = camera_ray;
+        for (int bounces = 0;; ++bounces) {
+            Intersection hit;
+            if (!scene.intersect(ray, hit)) return L + beta * scene.escaped_radiance();
+            L += beta * emitted_radiance(scene, hit, -normalize(ray.d));
+            const ShadingPoint sp = make_shading_point(scene, hit, normalize(ray.d));
+            if (sp.material->is_black() || !rules_.may_bounce(bounces)) return L;
+            const auto s = sp.material->sample(sp.wi, sampler.next2d());
+            if (!s) return L;
+            beta *= s->f * (std::abs(s->wo.z) / s->pdfW);
+            if (!rules_.survive_roulette(bounces + 1, beta, sampler)) return L;
+            ray = sp.spawn(s->wo);
+        }
+    }
+
+private:
+    PathRules rules_;
+};
+
+}  // namespace
+
+std::unique_ptr<Estimator> make_pt_naive(const EstimatorOptions& o) { return std::make_unique<PtNaive>(o); }
+
+}  // namespace pathlab

@@ -1,0 +1,63 @@
+// The random numbers of one path sample. A sample's stream is a pure function of (seed, pixel,
+// sample index), so an image does not depend on thread count, tile order or how a render is
+// split into parts.
+#pragma once
+
+#include <cstdint>
+
+#include "core/rng.hpp"
+#include "core/vec.hpp"
+#include "samplers/sobol.hpp"
+
+namespace pathlab {
+
+enum class SamplerKind {
+    Independent,  // PCG32 numbers: independent samples (the course's estimators, the tests)
+    Sobol,        // padded, shuffled, Owen-scrambled 2D Sobol points (lower error, see sobol.hpp)
+};
+
+// The random numbers of one path sample. With SamplerKind::Sobol, the k-th call of next1d() or
+// next2d() (a "dimension" of the path) takes the sample's point from a (0,2)-sequence that is
+// shuffled and scrambled independently per pixel and per dimension, so that each dimension on
+// its own is stratified across the pixel's samples while different dimensions stay
+// uncorrelated (padding). Samples stay a pure function of (seed, pixel, sample index).
+class Sampler {
+public:
+    Sampler(uint64_t seed, uint64_t pixel_index, uint64_t sample_index, SamplerKind kind = SamplerKind::Independent)
+        : rng_(mix64(mix64(seed ^ mix64(pixel_index)) + sample_index), mix64(seed + 0x5bd1e995ull * pixel_index)),
+          kind_(kind),
+          reversed_index_(reverse_bits(uint32_t(sample_index))),
+          pixel_hash_(mix64(seed ^ mix64(pixel_index ^ 0x243f6a8885a308d3ull))) {}
+
+    float next1d() {
+        if (kind_ == SamplerKind::Independent) return rng_.next_float();
+        const uint64_t h = dimension_hash();
+        return fixed_to_float(scrambled_dimension0(shuffled_index(uint32_t(h)), uint32_t(h >> 32)));
+    }
+    Vec2f next2d() {
+        if (kind_ == SamplerKind::Independent) {
+            const float a = rng_.next_float();
+            return {a, rng_.next_float()};
+        }
+        const uint64_t h = dimension_hash();
+        const uint32_t i = shuffled_index(uint32_t(h));
+        const uint32_t seed1 = uint32_t((h * 0xd1342543de82ef95ull) >> 32);  // a third seed
+        return {fixed_to_float(scrambled_dimension0(i, uint32_t(h >> 32))),
+                fixed_to_float(nested_uniform_scramble(sobol_dimension1(i), seed1))};
+    }
+
+private:
+    uint64_t dimension_hash() { return mix64(pixel_hash_ + 0x9e3779b97f4a7c15ull * ++dimension_); }
+    // nested_uniform_scramble(index, seed), with the index's bit reversal done once.
+    uint32_t shuffled_index(uint32_t seed) const { return reverse_bits(laine_karras_permutation(reversed_index_, seed)); }
+    // nested_uniform_scramble(sobol_dimension0(i), seed): the two bit reversals cancel.
+    static uint32_t scrambled_dimension0(uint32_t i, uint32_t seed) { return reverse_bits(laine_karras_permutation(i, seed)); }
+
+    Pcg32 rng_;
+    SamplerKind kind_;
+    uint32_t reversed_index_;  // bit-reversed sample index
+    uint32_t dimension_ = 0;
+    uint64_t pixel_hash_;
+};
+
+}  // namespace pathlab

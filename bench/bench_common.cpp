@@ -8,7 +8,7 @@ namespace pathlab::bench {
 
 RenderResult run(const Scene& scene, const std::string& algorithm, int size, int spp, double seconds, uint64_t seed,
                  std::function<void(const Film&, const RenderStats&)> after_pass, SamplerKind sampler) {
-    const auto estimator = find_estimator(algorithm)->make({});
+    const auto estimator = find_integrator(algorithm)->make({});
     RenderSettings rs;
     rs.width = rs.height = size;
     rs.spp = spp;

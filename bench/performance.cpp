@@ -187,7 +187,7 @@ void performance_suite(const PerfOptions& o) {
     for (int index : o.scenes) {
         const auto scene = Scene::build(make_builtin_scene(index));
         const std::string name = fmt::format("{} {}", index, builtin_scenes()[size_t(index)].name);
-        for (const EstimatorInfo& e : estimators()) {
+        for (const IntegratorInfo& e : integrators()) {
             const Scaling sc = measure_scaling(*scene, e.name, o, max_threads);
             const Throughput &one = sc.one, &many = sc.many;
             const double scaling = sc.ratio;

@@ -9,7 +9,7 @@
 namespace pathlab::test {
 
 // direct-light with the receiver's cos(theta) dropped (a classic student bug).
-class DirectLightWithoutCosine final : public Estimator {
+class DirectLightWithoutCosine final : public PixelIntegrator {
 public:
     Rgb radiance(const Scene& scene, const Ray& ray, Sampler& sampler) const override {
         Intersection hit;

@@ -32,8 +32,10 @@ TEST(Allocation, NoEstimatorAllocatesPerSample) {
     for (int index : {0, 3, 5, 7, -1}) {
         const auto scene = Scene::build(index < 0 ? with_new_materials(make_builtin_scene(3)) : make_builtin_scene(index));
         const CameraRays camera(scene->camera(), 64, 64);
-        for (const EstimatorInfo& info : estimators()) {
-            const auto estimator = info.make({});
+        for (const IntegratorInfo& info : integrators()) {
+            const auto integrator = info.make({});
+            const auto* estimator = dynamic_cast<const PixelIntegrator*>(integrator.get());
+            if (!estimator) continue;
             const uint64_t before = allocations_by_this_thread();
             for (uint64_t s = 0; s < 4096; ++s) {
                 Sampler sampler(7, s % 4096, s);

@@ -13,7 +13,7 @@ namespace {
 RenderResult render_with(int threads, int tile_size, uint64_t seed = 5, SamplerKind sampler = SamplerKind::Independent) {
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
     const auto scene = Scene::build(make_builtin_scene(3));
-    const auto estimator = find_estimator("direct-light")->make({});
+    const auto estimator = find_integrator("direct-light")->make({});
     RenderSettings rs;
     rs.width = 96;
     rs.height = 64;

@@ -41,7 +41,7 @@ std::pair<double, double> plane_hit(const CameraRays& cam, float sx, float sy) {
 
 TEST(PointLightOverPlane, EveryPixelCentreMatchesTheClosedForm) {
     const auto scene = Scene::build(point_light_over_plane());
-    const auto estimator = find_estimator("direct-light")->make({});
+    const auto estimator = make_pixel_integrator("direct-light");
     const CameraRays cam(scene->camera(), 32, 32);
     for (int y = 0; y < 32; ++y)
         for (int x = 0; x < 32; ++x) {
@@ -90,7 +90,7 @@ TEST(PointLightOverPlane, OnePercentTooBrightIsDetected) {
 // Camera rays that hit an emitter return exactly its radiance (emitters reflect nothing).
 void expect_emitter_pixels_exact(int scene_index, float radiance, int min_pixels) {
     const auto scene = Scene::build(make_builtin_scene(scene_index));
-    const auto estimator = find_estimator("direct-light")->make({});
+    const auto estimator = make_pixel_integrator("direct-light");
     const CameraRays cam(scene->camera(), 512, 512);
     int seen = 0;
     for (int y = 0; y < 512; y += 2)
@@ -121,7 +121,7 @@ TEST(Environment, EscapingRaysReturnItsRadiance) {
     SceneDescription d = point_light_over_plane();
     d.lights = {EnvironmentLight{Rgb(0.25f, 0.5f, 0.75f)}};
     const auto scene = Scene::build(d);
-    const auto estimator = find_estimator("direct-light")->make({});
+    const auto estimator = make_pixel_integrator("direct-light");
     Sampler sampler(1, 0, 0);
     EXPECT_EQ(estimator->radiance(*scene, Ray{{0, 0, 1}, {0, 0, 1}, kInf}, sampler), Rgb(0.25f, 0.5f, 0.75f));
 }

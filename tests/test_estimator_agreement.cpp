@@ -46,7 +46,7 @@ TEST(DirectAgreement, LightSamplingConvergesToTheMisImageWithPointLights) {
 
 // Test of the test: direct-brdf with the classic bug of dividing by the chosen lobe's density
 // (times its selection probability) instead of the mixture density must disagree.
-class BrdfSamplingWithChosenLobePdf final : public Estimator {
+class BrdfSamplingWithChosenLobePdf final : public PixelIntegrator {
 public:
     Rgb radiance(const Scene& scene, const Ray& ray, Sampler& sampler) const override {
         Intersection hit;

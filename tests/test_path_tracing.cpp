@@ -72,8 +72,8 @@ INSTANTIATE_TEST_SUITE_P(PathTracers, Furnace, ::testing::ValuesIn(kPathTracers)
     return n;
 });
 
-EstimatorOptions depth(int max_depth, int rr_depth = 3) {
-    EstimatorOptions o;
+IntegratorOptions depth(int max_depth, int rr_depth = 3) {
+    IntegratorOptions o;
     o.max_depth = max_depth;
     o.rr_depth = rr_depth;
     return o;

@@ -79,7 +79,7 @@ TEST(SobolSampler, ImagesAgreeWithIndependentSampling) {
     for (int scene : {3, 7}) {
         const SceneDescription d = make_builtin_scene(scene);
         const auto s = Scene::build(d);
-        const auto est = find_estimator("pt-mis")->make({});
+        const auto est = find_integrator("pt-mis")->make({});
         RenderSettings rs;
         rs.width = rs.height = 16;
         rs.spp = 2048;

@@ -15,9 +15,9 @@
 #include "app/interrupt.hpp"
 #include "app/command_arguments.hpp"
 #include "app/tool_commands.hpp"
-#include "app/usage_error.hpp"
+#include "job/usage_error.hpp"
 #include "image/image_io.hpp"
-#include "job/renderer.hpp"
+#include "job/render_job.hpp"
 #include "scene/builtin_scenes.hpp"
 #include "judge/check.hpp"
 #include "judge/reference_set.hpp"
@@ -63,7 +63,7 @@ CLI::App* add_check_command(CLI::App& app, CheckOptions& o) {
 }
 
 int run_check_command(const CheckOptions& o) {
-    const EstimatorInfo* info = &estimator_or_usage_error(o.algorithm);
+    const IntegratorInfo* info = &integrator_or_usage_error(o.algorithm);
     if (!fs::is_directory(o.references)) throw UsageError(fmt::format("--references {}: no such directory", o.references));
     std::map<int, std::string> mapping;
     if (!o.mapping.empty()) {
@@ -91,9 +91,11 @@ int run_check_command(const CheckOptions& o) {
     if (o.threads > 0) thread_limit.emplace(tbb::global_control::max_allowed_parallelism, size_t(o.threads));
     const bool show_progress = !o.quiet && isatty(STDERR_FILENO);
     const std::map<int, uint64_t> ref_seeds = reference_seeds(o.references);
-    EstimatorOptions est_opt;
-    est_opt.max_depth = o.max_depth;
-    const auto estimator = info->make(est_opt);
+    JobRequest request;
+    request.algorithm = info->name;
+    request.spp = uint64_t(o.spp);
+    request.max_depth = o.max_depth;
+    request.seed = o.seed;
 
     fmt::print("check {} at {} spp against {}\n", info->name, o.spp, o.references);
     InterruptGuard interrupt;
@@ -101,7 +103,7 @@ int run_check_command(const CheckOptions& o) {
     nlohmann::json results = nlohmann::json::array();
     for (const int index : scenes) {
         const BuiltinSceneInfo& s = builtin_scenes()[size_t(index)];
-        const auto scene = Scene::build(make_builtin_scene(index));
+        RenderJob job(index, request);
         SceneVerdict v;
         std::string reference_name = "-";
         double seconds = 0;
@@ -119,23 +121,21 @@ int run_check_command(const CheckOptions& o) {
                 unreadable = e.what();
             }
         }
-        if (info->blind_to_delta_lights && !scene->has_hittable_emitters()) {
+        if (info->blind_to_delta_lights && !job.scene().has_hittable_emitters()) {
             v = {Verdict::BlackByDesign, fmt::format("{} cannot sample point lights, the only lights here", info->name)};
         } else if (!ref) {
             v = {Verdict::Missing, "no reference: looked for " + tried};
         } else if (!loaded) {
             v = {Verdict::Error, unreadable};
         } else {
-            RenderSettings rs;
+            RenderSettings& rs = job.settings;
             rs.width = width > 0 ? width : loaded->width();
             rs.height = height > 0 ? height : loaded->height();
-            rs.spp = o.spp;
-            rs.seed = o.seed;
             const auto it = ref_seeds.find(index);
             if (it != ref_seeds.end() && it->second == o.seed) ++rs.seed;  // independent of the reference's samples
             rs.progress = show_progress;
             rs.cancel = &InterruptGuard::flag();
-            const RenderResult r = render(*scene, *estimator, rs);
+            const RenderResult r = job.run();
             seconds = r.stats.seconds;
             if (r.stats.interrupted) {
                 fmt::print(stderr, "pathlab: interrupted\n");

@@ -6,7 +6,7 @@
 
 #include "app/render_command.hpp"
 #include "app/tool_commands.hpp"
-#include "app/usage_error.hpp"
+#include "job/usage_error.hpp"
 #include "integrators/integrator.hpp"
 #include "scene/builtin_scenes.hpp"
 
@@ -29,7 +29,7 @@ void print_scenes() {
 }
 
 void print_algorithms() {
-    for (const EstimatorInfo& e : estimators()) {
+    for (const IntegratorInfo& e : integrators()) {
         const std::string alias = e.aliases.empty() ? "" : fmt::format("({})", fmt::join(e.aliases, "/"));
         fmt::print("{:<14} {:<5} {}\n", e.name, alias, e.summary);
     }

@@ -5,7 +5,7 @@
 #include <fmt/format.h>
 
 #include "app/tool_commands.hpp"
-#include "app/usage_error.hpp"
+#include "job/usage_error.hpp"
 #include "image/image_io.hpp"
 #include "judge/false_colour.hpp"
 #include "judge/image_compare.hpp"

@@ -16,9 +16,9 @@
 #include "app/interrupt.hpp"
 #include "app/command_arguments.hpp"
 #include "app/tool_commands.hpp"
-#include "app/usage_error.hpp"
+#include "job/usage_error.hpp"
 #include "image/image_io.hpp"
-#include "job/renderer.hpp"
+#include "job/render_job.hpp"
 #include "scene/builtin_scenes.hpp"
 #include "judge/reference_set.hpp"
 
@@ -68,7 +68,7 @@ CLI::App* add_reference_command(CLI::App& app, ReferenceOptions& o) {
 }
 
 int run_reference_command(const ReferenceOptions& o) {
-    const EstimatorInfo* info = &estimator_or_usage_error(o.algorithm);
+    const IntegratorInfo* info = &integrator_or_usage_error(o.algorithm);
     const std::vector<int> scenes = parse_builtin_scene_list(o.scenes);
     int width = 0, height = 0;
     parse_resolution_option(o.resolution, width, height);
@@ -90,22 +90,22 @@ int run_reference_command(const ReferenceOptions& o) {
     nlohmann::json entries = previous_entries(manifest_path);
 
     InterruptGuard interrupt;
-    EstimatorOptions est_opt;
-    est_opt.max_depth = o.max_depth;
-    const auto estimator = info->make(est_opt);
+    JobRequest request;
+    request.algorithm = info->name;
+    if (o.spp > 0) request.spp = uint64_t(o.spp);
+    request.default_spp = kDefaultReferenceSpp;
+    request.max_depth = o.max_depth;
+    request.width = width;
+    request.height = height;
+    request.time_limit = o.time_limit;
+    request.seed = o.seed;
     for (const int index : scenes) {
         const BuiltinSceneInfo& s = builtin_scenes()[size_t(index)];
-        const auto scene = Scene::build(make_builtin_scene(index));
-        RenderSettings rs;
-        rs.width = width;
-        rs.height = height;
-        rs.spp = o.spp > 0 ? o.spp : (o.time_limit > 0 ? 0 : kDefaultReferenceSpp);
-        rs.time_limit = o.time_limit;
-        rs.seed = o.seed;
-        rs.progress = show_progress;
-        rs.cancel = &InterruptGuard::flag();
+        RenderJob job(index, request);
+        job.settings.progress = show_progress;
+        job.settings.cancel = &InterruptGuard::flag();
         if (show_progress) fmt::print(stderr, "{} / {}\n", s.name, info->name);
-        const RenderResult r = render(*scene, *estimator, rs);
+        const RenderResult r = job.run();
 
         const std::string stem = fmt::format("{}-{}", s.index, s.name);
         const fs::path exr = dir / (stem + ".exr");

@@ -9,13 +9,10 @@
 
 #include "app/command_arguments.hpp"
 #include "app/interrupt.hpp"
-#include "app/usage_error.hpp"
+#include "job/usage_error.hpp"
 #include "image/image_io.hpp"
-#include "job/renderer.hpp"
-#include "scene/builtin_scenes.hpp"
-#include "scenefile/scene_file.hpp"
+#include "job/render_job.hpp"
 
-#include <filesystem>
 
 namespace pathlab {
 namespace {
@@ -23,54 +20,13 @@ namespace {
 constexpr int kDefaultSpp = 64;
 const char* const kDefaultOutputs[] = {"out/{index}-{scene}-{algorithm}.exr", "out/{index}-{scene}-{algorithm}.png"};
 
-struct SceneJob {
-    std::string name;   // for {scene}
-    std::string index;  // for {index}: the course index, or empty for scene files
-    SceneDescription desc;
-};
-
-
-bool looks_like_scene_file(const std::string& key) {
-    return key.size() > 4 && key.compare(key.size() - 4, 4, ".xml") == 0;
-}
-
-std::vector<SceneJob> resolve_scenes(const std::string& spec, const SceneDefines& defines) {
-    std::vector<SceneJob> jobs;
-    const auto add_builtin = [&](int i) {
-        jobs.push_back({builtin_scenes()[size_t(i)].name, std::to_string(i), make_builtin_scene(i)});
-    };
-    if (spec == "all") {
-        for (const BuiltinSceneInfo& s : builtin_scenes()) add_builtin(s.index);
-        return jobs;
-    }
-    for (const std::string& key : split_comma_list(spec)) {
-        if (looks_like_scene_file(key)) {
-            // Scene-file errors (file:line:column) are usage errors: exit code 2.
-            try {
-                const std::string stem = std::filesystem::path(key).stem().string();
-                jobs.push_back({stem, stem, load_scene_file(key, defines)});
-            } catch (const SceneFileError& e) {
-                throw UsageError(e.what());
-            }
-        } else {
-            add_builtin(builtin_scene_or_usage_error(key, /*scene_files_allowed=*/true));
-        }
-    }
-    return jobs;
-}
-
-std::string expand_output(const std::string& pattern, const SceneJob& job, const std::string& algorithm) {
-    return fmt::format(fmt::runtime(pattern), fmt::arg("scene", job.name), fmt::arg("index", job.index),
-                       fmt::arg("algorithm", algorithm));
-}
-
-void write_stats(const std::string& path, const SceneJob& job, const std::string& algorithm, const RenderSettings& rs,
-                 const RenderResult& r, const std::vector<std::string>& outputs, int threads) {
+void write_stats(const std::string& path, RenderJob& job, const RenderResult& r, int threads) {
     const RenderStats& s = r.stats;
+    const RenderSettings& rs = job.settings;
     nlohmann::json j = {
         {"pathlab_version", PATHLAB_VERSION},
-        {"scene", job.name},
-        {"algorithm", algorithm},
+        {"scene", job.scene_choice().name},
+        {"algorithm", job.integrator_info().name},
         {"resolution", {r.film.width(), r.film.height()}},
         {"spp", s.spp},
         {"seed", rs.seed},
@@ -83,7 +39,7 @@ void write_stats(const std::string& path, const SceneJob& job, const std::string
         {"rays_per_second", s.seconds > 0 ? double(s.rays) / s.seconds : 0.0},
         {"invalid_samples", s.invalid_samples},
         {"interrupted", s.interrupted},
-        {"outputs", outputs},
+        {"outputs", job.outputs},
     };
     write_text_file(path, j.dump(2) + "\n");
 }
@@ -120,7 +76,7 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
 }
 
 int run_render_command(const RenderCommandOptions& o) {
-    if (o.algorithm_given) estimator_or_usage_error(o.algorithm);
+    if (o.algorithm_given) integrator_or_usage_error(o.algorithm);
     SceneDefines defines;
     for (const std::string& d : o.defines) {
         const size_t eq = d.find('=');
@@ -128,48 +84,45 @@ int run_render_command(const RenderCommandOptions& o) {
             throw UsageError(fmt::format("invalid -D '{}': expected name=value", d));
         defines[d.substr(0, eq)] = d.substr(eq + 1);
     }
-    std::vector<SceneJob> jobs = resolve_scenes(o.scene, defines);
-    // Each job's estimator: --algorithm, else the scene file's integrator, else pt-mis.
-    std::vector<const EstimatorInfo*> job_estimators;
-    for (const SceneJob& job : jobs) {
-        const std::string name = o.algorithm_given ? o.algorithm : job.desc.algorithm.value_or(o.algorithm);
-        job_estimators.push_back(&estimator_or_usage_error(name));
+    JobRequest request;
+    if (o.algorithm_given) request.algorithm = o.algorithm;
+    if (o.spp_given) {
+        if (o.spp <= 0) throw UsageError(fmt::format("--spp must be a positive number of samples, got {}", o.spp));
+        request.spp = uint64_t(o.spp);
     }
-
-    int width = 0, height = 0;
-    parse_resolution_option(o.resolution, width, height);
-    if (o.spp_given && o.spp <= 0) throw UsageError(fmt::format("--spp must be a positive number of samples, got {}", o.spp));
-    if (o.time_limit < 0 || !std::isfinite(o.time_limit)) throw UsageError("--time must be a positive number of seconds");
-    if (o.threads < 0) throw UsageError("--threads must be positive");
+    if (o.max_depth_given) request.max_depth = o.max_depth;
+    if (o.rr_depth < 0) throw UsageError("--rr-depth must be zero or positive");
+    request.rr_depth = o.rr_depth;
+    parse_resolution_option(o.resolution, request.width, request.height);
+    request.time_limit = o.time_limit;
+    request.seed = o.seed;
     if (o.sampler != "independent" && o.sampler != "sobol")
         throw UsageError(fmt::format("unknown sampler '{}'. Valid samplers: independent, sobol", o.sampler));
-    if (o.rr_depth < 0) throw UsageError("--rr-depth must be zero or positive");
-    if (o.max_depth < -1 || o.max_depth == 0) throw UsageError("--max-depth must be positive, or -1 for unlimited");
+    request.sampler = o.sampler == "sobol" ? SamplerKind::Sobol : SamplerKind::Independent;
+    request.default_spp = kDefaultSpp;
+    if (o.threads < 0) throw UsageError("--threads must be positive");
+
+    std::vector<RenderJob> jobs;
+    for (SceneChoice& choice : resolve_scenes(o.scene, defines)) jobs.emplace_back(std::move(choice), request);
 
     std::vector<std::string> patterns(o.outputs.begin(), o.outputs.end());
     if (patterns.empty()) patterns.assign(std::begin(kDefaultOutputs), std::end(kDefaultOutputs));
     // Check every output before the first render starts.
-    std::vector<std::vector<std::string>> outputs(jobs.size());
     for (size_t j = 0; j < jobs.size(); ++j) {
         for (const std::string& p : patterns) {
-            std::string path;
-            try {
-                path = expand_output(p, jobs[j], job_estimators[j]->name);
-            } catch (const fmt::format_error& e) {
-                throw UsageError(fmt::format("invalid output pattern '{}': {} (placeholders: {{scene}}, {{index}}, {{algorithm}})", p, e.what()));
-            }
+            const std::string path = jobs[j].expand(p);
             try {
                 check_writable_image_path(path);
             } catch (const ImageIoError& e) {
                 throw UsageError(e.what());
             }
-            outputs[j].push_back(path);
+            jobs[j].outputs.push_back(path);
         }
         for (size_t k = 0; k < j; ++k)
-            for (const std::string& path : outputs[j])
-                if (std::find(outputs[k].begin(), outputs[k].end(), path) != outputs[k].end())
+            for (const std::string& path : jobs[j].outputs)
+                if (std::find(jobs[k].outputs.begin(), jobs[k].outputs.end(), path) != jobs[k].outputs.end())
                     throw UsageError(fmt::format("scenes {} and {} would both write {}: add {{scene}} or {{index}} to -o",
-                                                 jobs[k].name, jobs[j].name, path));
+                                                 jobs[k].scene_choice().name, jobs[j].scene_choice().name, path));
     }
 
     std::optional<tbb::global_control> thread_limit;
@@ -180,37 +133,21 @@ int run_render_command(const RenderCommandOptions& o) {
 
     InterruptGuard interrupt;
     for (size_t j = 0; j < jobs.size(); ++j) {
-        const SceneJob& job = jobs[j];
-        const EstimatorInfo* est_info = job_estimators[j];
-        EstimatorOptions est_opt;
-        est_opt.max_depth = o.max_depth_given ? o.max_depth : job.desc.max_depth.value_or(o.max_depth);
-        est_opt.rr_depth = o.rr_depth;
-        const std::unique_ptr<Estimator> estimator = est_info->make(est_opt);
-        const std::unique_ptr<Scene> scene = Scene::build(job.desc);
-        RenderSettings rs;
-        rs.width = width;
-        rs.height = height;
-        // --spp, else (without --time) the scene file's sample_count, else 64.
-        rs.spp = o.spp_given ? o.spp : (o.time_limit > 0 ? 0 : job.desc.spp.value_or(kDefaultSpp));
-        rs.time_limit = o.time_limit;
-        rs.seed = o.seed;
-        rs.sampler = o.sampler == "sobol" ? SamplerKind::Sobol : SamplerKind::Independent;
-        rs.progress = show_progress;
-        rs.cancel = &InterruptGuard::flag();
-        if (show_progress) fmt::print(stderr, "{} / {}\n", job.name, est_info->name);
-        const RenderResult result = render(*scene, *estimator, rs);
-
-        const Image image = result.film.mean();
-        for (const std::string& path : outputs[j]) write_image(image, path, o.exposure);
-        if (!o.stats_path.empty())
-            write_stats(expand_output(o.stats_path, job, est_info->name), job, est_info->name, rs, result, outputs[j], threads);
+        RenderJob& job = jobs[j];
+        job.settings.progress = show_progress;
+        job.settings.cancel = &InterruptGuard::flag();
+        const std::string& name = job.scene_choice().name;
+        if (show_progress) fmt::print(stderr, "{} / {}\n", name, job.integrator_info().name);
+        const RenderResult result = job.run();
+        job.write_outputs(result, o.exposure);
+        if (!o.stats_path.empty()) write_stats(job.expand(o.stats_path), job, result, threads);
         const RenderStats& s = result.stats;
         if (!o.quiet)
-            fmt::print(stderr, "{}: {} spp in {:.2f}s ({:.2f} Msamples/s, {:.2f} Mrays/s){} -> {}\n", job.name, s.spp,
-                       s.seconds, s.seconds > 0 ? s.samples / s.seconds * 1e-6 : 0.0,
-                       s.seconds > 0 ? s.rays / s.seconds * 1e-6 : 0.0,
+            fmt::print(stderr, "{}: {} spp in {:.2f}s ({:.2f} Msamples/s, {:.2f} Mrays/s){} -> {}\n", name, s.spp,
+                       s.seconds, s.seconds > 0 ? double(s.samples) / s.seconds * 1e-6 : 0.0,
+                       s.seconds > 0 ? double(s.rays) / s.seconds * 1e-6 : 0.0,
                        s.invalid_samples ? fmt::format(", {} NaN/Inf samples discarded", s.invalid_samples) : "",
-                       fmt::join(outputs[j], ", "));
+                       fmt::join(job.outputs, ", "));
         if (s.interrupted) {
             if (j + 1 < jobs.size()) fmt::print(stderr, "pathlab: interrupted; {} scene(s) not rendered\n", jobs.size() - j - 1);
             return 130;

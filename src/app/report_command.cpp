@@ -11,9 +11,9 @@
 #include "app/interrupt.hpp"
 #include "app/command_arguments.hpp"
 #include "app/tool_commands.hpp"
-#include "app/usage_error.hpp"
+#include "job/usage_error.hpp"
 #include "image/image_io.hpp"
-#include "job/renderer.hpp"
+#include "job/render_job.hpp"
 #include "scene/builtin_scenes.hpp"
 #include "judge/html_report.hpp"
 #include "judge/image_compare.hpp"
@@ -26,7 +26,7 @@ namespace {
 constexpr const char* kReferenceAlgorithm = "pt-mis";
 constexpr double kCheckpointGrowth = 1.25;  // checkpoints at geometrically spaced times
 
-bool is_direct_illumination(const EstimatorInfo& e) { return e.name.rfind("direct-", 0) == 0; }
+bool is_direct_illumination(const IntegratorInfo& e) { return e.name.rfind("direct-", 0) == 0; }
 
 std::string command_line(const ReportOptions& o) {
     std::string s = fmt::format("pathlab report --scene {} --algorithms {}", o.scene, fmt::join(o.algorithms, ","));
@@ -67,9 +67,9 @@ int run_report_command(const ReportOptions& o) {
     const std::vector<int> scene_list = parse_builtin_scene_list(o.scene);
     if (scene_list.size() != 1 || o.scene == "all") throw UsageError("report takes one --scene");
     const int scene_index = scene_list.front();
-    std::vector<const EstimatorInfo*> infos;
+    std::vector<const IntegratorInfo*> infos;
     for (const std::string& a : o.algorithms) {
-        const EstimatorInfo* e = &estimator_or_usage_error(a);
+        const IntegratorInfo* e = &integrator_or_usage_error(a);
         if (std::find(infos.begin(), infos.end(), e) != infos.end()) throw UsageError(fmt::format("algorithm '{}' is listed twice", a));
         infos.push_back(e);
     }
@@ -81,7 +81,7 @@ int run_report_command(const ReportOptions& o) {
     if (o.threads < 0) throw UsageError("--threads must be positive");
     int width = 0, height = 0;
     parse_resolution_option(o.resolution, width, height);
-    const size_t direct = size_t(std::count_if(infos.begin(), infos.end(), [](const EstimatorInfo* e) { return is_direct_illumination(*e); }));
+    const size_t direct = size_t(std::count_if(infos.begin(), infos.end(), [](const IntegratorInfo* e) { return is_direct_illumination(*e); }));
     const bool all_direct = direct == infos.size();
     if (o.reference.empty() && direct > 0 && !all_direct)
         throw UsageError("direct-illumination and global estimators converge to different images: compare them separately, "
@@ -116,7 +116,6 @@ int run_report_command(const ReportOptions& o) {
     if (o.threads > 0) thread_limit.emplace(tbb::global_control::max_allowed_parallelism, size_t(o.threads));
     const bool show_progress = !o.quiet && isatty(STDERR_FILENO);
     const BuiltinSceneInfo& info = builtin_scenes()[size_t(scene_index)];
-    const auto scene = Scene::build(make_builtin_scene(scene_index));
     data.title = fmt::format("scene {} {}", info.index, info.name);
     data.budget = o.time_limit > 0 ? fmt::format("equal time: {} s per algorithm", o.time_limit)
                                    : fmt::format("equal samples: {} spp per algorithm", o.spp);
@@ -125,17 +124,18 @@ int run_report_command(const ReportOptions& o) {
     InterruptGuard interrupt;
     bool interrupted = false;
     if (data.reference.pixel_count() == 0) {
-        EstimatorOptions ref_opt;
-        ref_opt.max_depth = all_direct ? 1 : o.max_depth;
-        RenderSettings rs;
-        rs.width = width;
-        rs.height = height;
-        rs.spp = o.reference_spp;
-        rs.seed = o.seed + 1000003;  // independent of the compared renders
-        rs.progress = show_progress;
-        rs.cancel = &InterruptGuard::flag();
+        JobRequest ref_request;
+        ref_request.algorithm = kReferenceAlgorithm;
+        ref_request.max_depth = all_direct ? 1 : o.max_depth;
+        ref_request.width = width;
+        ref_request.height = height;
+        ref_request.spp = uint64_t(o.reference_spp);
+        ref_request.seed = o.seed + 1000003;  // independent of the compared renders
+        RenderJob ref_job(scene_index, ref_request);
+        ref_job.settings.progress = show_progress;
+        ref_job.settings.cancel = &InterruptGuard::flag();
         if (!o.quiet) fmt::print(stderr, "reference: {} at {} spp\n", kReferenceAlgorithm, o.reference_spp);
-        const RenderResult r = render(*scene, *find_estimator(kReferenceAlgorithm)->make(ref_opt), rs);
+        const RenderResult r = ref_job.run();
         data.reference = r.film.mean();
         data.reference_se = r.film.standard_error();
         const std::string saved = (fs::path(report_files_dir(o.output)) / "reference.exr").string();
@@ -151,32 +151,33 @@ int run_report_command(const ReportOptions& o) {
         }
     }
 
-    for (const EstimatorInfo* e : infos) {
+    for (const IntegratorInfo* e : infos) {
         if (interrupted) {
             data.notes.push_back(fmt::format("Interrupted: {} was not rendered.", e->name));
             continue;
         }
-        EstimatorOptions est_opt;
-        est_opt.max_depth = o.max_depth;
-        const auto estimator = e->make(est_opt);
+        JobRequest request;
+        request.algorithm = e->name;
+        request.max_depth = o.max_depth;
+        request.width = data.reference.width();
+        request.height = data.reference.height();
+        if (o.spp > 0) request.spp = uint64_t(o.spp);
+        request.time_limit = o.time_limit;
+        request.seed = o.seed;
+        RenderJob job(scene_index, request);
         ReportRender entry{e->name, {}, {}, {}};
         double next_checkpoint = 0;
-        RenderSettings rs;
-        rs.width = data.reference.width();
-        rs.height = data.reference.height();
-        rs.spp = o.spp;
-        rs.time_limit = o.time_limit;
-        rs.seed = o.seed;
+        RenderSettings& rs = job.settings;
         rs.progress = show_progress;
         rs.cancel = &InterruptGuard::flag();
         rs.after_pass = [&](const Film& film, const RenderStats& st) {
-            const bool last = (o.spp > 0 && st.spp >= o.spp) || (o.time_limit > 0 && st.seconds >= o.time_limit);
+            const bool last = (o.spp > 0 && st.spp >= uint64_t(o.spp)) || (o.time_limit > 0 && st.seconds >= o.time_limit);
             if (st.seconds < next_checkpoint && !last) return;
             entry.convergence.push_back({st.seconds, rmse_against_reference(film.mean(), data.reference, data.reference_se)});
             next_checkpoint = st.seconds * kCheckpointGrowth;
         };
         if (!o.quiet) fmt::print(stderr, "{}\n", e->name);
-        const RenderResult r = render(*scene, *estimator, rs);
+        const RenderResult r = job.run();
         entry.mean = r.film.mean();
         entry.stats = r.stats;
         // The final point, if the last pass did not make a checkpoint (the time budget ended it).

@@ -1,6 +1,19 @@
-// The estimator interface and the registry of estimators selectable by name.
-// To add an estimator: implement Estimator in one file under src/render/ and add one entry to
-// the table in estimator_registry.cpp.
+// The integrator contract and the registry of integrators selectable by name.
+//
+// An integrator owns its render passes (as SmallVCM's RunIteration, pbrt-v4's
+// Integrator::Render or Mitsuba 3's render do): render_passes() is given the passes with
+// sample indices first, ..., first + count - 1 and must add, for each pass, one sample to
+// every pixel of the film, however it computes it. The driver (job/renderer.hpp) decides how
+// many passes go into one call, stops on a sample count, a time budget or Ctrl-C, and measures.
+// A pass must be a pure function of (seed, pass index): the result may not depend on the thread
+// count, the tile order or how the passes are split between calls.
+//
+// Two kinds exist today:
+//  - PixelIntegrator: one camera ray per pixel sample and one radiance value back (every
+//    estimator of the course); the adapter runs the tiles in parallel.
+//  - integrators that splat onto arbitrary pixels (the light tracer) collect each pass in a
+//    PassImage (render/pass_image.hpp).
+// To add an integrator: one file under src/integrators/<family>/ and one line in registry.cpp.
 #pragma once
 
 #include <functional>
@@ -8,36 +21,74 @@
 #include <string>
 #include <vector>
 
+#include "cameras/camera.hpp"
+#include "render/film.hpp"
 #include "samplers/sampler.hpp"
 #include "scene/scene.hpp"
 
 namespace pathlab {
 
-struct EstimatorOptions {
+struct IntegratorOptions {
     int max_depth = -1;  // longest path in bounces (1 = direct illumination only); -1 = unlimited
     int rr_depth = 3;    // bounces before Russian roulette may end a path
 };
 
-class Estimator {
-public:
-    virtual ~Estimator() = default;
-    // One Monte Carlo estimate of the radiance arriving at the camera along `ray`.
-    virtual Rgb radiance(const Scene& scene, const Ray& ray, Sampler& sampler) const = 0;
+// What every pass of one render sees; fixed for the whole render.
+struct RenderContext {
+    const Scene& scene;
+    const CameraRays& camera;  // prepared for width x height
+    int width = 0, height = 0;
+    uint64_t seed = 0;
+    SamplerKind sampler = SamplerKind::Independent;
+    int tile_size = 32;  // largest tile edge for pixel integrators (smaller when there are few tiles)
+
+    size_t pixel_count() const { return size_t(width) * size_t(height); }
 };
 
-struct EstimatorInfo {
+// What a call of render_passes counted.
+struct PassCounters {
+    uint64_t rays = 0;             // rays traced (camera, shadow, continuation, light paths)
+    uint64_t invalid_samples = 0;  // NaN/Inf contributions, discarded (never averaged in)
+};
+
+// Called from worker threads with the fraction of the current call's work that is done.
+using PassProgress = std::function<void(double)>;
+
+class Integrator {
+public:
+    virtual ~Integrator() = default;
+    // Called once before the first pass of a render (a cache or photon map built up front).
+    virtual void prepare(const RenderContext&) {}
+    virtual PassCounters render_passes(const RenderContext& ctx, Film& film, uint64_t first, int count,
+                                       const PassProgress& progress) = 0;
+};
+
+// Today's per-pixel estimators: one Monte Carlo estimate of the radiance arriving along a
+// camera ray. Sample s of pixel p uses Sampler(seed, p, s) (its first 2D sample jitters the
+// ray within the pixel), and each pixel accumulates its samples in index order.
+class PixelIntegrator : public Integrator {
+public:
+    virtual Rgb radiance(const Scene& scene, const Ray& ray, Sampler& sampler) const = 0;
+    PassCounters render_passes(const RenderContext& ctx, Film& film, uint64_t first, int count,
+                               const PassProgress& progress) final;
+};
+
+struct IntegratorInfo {
     std::string name;                  // e.g. "direct-light"
-    std::vector<std::string> aliases;  // the course's assignment numbers, e.g. "1"
+    std::vector<std::string> aliases;  // the course's assignment numbers ("1"), Mitsuba's names ("ptracer")
     std::string summary;               // one line
-    // True when the estimator cannot see delta (point/directional) lights at all, so its image
+    // True when the integrator cannot see delta (point/directional) lights at all, so its image
     // is black in scenes lit only by them (BRDF-sampled estimators).
     bool blind_to_delta_lights = false;
-    std::function<std::unique_ptr<Estimator>(const EstimatorOptions&)> make;
+    // False when pixels whose first camera-side vertex is specular stay black (the light
+    // tracer cannot connect through a Dirac lobe to the camera).
+    bool sees_specular_from_camera = true;
+    std::function<std::unique_ptr<Integrator>(const IntegratorOptions&)> make;
 };
 
-const std::vector<EstimatorInfo>& estimators();
-const EstimatorInfo* find_estimator(const std::string& name_or_alias);
+const std::vector<IntegratorInfo>& integrators();
+const IntegratorInfo* find_integrator(const std::string& name_or_alias);
 // "a, b (alias 1), ..." for error messages and help.
-std::string estimator_names();
+std::string integrator_names();
 
 }  // namespace pathlab

@@ -1,9 +1,9 @@
-// The render driver: progressive passes of one sample per pixel over image tiles, in parallel
-// with oneTBB, until a sample count or a time budget is reached or the render is cancelled.
-// Small images run several passes per parallel loop (a batch) to keep every core busy.
-// Sample s of pixel p always uses Sampler(seed, p, s), and each pixel accumulates its samples
-// in index order, so the result is bit-identical for any thread count, and a render split into
-// parts (first_sample) sums to the one-shot render.
+// The render driver: calls an integrator's passes, in batches, until a sample count or a time
+// budget is reached or the render is cancelled, and measures what was done. Small images run
+// several passes per call (a batch) to keep every core busy; the batch grows while a batch
+// takes under ~50 ms. Integrators make each pass a pure function of (seed, pass index), so the
+// result is bit-identical for any thread count and any batching, and a render continued into
+// the same film (first_sample) equals the one-shot render.
 #pragma once
 
 #include <atomic>
@@ -16,17 +16,17 @@
 namespace pathlab {
 
 struct RenderStats {
-    int spp = 0;                   // passes completed (samples per pixel)
+    uint64_t spp = 0;              // passes completed (samples per pixel)
     double seconds = 0;            // wall-clock time of the passes
-    uint64_t samples = 0;          // camera samples taken
-    uint64_t rays = 0;             // rays traced (camera, shadow, continuation)
+    uint64_t samples = 0;          // pixel samples (or light paths) taken: spp x pixels
+    uint64_t rays = 0;             // rays traced (camera, shadow, continuation, light paths)
     uint64_t invalid_samples = 0;  // NaN/Inf samples, discarded (not averaged in)
     bool interrupted = false;      // stopped by the cancel flag
 };
 
 struct RenderSettings {
     int width = 0, height = 0;  // 0: the scene's default resolution
-    int spp = 0;                // samples per pixel to take; 0: until the time budget ends
+    uint64_t spp = 0;           // samples per pixel to take; 0: until the time budget ends
     double time_limit = 0;      // seconds; 0: none
     uint64_t seed = 0;
     SamplerKind sampler = SamplerKind::Independent;
@@ -45,6 +45,13 @@ struct RenderResult {
 
 // Throws std::invalid_argument for a non-positive resolution, or when neither spp nor a time
 // limit bounds the render.
-RenderResult render(const Scene& scene, const Estimator& estimator, const RenderSettings& settings);
+RenderResult render(const Scene& scene, Integrator& integrator, const RenderSettings& settings);
+inline RenderResult render(const Scene& scene, Integrator&& integrator, const RenderSettings& settings) {
+    return render(scene, integrator, settings);
+}
+// The same, adding the passes to `film` (which must have the settings' resolution): a render
+// continued from where another stopped (settings.first_sample = its spp) ends bit-identical
+// to the one-shot render.
+RenderStats render_into(const Scene& scene, Integrator& integrator, const RenderSettings& settings, Film& film);
 
 }  // namespace pathlab

@@ -1,8 +1,23 @@
 #include "render/film.hpp"
 
 #include <cmath>
+#include <stdexcept>
 
 namespace pathlab {
+
+void Film::add_pass(const std::vector<Vec3d>& values) {
+    if (values.size() != sum_.size()) throw std::invalid_argument("Film::add_pass: the pass has another size");
+    for (size_t i = 0; i < values.size(); ++i) add(i, values[i]);
+}
+
+void Film::merge(const Film& other) {
+    if (other.width_ != width_ || other.height_ != height_) throw std::invalid_argument("Film::merge: films of different sizes");
+    for (size_t i = 0; i < sum_.size(); ++i) {
+        sum_[i] += other.sum_[i];
+        sumsq_[i] += other.sumsq_[i];
+        count_[i] += other.count_[i];
+    }
+}
 
 Image Film::mean() const {
     Image img(width_, height_);
@@ -14,7 +29,7 @@ Image Film::mean() const {
 Image Film::standard_error() const {
     Image img(width_, height_);
     for (size_t i = 0; i < sum_.size(); ++i) {
-        const double n = count_[i];
+        const double n = double(count_[i]);
         if (n < 2) continue;
         const Vec3d m = sum_[i] / n;
         for (int c = 0; c < 3; ++c) {

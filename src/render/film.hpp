@@ -1,10 +1,17 @@
-// Per-pixel accumulation of samples in double precision: sum, sum of squares and count, so
-// the image is the mean and every pixel also carries the standard error of that mean.
+// The film: per-pixel accumulation of samples in double precision (sum, sum of squares and
+// count), so the image is the mean and every pixel also carries the standard error of it.
+//
+// A "sample" of a pixel is one independent estimate of its value. Pixel integrators add one
+// per camera path (add); integrators that splat onto arbitrary pixels collect a whole pass in
+// a PassImage (render/pass_image.hpp) and add it as one sample of every pixel (add_pass): the
+// standard error is then that of the batch means over passes, which is exact because passes
+// are independent.
 #pragma once
 
 #include <cstdint>
 #include <vector>
 
+#include "core/vec.hpp"
 #include "image/image.hpp"
 
 namespace pathlab {
@@ -19,14 +26,22 @@ public:
     int height() const { return height_; }
     size_t pixel_count() const { return sum_.size(); }
 
-    // Not synchronised: during a pass each pixel is owned by exactly one thread.
-    void add(size_t pixel, const Rgb& v) {
-        const Vec3d d(v);
+    // One sample of one pixel. Not synchronised: during a pass each pixel is owned by one thread.
+    void add(size_t pixel, const Rgb& v) { add(pixel, Vec3d(v)); }
+    void add(size_t pixel, const Vec3d& d) {
         sum_[pixel] += d;
         sumsq_[pixel] += d * d;
         ++count_[pixel];
     }
-    uint32_t count(size_t pixel) const { return count_[pixel]; }
+    // One sample of every pixel: values[p] is pixel p's estimate from one pass.
+    void add_pass(const std::vector<Vec3d>& values);
+
+    uint64_t count(size_t pixel) const { return count_[pixel]; }
+    const Vec3d& sum(size_t pixel) const { return sum_[pixel]; }
+    const Vec3d& sum_of_squares(size_t pixel) const { return sumsq_[pixel]; }
+
+    // Adds another film's samples (another range of sample indices of the same render).
+    void merge(const Film& other);
 
     Image mean() const;
     // Standard error of each pixel's mean, sqrt(s^2 / n) with the unbiased sample variance s^2.
@@ -35,7 +50,7 @@ public:
 private:
     int width_ = 0, height_ = 0;
     std::vector<Vec3d> sum_, sumsq_;
-    std::vector<uint32_t> count_;
+    std::vector<uint64_t> count_;
 };
 
 }  // namespace pathlab

@@ -350,10 +350,10 @@ private:
         std::string algorithm;
         if (type == "path") algorithm = "pt-mis";
         else if (type == "direct") algorithm = "direct-mis";
-        else if (const EstimatorInfo* e = find_estimator(type)) algorithm = e->name;
+        else if (const IntegratorInfo* e = find_integrator(type)) algorithm = e->name;
         else
             fail(n, fmt::format("unsupported integrator type '{}'; supported: path (pt-mis), direct (direct-mis), or a "
-                                "pathlab algorithm: {}", type, estimator_names()));
+                                "pathlab algorithm: {}", type, integrator_names()));
         desc_.algorithm = algorithm;
         if (!plugin_children(n).empty()) fail(plugin_children(n).front(), "an <integrator> has no nested plugins");
         Properties p(*this, n);

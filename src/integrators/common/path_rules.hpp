@@ -19,7 +19,7 @@ inline constexpr int kMaxBounces = 1024;
 
 class PathRules {
 public:
-    explicit PathRules(const EstimatorOptions& o)
+    explicit PathRules(const IntegratorOptions& o)
         : max_depth_(o.max_depth < 0 ? kMaxBounces : std::min(o.max_depth, kMaxBounces)), rr_depth_(o.rr_depth) {}
 
     // May a path that has made `bounces` bounces make one more?

@@ -8,7 +8,7 @@
 namespace pathlab {
 namespace {
 
-class DirectLight final : public Estimator {
+class DirectLight final : public PixelIntegrator {
 public:
     Rgb radiance(const Scene& scene, const Ray& ray, Sampler& sampler) const override {
         Intersection hit;
@@ -22,6 +22,6 @@ public:
 
 }  // namespace
 
-std::unique_ptr<Estimator> make_direct_light(const EstimatorOptions&) { return std::make_unique<DirectLight>(); }
+std::unique_ptr<Integrator> make_direct_light(const IntegratorOptions&) { return std::make_unique<DirectLight>(); }
 
 }  // namespace pathlab

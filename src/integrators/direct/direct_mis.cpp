@@ -11,7 +11,7 @@ namespace pathlab {
 
 namespace {
 
-class DirectMis final : public Estimator {
+class DirectMis final : public PixelIntegrator {
 public:
     Rgb radiance(const Scene& scene, const Ray& ray, Sampler& sampler) const override {
         Intersection hit;
@@ -31,6 +31,6 @@ public:
 
 }  // namespace
 
-std::unique_ptr<Estimator> make_direct_mis(const EstimatorOptions&) { return std::make_unique<DirectMis>(); }
+std::unique_ptr<Integrator> make_direct_mis(const IntegratorOptions&) { return std::make_unique<DirectMis>(); }
 
 }  // namespace pathlab

@@ -13,7 +13,7 @@ namespace {
 
 enum class Strategy { UniformHemisphere, CosineHemisphere, Brdf };
 
-class DirectBySampling final : public Estimator {
+class DirectBySampling final : public PixelIntegrator {
 public:
     explicit DirectBySampling(Strategy s) : strategy_(s) {}
 
@@ -57,13 +57,13 @@ private:
 
 }  // namespace
 
-std::unique_ptr<Estimator> make_direct_uniform(const EstimatorOptions&) {
+std::unique_ptr<Integrator> make_direct_uniform(const IntegratorOptions&) {
     return std::make_unique<DirectBySampling>(Strategy::UniformHemisphere);
 }
-std::unique_ptr<Estimator> make_direct_cosine(const EstimatorOptions&) {
+std::unique_ptr<Integrator> make_direct_cosine(const IntegratorOptions&) {
     return std::make_unique<DirectBySampling>(Strategy::CosineHemisphere);
 }
-std::unique_ptr<Estimator> make_direct_brdf(const EstimatorOptions&) {
+std::unique_ptr<Integrator> make_direct_brdf(const IntegratorOptions&) {
     return std::make_unique<DirectBySampling>(Strategy::Brdf);
 }
 

@@ -5,7 +5,7 @@
 namespace pathlab {
 namespace {
 
-class EyeLight final : public Estimator {
+class EyeLight final : public PixelIntegrator {
 public:
     Rgb radiance(const Scene& scene, const Ray& ray, Sampler&) const override {
         Intersection hit;
@@ -16,6 +16,6 @@ public:
 
 }  // namespace
 
-std::unique_ptr<Estimator> make_eyelight(const EstimatorOptions&) { return std::make_unique<EyeLight>(); }
+std::unique_ptr<Integrator> make_eyelight(const IntegratorOptions&) { return std::make_unique<EyeLight>(); }
 
 }  // namespace pathlab

@@ -15,9 +15,9 @@
 namespace pathlab {
 namespace {
 
-class PtMis final : public Estimator {
+class PtMis final : public PixelIntegrator {
 public:
-    PtMis(const EstimatorOptions& o, bool separate_continuation) : rules_(o), three_rays_(separate_continuation) {}
+    PtMis(const IntegratorOptions& o, bool separate_continuation) : rules_(o), three_rays_(separate_continuation) {}
 
     Rgb radiance(const Scene& scene, const Ray& camera_ray, Sampler& sampler) const override {
         Intersection hit;
@@ -62,7 +62,7 @@ private:
 
 }  // namespace
 
-std::unique_ptr<Estimator> make_pt_mis3(const EstimatorOptions& o) { return std::make_unique<PtMis>(o, true); }
-std::unique_ptr<Estimator> make_pt_mis(const EstimatorOptions& o) { return std::make_unique<PtMis>(o, false); }
+std::unique_ptr<Integrator> make_pt_mis3(const IntegratorOptions& o) { return std::make_unique<PtMis>(o, true); }
+std::unique_ptr<Integrator> make_pt_mis(const IntegratorOptions& o) { return std::make_unique<PtMis>(o, false); }
 
 }  // namespace pathlab

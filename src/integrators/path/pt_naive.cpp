@@ -10,9 +10,9 @@
 namespace pathlab {
 namespace {
 
-class PtNaive final : public Estimator {
+class PtNaive final : public PixelIntegrator {
 public:
-    explicit PtNaive(const EstimatorOptions& o) : rules_(o) {}
+    explicit PtNaive(const IntegratorOptions& o) : rules_(o) {}
 
     Rgb radiance(const Scene& scene, const Ray& camera_ray, Sampler& sampler) const override {
         Rgb L(0.0f), beta(1.0f);
@@ -37,6 +37,6 @@ private:
 
 }  // namespace
 
-std::unique_ptr<Estimator> make_pt_naive(const EstimatorOptions& o) { return std::make_unique<PtNaive>(o); }
+std::unique_ptr<Integrator> make_pt_naive(const IntegratorOptions& o) { return std::make_unique<PtNaive>(o); }
 
 }  // namespace pathlab

@@ -1,0 +1,51 @@
+// The tile loop of pixel integrators: tiles in parallel, and within a tile every pixel takes
+// its samples of this call in index order, so the result does not depend on threads or tiles.
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <atomic>
+
+#include "integrators/integrator.hpp"
+
+namespace pathlab {
+
+PassCounters PixelIntegrator::render_passes(const RenderContext& ctx, Film& film, uint64_t first, int count,
+                                            const PassProgress& progress) {
+    const int w = ctx.width, h = ctx.height;
+    // Tiles small enough that every worker gets several (small images still use all cores).
+    const int workers = std::max(1, tbb::this_task_arena::max_concurrency());
+    int ts = std::max(1, ctx.tile_size);
+    while (ts > 4 && ((w + ts - 1) / ts) * ((h + ts - 1) / ts) < 4 * workers) ts /= 2;
+    const int tiles_x = (w + ts - 1) / ts, tiles_y = (h + ts - 1) / ts;
+    const int tile_count = tiles_x * tiles_y;
+
+    std::atomic<uint64_t> rays{0}, invalid{0};
+    std::atomic<int> tiles_done{0};
+    tbb::parallel_for(tbb::blocked_range<int>(0, tile_count, 1), [&](const tbb::blocked_range<int>& range) {
+        for (int tile = range.begin(); tile != range.end(); ++tile) {
+            const uint64_t rays_before = Scene::rays_traced_by_this_thread();
+            uint64_t tile_invalid = 0;
+            const int x0 = (tile % tiles_x) * ts, y0 = (tile / tiles_x) * ts;
+            for (int y = y0; y < std::min(y0 + ts, h); ++y)
+                for (int x = x0; x < std::min(x0 + ts, w); ++x) {
+                    const size_t pixel = size_t(y) * size_t(w) + size_t(x);
+                    for (int k = 0; k < count; ++k) {
+                        Sampler sampler(ctx.seed, pixel, first + uint64_t(k), ctx.sampler);
+                        const Vec2f jitter = sampler.next2d();
+                        const Ray ray = ctx.camera.generate(float(x) + jitter.x, float(y) + jitter.y);
+                        const Rgb L = radiance(ctx.scene, ray, sampler);
+                        if (is_finite(L)) film.add(pixel, L);
+                        else ++tile_invalid;
+                    }
+                }
+            rays += Scene::rays_traced_by_this_thread() - rays_before;
+            invalid += tile_invalid;
+            if (progress) progress(double(++tiles_done) / tile_count);
+        }
+    });
+    return {rays.load(), invalid.load()};
+}
+
+}  // namespace pathlab

@@ -1,0 +1,58 @@
+#include "job/render_job.hpp"
+
+#include <fmt/format.h>
+
+#include "image/image_io.hpp"
+#include "job/usage_error.hpp"
+
+namespace pathlab {
+
+const IntegratorInfo& integrator_or_usage_error(const std::string& name) {
+    const IntegratorInfo* info = find_integrator(name);
+    if (!info) throw UsageError(fmt::format("unknown algorithm '{}'. Valid algorithms: {}", name, integrator_names()));
+    return *info;
+}
+
+RenderJob::RenderJob(SceneChoice scene, const JobRequest& r) : choice_(std::move(scene)) {
+    const SceneDescription& d = choice_.description;
+    info_ = &integrator_or_usage_error(r.algorithm ? *r.algorithm : d.algorithm.value_or("pt-mis"));
+    options_.max_depth = r.max_depth ? *r.max_depth : d.max_depth.value_or(-1);
+    options_.rr_depth = r.rr_depth;
+    if (options_.max_depth < -1 || options_.max_depth == 0) throw UsageError("--max-depth must be positive, or -1 for unlimited");
+    if (r.time_limit < 0 || !std::isfinite(r.time_limit)) throw UsageError("--time must be a positive number of seconds");
+    if (r.spp && *r.spp == 0) throw UsageError("--spp must be a positive number of samples");
+    integrator_ = info_->make(options_);
+
+    settings.width = r.width;
+    settings.height = r.height;
+    settings.spp = r.spp ? *r.spp : (r.time_limit > 0 ? 0 : (d.spp ? uint64_t(*d.spp) : r.default_spp));
+    settings.time_limit = r.time_limit;
+    settings.seed = r.seed;
+    settings.sampler = r.sampler;
+}
+
+const Scene& RenderJob::scene() {
+    if (!scene_) scene_ = Scene::build(choice_.description);
+    return *scene_;
+}
+
+RenderResult RenderJob::run() { return render(scene(), *integrator_, settings); }
+
+RenderStats RenderJob::run_into(Film& film) { return render_into(scene(), *integrator_, settings, film); }
+
+std::string RenderJob::expand(const std::string& pattern) const {
+    try {
+        return fmt::format(fmt::runtime(pattern), fmt::arg("scene", choice_.name), fmt::arg("index", choice_.index),
+                           fmt::arg("algorithm", info_->name));
+    } catch (const fmt::format_error& e) {
+        throw UsageError(fmt::format("invalid output pattern '{}': {} (placeholders: {{scene}}, {{index}}, {{algorithm}})",
+                                     pattern, e.what()));
+    }
+}
+
+void RenderJob::write_outputs(const RenderResult& result, float exposure) const {
+    const Image image = result.film.mean();
+    for (const std::string& path : outputs) write_image(image, path, exposure);
+}
+
+}  // namespace pathlab

@@ -1,0 +1,70 @@
+// One render: a scene, an integrator with its options, the render settings and the outputs.
+// Every command (render, reference, check, report), the benchmarks and the tests set their
+// renders up through it, so the rules of precedence live here only:
+//   algorithm  the request's, else the scene file's <integrator>, else pt-mis
+//   spp        the request's, else (without a time budget) the scene file's sample_count,
+//              else the request's default_spp (64 for renders)
+//   max_depth  the request's, else the scene file's, else -1 (unlimited)
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "integrators/integrator.hpp"
+#include "job/renderer.hpp"
+#include "job/scene_choice.hpp"
+
+namespace pathlab {
+
+struct JobRequest {
+    std::optional<std::string> algorithm;
+    std::optional<uint64_t> spp;
+    std::optional<int> max_depth;
+    int rr_depth = 3;           // -1: no Russian roulette
+    int width = 0, height = 0;  // 0: the scene's resolution
+    double time_limit = 0;      // seconds; 0: none
+    uint64_t seed = 1234;
+    SamplerKind sampler = SamplerKind::Independent;
+    uint64_t default_spp = 64;
+};
+
+// The integrator `name` (or an alias); a UsageError listing them all otherwise.
+const IntegratorInfo& integrator_or_usage_error(const std::string& name);
+
+class RenderJob {
+public:
+    // Makes the integrator (the scene is built when first needed). Unknown algorithms and
+    // invalid values are UsageErrors; a scene that cannot be built throws SceneError.
+    RenderJob(SceneChoice scene, const JobRequest& request);
+    RenderJob(int builtin_scene, const JobRequest& request) : RenderJob(builtin_scene_choice(builtin_scene), request) {}
+
+    const SceneChoice& scene_choice() const { return choice_; }
+    const Scene& scene();
+    const IntegratorInfo& integrator_info() const { return *info_; }
+    Integrator& integrator() { return *integrator_; }
+    const IntegratorOptions& integrator_options() const { return options_; }
+    // Progress, cancellation, callbacks and the size may be adjusted before run().
+    RenderSettings settings;
+    // Output files (patterns already expanded), written by write_outputs().
+    std::vector<std::string> outputs;
+
+    RenderResult run();
+    // Continues a render into `film` (see render_into); settings.first_sample says where.
+    RenderStats run_into(Film& film);
+
+    // Expands {scene}, {index} and {algorithm} in an output pattern (UsageError if malformed).
+    std::string expand(const std::string& pattern) const;
+    // Writes the mean image to every output (format by extension; `exposure` for .png).
+    void write_outputs(const RenderResult& result, float exposure = 0) const;
+
+private:
+    SceneChoice choice_;
+    std::unique_ptr<Scene> scene_;
+    const IntegratorInfo* info_ = nullptr;
+    IntegratorOptions options_;
+    std::unique_ptr<Integrator> integrator_;
+};
+
+}  // namespace pathlab

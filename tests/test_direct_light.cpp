@@ -113,8 +113,8 @@ TEST(AreaLight, EmitsOnItsNormalSideOnly) {
     const TriangleLight tri({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, Rgb(2.0f));  // normal +z
     EXPECT_EQ(tri.emitted({0, 0, 1}), Rgb(2.0f));
     EXPECT_EQ(tri.emitted(normalize(Vec3f(1, 1, -1))), Rgb(0.0f));
-    EXPECT_FALSE(tri.sample({0.2f, 0.2f, -1.0f}, {0.3f, 0.3f}));  // behind it: nothing to sample
-    EXPECT_TRUE(tri.sample({0.2f, 0.2f, 1.0f}, {0.3f, 0.3f}));
+    EXPECT_FALSE(tri.sample_li({0.2f, 0.2f, -1.0f}, {0.3f, 0.3f}));  // behind it: nothing to sample
+    EXPECT_TRUE(tri.sample_li({0.2f, 0.2f, 1.0f}, {0.3f, 0.3f}));
 }
 
 TEST(Environment, EscapingRaysReturnItsRadiance) {

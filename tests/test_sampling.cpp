@@ -92,7 +92,7 @@ TEST(Sampling, TrianglePointsAreUniformByArea) {
     const Vec3f e1 = b - a, e2 = c - a;
     const float d11 = dot(e1, e1), d12 = dot(e1, e2), d22 = dot(e2, e2), det = d11 * d22 - d12 * d12;
     for (int i = 0; i < N; ++i) {
-        const auto s = tri.sample(ref, rng.next2d());
+        const auto s = tri.sample_li(ref, rng.next2d());
         if (!s) {
             observed.back() += 1;
             continue;
@@ -140,13 +140,13 @@ TEST_P(TriangleLightDirections, MatchSolidAnglePdf) {
     opt.integration_steps = 64;  // the silhouette cuts cells; resolve it finely
     const auto r = chi2_directions(
         [&](Vec2f u) -> std::optional<Vec3f> {
-            const auto s = tri.sample(p, u);
+            const auto s = tri.sample_li(p, u);
             if (!s) return std::nullopt;
             return s->wi;
         },
         [&](const Vec3f& w) -> float {
             const auto q = hit_point(w);
-            return q ? tri.pdfW(p, *q) : 0.0f;
+            return q ? tri.pdf_li(p, *q) : 0.0f;
         },
         centre - p, opt);
     EXPECT_GT(r.p_value, kAlpha) << r.describe();
@@ -159,8 +159,8 @@ INSTANTIATE_TEST_SUITE_P(ReferencePoints, TriangleLightDirections,
 TEST(Sampling, EnvironmentLightIsUniformOverTheSphere) {
     const EnvironmentLight env{Rgb(1.0f)};
     const auto r = chi2_directions(
-        [&](Vec2f u) -> std::optional<Vec3f> { return env.sample(Vec3f(0.0f), u)->wi; },
-        [&](const Vec3f&) { return env.pdfW(); }, {0.3f, 0.4f, 0.5f});
+        [&](Vec2f u) -> std::optional<Vec3f> { return env.sample_li(Vec3f(0.0f), u)->wi; },
+        [&](const Vec3f&) { return env.pdf_li(); }, {0.3f, 0.4f, 0.5f});
     EXPECT_GT(r.p_value, kAlpha) << r.describe();
 }
 

@@ -148,12 +148,12 @@ TEST(SphereLight, SamplesAreUniformOverTheVisibleCap) {
     Sampler rng(13, 0, 0);
     long pdf_mismatches = 0;
     for (int i = 0; i < N; ++i) {
-        const auto s = light.sample(p, rng.next2d());
+        const auto s = light.sample_li(p, rng.next2d());
         if (!s) {
             observed.back() += 1;
             continue;
         }
-        const float expected_pdf = light.pdfW(p, s->point, s->normal);
+        const float expected_pdf = light.pdf_li(p, s->point, s->normal);
         if (std::abs(s->pdfW - expected_pdf) > 1e-4f * expected_pdf) ++pdf_mismatches;
         const Vec3f l = frame.to_local((s->point - light.center) / light.radius);
         double phi = std::atan2(l.y, l.x);
@@ -193,7 +193,7 @@ TEST(SphereLight, SolidAnglePdfIntegratesToTheVisibleFraction) {
         double v = 0;
         if (disc >= 0) {
             const Vec3f q = p + w * (-b - std::sqrt(disc));
-            v = light.pdfW(p, q, normalize(q - light.center)) * cone;
+            v = light.pdf_li(p, q, normalize(q - light.center)) * cone;
         }
         sum += v, sum2 += v * v;
     }

@@ -1,7 +1,6 @@
 #include "scene/scene.hpp"
 
 #include <algorithm>
-#include <numeric>
 
 #include <fmt/format.h>
 
@@ -103,37 +102,16 @@ std::unique_ptr<Scene> Scene::build(const SceneDescription& desc) {
         s->radius_ = std::max(1e-3f, 0.5f * length(hi - lo));
     }
 
-    // Light selection proportional to power.
-    const size_t n = s->lights_.size();
-    s->pmf_.resize(n);
-    for (size_t i = 0; i < n; ++i) s->pmf_[i] = std::max(0.0f, light_power(s->lights_[i], s->radius_));
-    const double total = std::accumulate(s->pmf_.begin(), s->pmf_.end(), 0.0);
-    for (float& p : s->pmf_) p = total > 0 ? float(p / total) : 1.0f / float(n);
-    s->cdf_.resize(n);
-    double running = 0;
-    for (size_t i = 0; i < n; ++i) s->cdf_[i] = float(running += s->pmf_[i]);
-    if (n) s->cdf_.back() = 1.0f;
+    s->light_distribution_ = LightDistribution(s->lights_, s->scene_sphere());
     return s;
 }
 
 bool Scene::has_delta_lights() const {
-    return std::any_of(lights_.begin(), lights_.end(), [](const Light& l) {
-        return std::holds_alternative<PointLight>(l) || std::holds_alternative<DirectionalLight>(l);
-    });
+    return std::any_of(lights_.begin(), lights_.end(), [](const Light& l) { return is_delta_light(l); });
 }
 
 bool Scene::has_hittable_emitters() const {
-    return std::any_of(lights_.begin(), lights_.end(), [](const Light& l) {
-        return std::holds_alternative<TriangleLight>(l) || std::holds_alternative<SphereLight>(l) ||
-               std::holds_alternative<EnvironmentLight>(l);
-    });
-}
-
-LightChoice Scene::choose_light(float u) const {
-    if (lights_.empty()) return {};
-    const auto it = std::upper_bound(cdf_.begin(), cdf_.end(), u);
-    const int index = int(std::min<ptrdiff_t>(it - cdf_.begin(), ptrdiff_t(cdf_.size()) - 1));
-    return {index, pmf_[size_t(index)]};
+    return std::any_of(lights_.begin(), lights_.end(), [](const Light& l) { return !is_delta_light(l); });
 }
 
 bool Scene::intersect(const Ray& ray, Intersection& hit) const {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "geometry/accel.hpp"
+#include "lights/light_distribution.hpp"
 #include "scene/scene_description.hpp"
 
 namespace pathlab {
@@ -25,11 +26,6 @@ struct Intersection {
     float t = 0;
     uint32_t material = 0;
     int32_t light = -1;  // index into Scene::lights() of the area light here, or -1
-};
-
-struct LightChoice {
-    int index = -1;
-    float pmf = 0;  // probability of having chosen this light
 };
 
 class Scene {
@@ -53,13 +49,17 @@ public:
     // True when a sampled direction can find emission (an area light or the environment).
     bool has_hittable_emitters() const;
 
-    // Radiance along a ray that escapes the scene (the constant environment, if any).
-    Rgb escaped_radiance() const { return environment_ >= 0 ? std::get<EnvironmentLight>(lights_[environment_]).radiance : Rgb(0.0f); }
+    // Radiance along a ray that escapes the scene in direction w (the environment, if any).
+    Rgb escaped_radiance(const Vec3f& w = {}) const {
+        return environment_ >= 0 ? std::get<EnvironmentLight>(lights_[size_t(environment_)]).Le(w) : Rgb(0.0f);
+    }
     int environment_light() const { return environment_; }
 
     // Chooses a light with probability proportional to its power (uniformly if all are 0).
-    LightChoice choose_light(float u) const;
-    float light_pmf(int index) const { return pmf_[size_t(index)]; }
+    LightChoice choose_light(float u) const { return light_distribution_.choose(u); }
+    float light_pmf(int index) const { return light_distribution_.pmf(index); }
+    // The bounding sphere that lights at infinity emit light paths through.
+    SceneSphere scene_sphere() const { return {center_, radius_}; }
 
     const Accel& accel() const { return accel_; }
     Vec3f bounds_center() const { return center_; }
@@ -87,7 +87,7 @@ private:
     std::vector<std::vector<Vec3f>> face_normals_;  // per mesh, per triangle
     std::vector<Material> materials_;
     std::vector<Light> lights_;
-    std::vector<float> pmf_, cdf_;
+    LightDistribution light_distribution_;
     int environment_ = -1;
     Vec3f center_{0.0f};
     float radius_ = 1;

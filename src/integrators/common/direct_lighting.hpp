@@ -52,15 +52,15 @@ inline EmitterHit trace_to_emitter(const Scene& scene, const Ray& ray, const Vec
     if (!e.hit) {
         const int env = scene.environment_light();
         if (env >= 0) {
-            e.Le = scene.escaped_radiance();
-            e.pdf_light = scene.light_pmf(env) * std::get<EnvironmentLight>(scene.lights()[size_t(env)]).pdfW();
+            e.Le = scene.escaped_radiance(ray.d);
+            e.pdf_light = scene.light_pmf(env) * std::get<EnvironmentLight>(scene.lights()[size_t(env)]).pdf_li(ray.d);
         }
         return e;
     }
     e.Le = emitted_radiance(scene, e.isect, -ray.d / length(ray.d));
     if (!is_black(e.Le)) {
         const Light& light = scene.lights()[size_t(e.isect.light)];
-        e.pdf_light = scene.light_pmf(e.isect.light) * surface_light_pdfW(light, from, e.isect.p, e.isect.ng);
+        e.pdf_light = scene.light_pmf(e.isect.light) * surface_light_pdf_li(light, from, e.isect.p, e.isect.ng);
     }
     return e;
 }

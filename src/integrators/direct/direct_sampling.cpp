@@ -19,7 +19,7 @@ public:
 
     Rgb radiance(const Scene& scene, const Ray& ray, Sampler& sampler) const override {
         Intersection hit;
-        if (!scene.intersect(ray, hit)) return scene.escaped_radiance();
+        if (!scene.intersect(ray, hit)) return scene.escaped_radiance(ray.d);
         Rgb L = emitted_radiance(scene, hit, -ray.d);
         const ShadingPoint sp = make_shading_point(scene, hit, ray.d);
         if (sp.material->is_black()) return L;

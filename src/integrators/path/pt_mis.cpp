@@ -21,7 +21,7 @@ public:
 
     Rgb radiance(const Scene& scene, const Ray& camera_ray, Sampler& sampler) const override {
         Intersection hit;
-        if (!scene.intersect(camera_ray, hit)) return scene.escaped_radiance();
+        if (!scene.intersect(camera_ray, hit)) return scene.escaped_radiance(camera_ray.d);
         Vec3f dir = camera_ray.d;
         Rgb L = emitted_radiance(scene, hit, -dir);
         Rgb beta(1.0f);

@@ -19,7 +19,7 @@ public:
         Ray ray = camera_ray;
         for (int bounces = 0;; ++bounces) {
             Intersection hit;
-            if (!scene.intersect(ray, hit)) return L + beta * scene.escaped_radiance();
+            if (!scene.intersect(ray, hit)) return L + beta * scene.escaped_radiance(ray.d);
             L += beta * emitted_radiance(scene, hit, -normalize(ray.d));
             const ShadingPoint sp = make_shading_point(scene, hit, normalize(ray.d));
             if (sp.material->is_black() || !rules_.may_bounce(bounces)) return L;

@@ -31,7 +31,7 @@ SceneDescription with_new_materials(SceneDescription d) {
 TEST(Allocation, NoEstimatorAllocatesPerSample) {
     for (int index : {0, 3, 5, 7, -1}) {
         const auto scene = Scene::build(index < 0 ? with_new_materials(make_builtin_scene(3)) : make_builtin_scene(index));
-        const CameraRays camera(scene->camera(), 64, 64);
+        const PerspectiveCamera camera(scene->camera(), 64, 64);
         for (const IntegratorInfo& info : integrators()) {
             const auto integrator = info.make({});
             const auto* estimator = dynamic_cast<const PixelIntegrator*>(integrator.get());

@@ -33,7 +33,7 @@ double closed_form(double x, double y) {
 }
 
 // Where a camera ray through raster point (sx, sy) meets the plane z = 0.
-std::pair<double, double> plane_hit(const CameraRays& cam, float sx, float sy) {
+std::pair<double, double> plane_hit(const PerspectiveCamera& cam, float sx, float sy) {
     const Ray r = cam.generate(sx, sy);
     const double t = -double(r.o.z) / double(r.d.z);
     return {r.o.x + t * r.d.x, r.o.y + t * r.d.y};
@@ -42,7 +42,7 @@ std::pair<double, double> plane_hit(const CameraRays& cam, float sx, float sy) {
 TEST(PointLightOverPlane, EveryPixelCentreMatchesTheClosedForm) {
     const auto scene = Scene::build(point_light_over_plane());
     const auto estimator = make_pixel_integrator("direct-light");
-    const CameraRays cam(scene->camera(), 32, 32);
+    const PerspectiveCamera cam(scene->camera(), 32, 32);
     for (int y = 0; y < 32; ++y)
         for (int x = 0; x < 32; ++x) {
             Sampler sampler(1, uint64_t(y * 32 + x), 0);
@@ -59,7 +59,7 @@ TEST(PointLightOverPlane, EveryPixelCentreMatchesTheClosedForm) {
 // the pixel footprint, judged by the per-pixel standard errors.
 AgreementResult render_against_closed_form(float intensity) {
     const RenderResult r = render_scene(point_light_over_plane(intensity), "direct-light", 32, 32, 64, 7);
-    const CameraRays cam(Camera(Scene::build(point_light_over_plane())->camera()), 32, 32);
+    const PerspectiveCamera cam(Camera(Scene::build(point_light_over_plane())->camera()), 32, 32);
     Image exact(32, 32);
     constexpr int kSub = 32;
     for (int y = 0; y < 32; ++y)
@@ -91,7 +91,7 @@ TEST(PointLightOverPlane, OnePercentTooBrightIsDetected) {
 void expect_emitter_pixels_exact(int scene_index, float radiance, int min_pixels) {
     const auto scene = Scene::build(make_builtin_scene(scene_index));
     const auto estimator = make_pixel_integrator("direct-light");
-    const CameraRays cam(scene->camera(), 512, 512);
+    const PerspectiveCamera cam(scene->camera(), 512, 512);
     int seen = 0;
     for (int y = 0; y < 512; y += 2)
         for (int x = 0; x < 512; x += 2) {
@@ -106,8 +106,8 @@ void expect_emitter_pixels_exact(int scene_index, float radiance, int min_pixels
     EXPECT_GE(seen, min_pixels);
 }
 
-TEST(AreaLight, CameraRaysHittingTheCeilingReturnItsRadiance) { expect_emitter_pixels_exact(2, 1.21f, 41'618 / 4 - 200); }
-TEST(AreaLight, CameraRaysHittingTheLightBoxReturnItsRadiance) { expect_emitter_pixels_exact(4, 31.831f, 1'518 / 4 - 50); }
+TEST(AreaLight, PerspectiveCameraHittingTheCeilingReturnItsRadiance) { expect_emitter_pixels_exact(2, 1.21f, 41'618 / 4 - 200); }
+TEST(AreaLight, PerspectiveCameraHittingTheLightBoxReturnItsRadiance) { expect_emitter_pixels_exact(4, 31.831f, 1'518 / 4 - 50); }
 
 TEST(AreaLight, EmitsOnItsNormalSideOnly) {
     const TriangleLight tri({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, Rgb(2.0f));  // normal +z

@@ -13,7 +13,7 @@ namespace {
 // half finds it by tracing the direction) and check the two weights sum to 1.
 void check_weights(int scene_index) {
     const auto scene = Scene::build(make_builtin_scene(scene_index));
-    const CameraRays cam(scene->camera(), 64, 64);
+    const PerspectiveCamera cam(scene->camera(), 64, 64);
     Sampler rng(21, 0, 0);
     int checked = 0;
     for (int i = 0; i < 20000; ++i) {

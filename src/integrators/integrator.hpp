@@ -36,7 +36,7 @@ struct IntegratorOptions {
 // What every pass of one render sees; fixed for the whole render.
 struct RenderContext {
     const Scene& scene;
-    const CameraRays& camera;  // prepared for width x height
+    const PerspectiveCamera& camera;  // prepared for width x height
     int width = 0, height = 0;
     uint64_t seed = 0;
     SamplerKind sampler = SamplerKind::Independent;

@@ -35,7 +35,7 @@ RenderStats render_into(const Scene& scene, Integrator& integrator, const Render
     if (settings.spp <= 0 && settings.time_limit <= 0)
         throw std::invalid_argument("a render needs a positive sample count or time limit");
 
-    const CameraRays camera(scene.camera(), w, h);
+    const PerspectiveCamera camera(scene.camera(), w, h);
     const RenderContext ctx{scene, camera, w, h, settings.seed, settings.sampler, settings.tile_size};
     Progress progress(settings.progress);
     const auto start = std::chrono::steady_clock::now();

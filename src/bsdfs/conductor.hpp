@@ -30,7 +30,7 @@ struct ConductorMaterial {
     std::optional<BsdfSample> sample(const Vec3f& wi, Vec2f) const {
         if (wi.z <= 0) return std::nullopt;
         const Vec3f wo(-wi.x, -wi.y, wi.z);
-        return BsdfSample{wo, fresnel(wi.z) / wo.z, 1.0f, true};
+        return BsdfSample{wo, fresnel(wi.z) / wo.z, 1.0f, true, kLobeSpecular | kLobeReflection};
     }
 };
 

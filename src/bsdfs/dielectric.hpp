@@ -35,13 +35,13 @@ struct DielectricMaterial {
         const float F = fresnel_dielectric(cos_i, eta_other / eta_wi, &cos_t);
         if (u.x < F) {
             const Vec3f wo(-wi.x, -wi.y, wi.z);
-            return BsdfSample{wo, Rgb(F / cos_i), F, true};
+            return BsdfSample{wo, Rgb(F / cos_i), F, true, kLobeSpecular | kLobeReflection};
         }
         // Refraction: wo on the other side, tangential part scaled by eta_wi / eta_other.
         const float r = eta_wi / eta_other;
         const Vec3f wo(-wi.x * r, -wi.y * r, outside ? -cos_t : cos_t);
         const float scale = r * r;  // (eta_wi / eta_wo)^2
-        return BsdfSample{wo, Rgb((1 - F) * scale / cos_t), 1 - F, true};
+        return BsdfSample{wo, Rgb((1 - F) * scale / cos_t), 1 - F, true, kLobeSpecular | kLobeTransmission};
     }
 };
 

@@ -2,16 +2,21 @@
 //
 // Conventions, stated once for every material:
 //  - Directions are unit vectors in the local shading frame (normal = +z), and both point
-//    away from the surface: `wi` towards where the path came from (the camera side), `wo`
-//    the other direction (towards a light, or the sampled continuation).
+//    away from the surface: `wi` towards where the path came from (the camera side for camera
+//    paths, the light side for light paths), `wo` the other direction (towards a light or the
+//    camera, or the sampled continuation).
 //  - eval(wi, wo) returns the BSDF value f (no cosine factor).
 //  - pdf(wi, wo) and BsdfSample::pdfW are densities per unit solid angle of wo.
 //  - sample(wi, u) draws wo given two uniform numbers in [0,1).
+// The models (one header each) compute radiance-mode values. Material's functions that take a
+// BsdfContext apply the transport mode (bsdf_context.hpp) and fill the reverse pdf; the ones
+// without a context are the plain radiance-mode models.
 #pragma once
 
 #include <optional>
 #include <variant>
 
+#include "bsdfs/bsdf_context.hpp"
 #include "bsdfs/conductor.hpp"
 #include "bsdfs/dielectric.hpp"
 #include "bsdfs/phong.hpp"
@@ -55,6 +60,34 @@ struct Material {
     std::optional<BsdfSample> sample(const Vec3f& wi, const Vec2f& u) const {
         return std::visit([&](const auto& m) { return m.sample(wi, u); }, model);
     }
+    // ---- with a shading context (transport mode, reverse pdf) ----------------------------
+    Rgb eval(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo) const {
+        Rgb f = eval(wi, wo);
+        if (ctx.mode == TransportMode::Importance) f *= importance_factor(ctx, wi, wo);
+        return f;
+    }
+    float pdf(const BsdfContext&, const Vec3f& wi, const Vec3f& wo) const { return pdf(wi, wo); }
+    Rgb eval_and_pdf(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo, float& pdf) const {
+        Rgb f = eval_and_pdf(wi, wo, pdf);
+        if (ctx.mode == TransportMode::Importance) f *= importance_factor(ctx, wi, wo);
+        return f;
+    }
+    std::optional<BsdfSample> sample(const BsdfContext& ctx, const Vec3f& wi, const Vec2f& u) const {
+        std::optional<BsdfSample> s = sample(wi, u);
+        if (!s) return s;
+        if (ctx.mode == TransportMode::Importance) {
+            const float k = importance_factor(ctx, wi, s->wo);
+            if (!(k > 0)) return std::nullopt;
+            s->f *= k;
+        }
+        if (ctx.reverse_pdf) s->pdf_rev = s->delta ? s->pdfW : pdf(s->wo, wi);
+        return s;
+    }
+    // The flags of every lobe the material has (BsdfLobe).
+    uint32_t lobes() const {
+        return std::visit([](const auto& m) { return lobes_of(m); }, model);
+    }
+
     // True when the material reflects nothing (pure emitters): estimators stop there.
     bool is_black() const {
         if (const auto* p = std::get_if<PhongMaterial>(&model))
@@ -70,6 +103,35 @@ struct Material {
     bool is_dielectric() const {
         return std::holds_alternative<DielectricMaterial>(model) || std::holds_alternative<RoughDielectricMaterial>(model);
     }
+
+    // What importance transport multiplies the radiance-mode BSDF by (bsdf_context.hpp): the
+    // refraction factor (eta_wo / eta_wi)^2 and the shading-normal correction; 0 for directions
+    // on different sides of the geometric and the shading surface.
+    float importance_factor(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo) const {
+        const Vec3f ng = ctx.frame.to_local(ctx.ng);
+        const float wi_ng = dot(wi, ng), wo_ng = dot(wo, ng);
+        if (wi_ng * wi.z <= 0 || wo_ng * wo.z <= 0) return 0.0f;
+        float k = std::abs(wi.z * wo_ng) / std::abs(wi_ng * wo.z);
+        if (wi.z * wo.z < 0) {
+            float int_ior = 1, ext_ior = 1;
+            if (const auto* d = std::get_if<DielectricMaterial>(&model)) int_ior = d->int_ior, ext_ior = d->ext_ior;
+            if (const auto* d = std::get_if<RoughDielectricMaterial>(&model)) int_ior = d->int_ior, ext_ior = d->ext_ior;
+            const float eta_wi = wi.z > 0 ? ext_ior : int_ior, eta_wo = wo.z > 0 ? ext_ior : int_ior;
+            k *= (eta_wo * eta_wo) / (eta_wi * eta_wi);
+        }
+        return k;
+    }
+
+private:
+    static uint32_t lobes_of(const PhongMaterial& m) {
+        return kLobeReflection | (pathlab::is_black(m.diffuse) ? 0u : kLobeDiffuse) | (pathlab::is_black(m.specular) ? 0u : kLobeGlossy);
+    }
+    static uint32_t lobes_of(const ConductorMaterial&) { return kLobeSpecular | kLobeReflection; }
+    static uint32_t lobes_of(const DielectricMaterial&) { return kLobeSpecular | kLobeReflection | kLobeTransmission; }
+    static uint32_t lobes_of(const RoughConductorMaterial&) { return kLobeGlossy | kLobeReflection; }
+    static uint32_t lobes_of(const RoughDielectricMaterial&) { return kLobeGlossy | kLobeReflection | kLobeTransmission; }
+    static uint32_t lobes_of(const PlasticMaterial&) { return kLobeDiffuse | kLobeSpecular | kLobeReflection; }
+    static uint32_t lobes_of(const RoughPlasticMaterial&) { return kLobeDiffuse | kLobeGlossy | kLobeReflection; }
 };
 
 inline Material make_phong(const Rgb& diffuse, const Rgb& specular = Rgb(0.0f), float exponent = 1) {

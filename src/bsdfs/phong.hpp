@@ -64,6 +64,7 @@ struct PhongMaterial {
         if (wi.z <= 0 || (is_black(diffuse) && is_black(specular))) return std::nullopt;
         const float pd = diffuse_probability();
         Vec3f wo;
+        const uint32_t lobe = kLobeReflection | (u.x < pd ? kLobeDiffuse : kLobeGlossy);
         if (u.x < pd) {
             u.x /= pd;
             wo = square_to_cosine_hemisphere(u);
@@ -75,7 +76,7 @@ struct PhongMaterial {
         float p;
         const Rgb f = eval_and_pdf(wi, wo, p);
         if (!(p > 0)) return std::nullopt;
-        return BsdfSample{wo, f, p, false};
+        return BsdfSample{wo, f, p, false, lobe};
     }
 
     static Vec3f mirror(const Vec3f& w) { return {-w.x, -w.y, w.z}; }

@@ -75,14 +75,14 @@ struct PlasticMaterial {
         const float F = coat.fresnel(wi.z), ps = coat.specular_probability(F);
         if (u.x < ps) {
             const Vec3f wo(-wi.x, -wi.y, wi.z);
-            return BsdfSample{wo, coat.specular_reflectance * (F / wo.z), ps, true};
+            return BsdfSample{wo, coat.specular_reflectance * (F / wo.z), ps, true, kLobeSpecular | kLobeReflection};
         }
         u.x = std::min((u.x - ps) / (1 - ps), 0x1.fffffep-1f);
         const Vec3f wo = square_to_cosine_hemisphere(u);
         if (wo.z <= 0) return std::nullopt;
         const float p = (1 - ps) * cosine_hemisphere_pdf(wo);
         if (!(p > 0)) return std::nullopt;
-        return BsdfSample{wo, coat.diffuse(F, wo.z), p, false};
+        return BsdfSample{wo, coat.diffuse(F, wo.z), p, false, kLobeDiffuse | kLobeReflection};
     }
 };
 

@@ -62,7 +62,7 @@ struct RoughConductorMaterial {
         float p;
         const Rgb f = eval_and_pdf(wi, wo, p);
         if (!(p > 0)) return std::nullopt;
-        return BsdfSample{wo, f, p, false};
+        return BsdfSample{wo, f, p, false, kLobeGlossy | kLobeReflection};
     }
 };
 

@@ -120,7 +120,7 @@ struct RoughDielectricMaterial {
         float p;
         const Rgb f = eval_and_pdf(wi_in, wo, p);
         if (!(p > 0)) return std::nullopt;
-        return BsdfSample{wo, f, p, false};
+        return BsdfSample{wo, f, p, false, kLobeGlossy | (reflect_lobe ? kLobeReflection : kLobeTransmission)};
     }
 };
 

@@ -97,6 +97,7 @@ struct RoughPlasticMaterial {
         if (wi.z <= 0) return std::nullopt;
         const float ps = coat.specular_probability(1 - T(wi.z));
         Vec3f wo;
+        const uint32_t lobe = kLobeReflection | (u.x < ps ? kLobeGlossy : kLobeDiffuse);
         if (u.x < ps) {
             u.x = u.x / ps;
             wo = reflect(wi, distribution.sample(wi, u));
@@ -108,7 +109,7 @@ struct RoughPlasticMaterial {
         float p;
         const Rgb f = eval_and_pdf(wi, wo, p);
         if (!(p > 0)) return std::nullopt;
-        return BsdfSample{wo, f, p, false};
+        return BsdfSample{wo, f, p, false, lobe};
     }
 
 private:

@@ -13,6 +13,9 @@ struct Vec2 {
     constexpr Vec2() = default;
     constexpr Vec2(T x_, T y_) : x(x_), y(y_) {}
     constexpr T operator[](int i) const { return i == 0 ? x : y; }
+    constexpr Vec2 operator+(const Vec2& o) const { return {x + o.x, y + o.y}; }
+    constexpr Vec2 operator*(T s) const { return {x * s, y * s}; }
+    constexpr bool operator==(const Vec2&) const = default;
 };
 
 template <typename T>

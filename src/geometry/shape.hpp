@@ -15,6 +15,7 @@ struct MeshDesc {
     std::string name;
     std::vector<Vec3f> positions;
     std::vector<Vec3f> normals;  // per vertex, optional (empty: flat shading)
+    std::vector<Vec2f> uvs;      // per vertex texture coordinates, optional
     std::vector<std::array<uint32_t, 3>> triangles;
     uint32_t material = 0;
     Rgb emission{0.0f};  // radiance of a one-sided area emitter on the winding-normal side

@@ -23,6 +23,8 @@ void validate(const SceneDescription& d) {
             if (!is_finite(p)) throw SceneError(what + " has a NaN or infinite vertex");
         if (!m.normals.empty() && m.normals.size() != m.positions.size())
             throw SceneError(fmt::format("{} has {} normals for {} vertices", what, m.normals.size(), m.positions.size()));
+        if (!m.uvs.empty() && m.uvs.size() != m.positions.size())
+            throw SceneError(fmt::format("{} has {} texture coordinates for {} vertices", what, m.uvs.size(), m.positions.size()));
         for (const auto& tri : m.triangles)
             for (uint32_t v : tri)
                 if (v >= m.positions.size())
@@ -142,6 +144,7 @@ bool Scene::intersect(const Ray& ray, Intersection& hit) const {
             const Vec3f n = m.normals[tri[0]] * b0 + m.normals[tri[1]] * b1 + m.normals[tri[2]] * b2;
             if (dot(n, n) > 0) hit.ns = normalize(n);
         }
+        if (!m.uvs.empty()) hit.uv = m.uvs[tri[0]] * b0 + m.uvs[tri[1]] * b1 + m.uvs[tri[2]] * b2;
         hit.material = m.material;
         hit.light = rec.first_light >= 0 ? rec.first_light + int32_t(raw.prim_id) : -1;
     }

@@ -23,6 +23,7 @@ struct Intersection {
     Vec3f p;             // hit point, recomputed from the primitive (not o + t d) for accuracy
     Vec3f ng;            // unit geometric normal as the shape defines it (winding / outward)
     Vec3f ns;            // unit shading normal (ng unless the mesh has vertex normals)
+    Vec2f uv{0.0f, 0.0f};  // surface coordinates (mesh texture coordinates); (0, 0) where there are none
     float t = 0;
     uint32_t material = 0;
     int32_t light = -1;  // index into Scene::lights() of the area light here, or -1

@@ -24,7 +24,7 @@ inline Rgb estimate_light_sample(const Scene& scene, const ShadingPoint& sp, Sam
     if (dot(ls->wi, sp.ng) <= 0 && !sp.material->is_dielectric()) return Rgb(0.0f);
     const Vec3f wo = sp.frame.to_local(ls->wi);
     float pdf_bsdf;
-    const Rgb f = sp.material->eval_and_pdf(sp.wi, wo, pdf_bsdf);
+    const Rgb f = sp.material->eval_and_pdf(sp, sp.wi, wo, pdf_bsdf);
     if (is_black(f)) return Rgb(0.0f);
     const Ray shadow = std::isinf(ls->distance) ? spawn_ray(sp.p, sp.ng, ls->wi)
                                                 : spawn_segment(sp.p, sp.ng, ls->point, ls->normal);

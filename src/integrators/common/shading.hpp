@@ -7,12 +7,10 @@
 
 namespace pathlab {
 
-struct ShadingPoint {
+// The BSDF's shading context (p, uv, frame, ng, transport mode) and what the integrator adds.
+struct ShadingPoint : BsdfContext {
     const Material* material = nullptr;
-    Vec3f p;
-    Vec3f ng;     // geometric normal, on the same side as frame.n
-    Frame frame;  // shading frame
-    Vec3f wi;     // local direction back along the arriving ray (towards the camera side)
+    Vec3f wi;  // local direction back along the arriving ray (where the path came from)
 
     // A ray leaving the surface in the local direction w.
     Ray spawn(const Vec3f& w_local) const { return spawn_ray(p, ng, frame.to_world(w_local)); }
@@ -20,10 +18,13 @@ struct ShadingPoint {
 
 // Two-sided materials see the front of every surface: their normals are flipped to face the
 // arriving ray. One-sided ones keep the shape's orientation (black from behind).
-inline ShadingPoint make_shading_point(const Scene& scene, const Intersection& hit, const Vec3f& ray_dir) {
+inline ShadingPoint make_shading_point(const Scene& scene, const Intersection& hit, const Vec3f& ray_dir,
+                                       TransportMode mode = TransportMode::Radiance) {
     ShadingPoint sp;
     sp.material = &scene.material(hit.material);
     sp.p = hit.p;
+    sp.uv = hit.uv;
+    sp.mode = mode;
     sp.ng = hit.ng;
     Vec3f ns = hit.ns;
     if (sp.material->two_sided && dot(ray_dir, hit.ng) > 0) {

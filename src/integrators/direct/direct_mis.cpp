@@ -21,7 +21,7 @@ public:
         if (sp.material->is_black()) return L;
         L += estimate_light_sample(scene, sp, sampler, /*mis=*/true);
         if (!scene.has_hittable_emitters()) return L;  // only delta lights: the BSDF ray finds nothing
-        if (const auto s = sp.material->sample(sp.wi, sampler.next2d())) {
+        if (const auto s = sp.material->sample(sp, sp.wi, sampler.next2d())) {
             EmitterHit found;
             L += estimate_bsdf_sample_mis(scene, sp, *s, found);
         }

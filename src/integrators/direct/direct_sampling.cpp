@@ -32,15 +32,15 @@ public:
             case Strategy::UniformHemisphere:
                 wo = square_to_uniform_hemisphere(u);
                 pdfW = uniform_hemisphere_pdf(wo);
-                f = sp.material->eval(sp.wi, wo);
+                f = sp.material->eval(sp, sp.wi, wo);
                 break;
             case Strategy::CosineHemisphere:
                 wo = square_to_cosine_hemisphere(u);
                 pdfW = cosine_hemisphere_pdf(wo);
-                f = sp.material->eval(sp.wi, wo);
+                f = sp.material->eval(sp, sp.wi, wo);
                 break;
             case Strategy::Brdf: {
-                const auto s = sp.material->sample(sp.wi, u);
+                const auto s = sp.material->sample(sp, sp.wi, u);
                 if (!s) return L;
                 wo = s->wo, f = s->f, pdfW = s->pdfW;
                 break;

@@ -30,7 +30,7 @@ public:
             if (sp.material->is_black()) break;
             // Paths of bounces + 1 bounces ending on a light: the MIS pair.
             L += beta * estimate_light_sample(scene, sp, sampler, /*mis=*/true);
-            const auto s = sp.material->sample(sp.wi, sampler.next2d());
+            const auto s = sp.material->sample(sp, sp.wi, sampler.next2d());
             EmitterHit found;
             if (s) L += beta * estimate_bsdf_sample_mis(scene, sp, *s, found);
             if (!rules_.may_bounce(bounces + 1)) break;
@@ -41,7 +41,7 @@ public:
             if (!three_rays_ && !s) break;
             BsdfSample next = s ? *s : BsdfSample{};
             if (three_rays_) {
-                const auto c = sp.material->sample(sp.wi, sampler.next2d());
+                const auto c = sp.material->sample(sp, sp.wi, sampler.next2d());
                 if (!c) break;
                 next = *c;
                 found.hit = scene.intersect(sp.spawn(next.wo), found.isect);

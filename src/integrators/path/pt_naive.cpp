@@ -23,7 +23,7 @@ public:
             L += beta * emitted_radiance(scene, hit, -normalize(ray.d));
             const ShadingPoint sp = make_shading_point(scene, hit, normalize(ray.d));
             if (sp.material->is_black() || !rules_.may_bounce(bounces)) return L;
-            const auto s = sp.material->sample(sp.wi, sampler.next2d());
+            const auto s = sp.material->sample(sp, sp.wi, sampler.next2d());
             if (!s) return L;
             beta *= s->f * (std::abs(s->wo.z) / s->pdfW);
             if (!rules_.survive_roulette(bounces + 1, beta, sampler)) return L;

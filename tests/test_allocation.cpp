@@ -1,8 +1,10 @@
-// The hot path allocates nothing: every estimator's radiance() for thousands of samples makes no
-// heap allocation (counted by replacing operator new in this test binary).
+// The hot path allocates nothing: every estimator's radiance() for thousands of samples, and
+// the light tracer's paths once its splat list has the size of a pass, make no heap
+// allocation (counted by replacing operator new in this test binary).
 #include <gtest/gtest.h>
 
 #include "instrument/allocation_counter.hpp"
+#include "integrators/bidir/light_tracer.hpp"
 #include "job/renderer.hpp"
 #include "scene/builtin_scenes.hpp"
 
@@ -34,8 +36,28 @@ TEST(Allocation, NoEstimatorAllocatesPerSample) {
         const PerspectiveCamera camera(scene->camera(), 64, 64);
         for (const IntegratorInfo& info : integrators()) {
             const auto integrator = info.make({});
+            if (const auto* lt = dynamic_cast<const LightTracer*>(integrator.get())) {
+                // Light paths: once the splat list has grown (here: by a pass of twice as many
+                // paths as are then counted), none allocates.
+                const RenderContext ctx{*scene, camera, 64, 64, 7, SamplerKind::Independent, 32};
+                SplatList splats;
+                uint64_t invalid = 0;
+                for (uint64_t j = 0; j < 8192; ++j) {
+                    Sampler sampler(7, j, 0);
+                    lt->trace(ctx, sampler, splats, invalid);
+                }
+                splats.clear();
+                const uint64_t before = allocations_by_this_thread();
+                for (uint64_t j = 0; j < 4096; ++j) {
+                    Sampler sampler(7, j, 1);
+                    lt->trace(ctx, sampler, splats, invalid);
+                }
+                EXPECT_EQ(allocations_by_this_thread() - before, 0u) << info.name << " on scene " << index;
+                EXPECT_GT(splats.splats().size(), 100u) << "the light paths must reach the camera";
+                continue;
+            }
             const auto* estimator = dynamic_cast<const PixelIntegrator*>(integrator.get());
-            if (!estimator) continue;
+            ASSERT_TRUE(estimator) << info.name << ": a new kind of integrator needs its own allocation check here";
             const uint64_t before = allocations_by_this_thread();
             for (uint64_t s = 0; s < 4096; ++s) {
                 Sampler sampler(7, s % 4096, s);

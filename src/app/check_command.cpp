@@ -21,6 +21,7 @@
 #include "scene/builtin_scenes.hpp"
 #include "judge/check.hpp"
 #include "judge/reference_set.hpp"
+#include "judge/specular_mask.hpp"
 
 namespace pathlab {
 namespace fs = std::filesystem;
@@ -141,7 +142,17 @@ int run_check_command(const CheckOptions& o) {
                 fmt::print(stderr, "pathlab: interrupted\n");
                 return 130;
             }
-            v = judge_render(r.film.mean(), r.film.standard_error(), *loaded);
+            // Pixels the integrator leaves black by design (a light tracer behind mirrors and glass).
+            std::vector<uint8_t> black;
+            if (!info->sees_specular_from_camera) black = specular_first_vertex_mask(job.scene(), rs.width, rs.height);
+            const size_t left_out = count_marked(black);
+            v = left_out == black.size() && left_out > 0
+                    ? SceneVerdict{Verdict::BlackByDesign,
+                                   fmt::format("{} sees no pixel: all show specular surfaces first", info->name)}
+                    : judge_render(r.film.mean(), r.film.standard_error(), *loaded, left_out ? &black : nullptr);
+            if (left_out && v.verdict != Verdict::BlackByDesign)
+                v.detail += fmt::format("; {} pixels ({:.1f}%) left out: black by design for {} (their first surface is specular)",
+                                        left_out, 100.0 * double(left_out) / double(black.size()), info->name);
             if (v.verdict == Verdict::Ok || v.verdict == Verdict::Fail) ++compared;
         }
         if (v.verdict == Verdict::Fail || v.verdict == Verdict::Error) ++failed;

@@ -14,5 +14,6 @@ std::unique_ptr<Integrator> make_direct_mis(const IntegratorOptions&);
 std::unique_ptr<Integrator> make_pt_naive(const IntegratorOptions&);
 std::unique_ptr<Integrator> make_pt_mis3(const IntegratorOptions&);
 std::unique_ptr<Integrator> make_pt_mis(const IntegratorOptions&);
+std::unique_ptr<Integrator> make_light_tracer(const IntegratorOptions&);
 
 }  // namespace pathlab

@@ -17,6 +17,7 @@ const std::vector<IntegratorInfo>& integrators() {
         {"pt-naive", {"4a"}, "path tracing by BRDF sampling, Russian roulette", true, true, make_pt_naive},
         {"pt-mis3", {"4b"}, "path tracing, MIS direct lighting at every bounce + a third continuation ray", false, true, make_pt_mis3},
         {"pt-mis", {"4c"}, "path tracing, MIS direct lighting whose BRDF ray continues the path", false, true, make_pt_mis},
+        {"lt", {"ptracer"}, "light tracing: paths from the lights, every vertex connected to the camera", false, false, make_light_tracer},
     };
     return table;
 }

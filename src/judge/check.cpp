@@ -36,7 +36,7 @@ std::string LinearCheck::describe() const {
 }
 
 LinearCheck check_against_linear_reference(const Image& render, const Image& render_se, const Image& reference,
-                                           const Image& reference_se) {
+                                           const Image& reference_se, const std::vector<uint8_t>* excluded) {
     check_size(render, reference, "the reference");
     check_size(render, render_se, "its standard-error image");
     LinearCheck out;
@@ -46,6 +46,7 @@ LinearCheck check_against_linear_reference(const Image& render, const Image& ren
     for (int c = 0; c < 3; ++c) {
         double diff = 0, var = 0, ref = 0;
         for (size_t i = 0; i < render.pixel_count(); ++i) {
+            if (excluded && i < excluded->size() && (*excluded)[i]) continue;
             diff += double(render[i][c]) - reference[i][c];
             ref += reference[i][c];
             var += double(render_se[i][c]) * render_se[i][c];
@@ -84,13 +85,15 @@ LoadedReference load_reference(const ReferenceFile& reference) {
     return r;
 }
 
-SceneVerdict judge_render(const Image& mean, const Image& std_error, const LoadedReference& reference) {
+SceneVerdict judge_render(const Image& mean, const Image& std_error, const LoadedReference& reference,
+                          const std::vector<uint8_t>* excluded) {
     try {
         if (reference.kind == ReferenceKind::Course8bit) {
-            const BlockComparison cmp = compare_with_course_reference(mean, reference.course, std_error);
+            const BlockComparison cmp = compare_with_course_reference(mean, reference.course, std_error, kCourseSaturatedMargin,
+                                                                      kCourseBlock, excluded);
             return {cmp.passes_allowing_for_noise() ? Verdict::Ok : Verdict::Fail, cmp.describe()};
         }
-        const LinearCheck cmp = check_against_linear_reference(mean, std_error, reference.linear, reference.linear_se);
+        const LinearCheck cmp = check_against_linear_reference(mean, std_error, reference.linear, reference.linear_se, excluded);
         return {cmp.passes() ? Verdict::Ok : Verdict::Fail, cmp.describe()};
     } catch (const std::exception& e) {  // size mismatch
         return {Verdict::Error, e.what()};

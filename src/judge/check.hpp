@@ -16,7 +16,9 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include "image/image.hpp"
 #include "judge/reference_set.hpp"
@@ -37,8 +39,9 @@ struct LinearCheck {
 constexpr double kCheckFalseAlarmRate = 1e-3;
 
 // `reference_se` may be empty (an exact reference). Throws ImageSizeMismatch when sizes differ.
+// Pixels marked in `excluded` (if given) are left out.
 LinearCheck check_against_linear_reference(const Image& render, const Image& render_se, const Image& reference,
-                                           const Image& reference_se = {});
+                                           const Image& reference_se = {}, const std::vector<uint8_t>* excluded = nullptr);
 
 enum class Verdict { Ok, Fail, Missing, BlackByDesign, Error };
 const char* verdict_name(Verdict v);  // "OK", "FAIL", "MISSING", "BLACK-BY-DESIGN", "ERROR"
@@ -60,9 +63,11 @@ struct LoadedReference {
 // Throws ImageIoError naming the file that cannot be read.
 LoadedReference load_reference(const ReferenceFile& reference);
 
-// Judges the render (mean and per-pixel standard errors) against the reference. Size
-// mismatches (and, in the second form, unreadable files) give Verdict::Error with the reason.
-SceneVerdict judge_render(const Image& mean, const Image& std_error, const LoadedReference& reference);
+// Judges the render (mean and per-pixel standard errors) against the reference, leaving out the
+// pixels marked in `excluded` (those an integrator leaves black by design). Size mismatches
+// (and, in the second form, unreadable files) give Verdict::Error with the reason.
+SceneVerdict judge_render(const Image& mean, const Image& std_error, const LoadedReference& reference,
+                          const std::vector<uint8_t>* excluded = nullptr);
 SceneVerdict judge_render(const Image& mean, const Image& std_error, const ReferenceFile& reference);
 
 }  // namespace pathlab

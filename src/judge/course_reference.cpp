@@ -57,12 +57,14 @@ std::vector<uint8_t> saturated_mask(const Image8& ref, int margin) {
 }  // namespace
 
 BlockComparison compare_with_course_reference(const Image& render, const Image8& ref, const Image& render_se,
-                                              int saturated_margin, int block) {
+                                              int saturated_margin, int block, const std::vector<uint8_t>* also_excluded) {
     if (render.width() != ref.width || render.height() != ref.height)
         throw std::invalid_argument(fmt::format("render is {}x{} but the reference is {}x{}", render.width(),
                                                 render.height(), ref.width, ref.height));
     const bool have_se = render_se.pixel_count() == render.pixel_count();
-    const std::vector<uint8_t> excluded = saturated_mask(ref, std::max(0, saturated_margin));
+    std::vector<uint8_t> excluded = saturated_mask(ref, std::max(0, saturated_margin));
+    if (also_excluded && also_excluded->size() == excluded.size())
+        for (size_t i = 0; i < excluded.size(); ++i) excluded[i] |= (*also_excluded)[i];
     BlockComparison out;
     double sum_abs = 0, sum_signed = 0;
     long terms = 0;

@@ -14,7 +14,9 @@
 // put blocks off by several levels.
 #pragma once
 
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include "image/image.hpp"
 
@@ -76,6 +78,7 @@ constexpr double kUnresolvedNegligibleFraction = 0.01;
 // `render_se` (optional, may be empty) holds per-pixel standard errors of the render; it
 // gives each block difference a standard error (propagated through the encoding's slope). Throws std::invalid_argument if sizes differ.
 BlockComparison compare_with_course_reference(const Image& render, const Image8& reference, const Image& render_se = {},
-                                              int saturated_margin = kCourseSaturatedMargin, int block = kCourseBlock);
+                                              int saturated_margin = kCourseSaturatedMargin, int block = kCourseBlock,
+                                              const std::vector<uint8_t>* excluded = nullptr);
 
 }  // namespace pathlab

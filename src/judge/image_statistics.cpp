@@ -31,9 +31,9 @@ long binomial_upper_quantile(long n, double p, double alpha) {
 
 std::string AgreementResult::describe() const {
     return fmt::format("{}: {} outliers (allowed {}) of {} pixel-channels, max |z| = {:.2f}, bias z = ({:.2f}, {:.2f}, "
-                       "{:.2f}) (limit {:.2f}), {} unresolved",
+                       "{:.2f}) (limit {:.2f}), {} unresolved{}",
                        agree ? "agree" : "DISAGREE", outliers, allowed_outliers, pixels, max_abs_z, bias_z[0], bias_z[1],
-                       bias_z[2], bias_limit, unresolved);
+                       bias_z[2], bias_limit, unresolved, excluded ? fmt::format(", {} pixels left out", excluded) : "");
 }
 
 AgreementResult test_agreement(const Image& a, const Image& se_a, const Image& b, const Image& se_b,
@@ -46,7 +46,10 @@ AgreementResult test_agreement(const Image& a, const Image& se_a, const Image& b
     const double channel_pixel_alpha = o.pixel_alpha;
     const double channel_family_alpha = o.family_alpha / 6;  // 3 channels x 2 checks
     const double z_pixel = normal_quantile_two_sided(channel_pixel_alpha);
-    const long n = long(a.pixel_count());
+    if (o.excluded && o.excluded->size() != a.pixel_count()) throw std::invalid_argument("test_agreement: the mask differs in size");
+    const auto left_out = [&](size_t i) { return o.excluded && (*o.excluded)[i] != 0; };
+    for (size_t i = 0; i < a.pixel_count(); ++i) r.excluded += left_out(i);
+    const long n = long(a.pixel_count()) - r.excluded;
     r.pixels = 3 * n;
     r.allowed_outliers = binomial_upper_quantile(n, channel_pixel_alpha, channel_family_alpha);
     r.bias_limit = normal_quantile_two_sided(channel_family_alpha);
@@ -57,6 +60,7 @@ AgreementResult test_agreement(const Image& a, const Image& se_a, const Image& b
         long outliers = 0;
         double sum_d = 0, sum_var = 0;
         for (size_t i = 0; i < a.pixel_count(); ++i) {
+            if (left_out(i)) continue;
             // Images are stored in float: differences at rounding level are no difference (a
             // zero-variance estimator, such as BRDF sampling in a white furnace, would otherwise
             // meet a standard error of 0 with a rounding error).
@@ -64,7 +68,12 @@ AgreementResult test_agreement(const Image& a, const Image& se_a, const Image& b
             if (std::abs(d) <= 1e-6 * std::max(std::abs(double(a[i][c])), std::abs(double(b[i][c])))) d = 0;
             const double sb = b_exact ? 0.0 : double(se_b[i][c]);
             const double se = std::sqrt(double(se_a[i][c]) * se_a[i][c] + sb * sb);
-            if (!b_exact && (se_a[i][c] == 0) != (sb == 0) && d != 0) {
+            // One image has no variance here. If its value is not 0, every one of its samples
+            // gave that value (an emitter seen directly): it is exact, and the z of the other
+            // image's error decides. If it is 0, it may simply have drawn no hit yet.
+            const bool a_flat = se_a[i][c] == 0, b_flat = !b_exact && sb == 0;
+            const bool flat_is_exact = (a_flat && a[i][c] != 0) || (b_flat && b[i][c] != 0);
+            if (!b_exact && a_flat != b_flat && d != 0 && !flat_is_exact) {
                 if (std::abs(d) <= o.negligible_fraction * mean_b) {
                     ++r.unresolved;
                     continue;

@@ -1,0 +1,114 @@
+#include "integrators/bidir/light_tracer.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <atomic>
+
+#include "integrators/common/shading.hpp"
+#include "integrators/integrators.hpp"
+
+namespace pathlab {
+namespace {
+
+void splat(SplatList& out, const PerspectiveCamera& camera, const Vec2f& raster, const Rgb& value, uint64_t& invalid) {
+    if (!is_finite(value)) {
+        ++invalid;
+        return;
+    }
+    if (!is_black(value)) out.add(uint32_t(camera.pixel_of(raster)), value);
+}
+
+}  // namespace
+
+void LightTracer::trace(const RenderContext& ctx, Sampler& sampler, SplatList& out, uint64_t& invalid) const {
+    const Scene& scene = ctx.scene;
+    const PerspectiveCamera& camera = ctx.camera;
+    const LightChoice choice = scene.choose_light(sampler.next1d());
+    const Vec2f u_pos = sampler.next2d(), u_dir = sampler.next2d();
+    if (choice.index < 0) return;
+    const Light& light = scene.lights()[size_t(choice.index)];
+    const auto es = sample_emission(light, u_pos, u_dir, scene.scene_sphere());
+    if (!es || is_black(es->Le) || !(es->pdfA > 0) || !(es->pdfW > 0)) return;
+    const uint32_t flags = light_flags(light);
+
+    // Paths of no bounce: the emitter seen by the camera.
+    if (flags & kLightSurface) {
+        if (const auto k = camera.connect(es->origin)) {
+            const float cos_light = dot(es->normal, k->wi);
+            if (cos_light > 0 && !scene.occluded(spawn_segment(es->origin, es->normal, camera.position(), Vec3f(0.0f))))
+                splat(out, camera, k->raster, es->Le * (cos_light * k->We / (choice.pmf * es->pdfA * k->pdfW)), invalid);
+        }
+    } else if ((flags & kLightInfinite) && !(flags & kLightDeltaDirection)) {
+        const Vec2f u = sampler.next2d();
+        if (const auto ls = sample_light(light, camera.position(), u)) {
+            const auto raster = camera.raster_of(ls->wi);
+            if (raster && ls->pdfW > 0 && !scene.occluded(Ray{camera.position(), ls->wi, kInf})) {
+                const float cos_lens = dot(ls->wi, camera.forward());
+                splat(out, camera, *raster, ls->Le * (camera.We(ls->wi) * cos_lens / (choice.pmf * ls->pdfW)), invalid);
+            }
+        }
+    }
+
+    // The emitted power this path carries, and its scattering throughput (for roulette).
+    const float emission_pdf = faults_.drop_emission_pdf ? 1.0f : es->pdfA * es->pdfW;
+    const Rgb power = es->Le * (es->cos / (choice.pmf * emission_pdf));
+    Rgb beta(1.0f);
+    Ray ray = (flags & kLightSurface) ? spawn_ray(es->origin, es->normal, es->direction) : Ray{es->origin, es->direction, kInf};
+    for (int bounces = 1;; ++bounces) {
+        Intersection hit;
+        if (!scene.intersect(ray, hit)) return;
+        const ShadingPoint sp = make_shading_point(scene, hit, ray.d, TransportMode::Importance);
+        const Material& m = *sp.material;
+        if (m.is_black()) return;
+        // Connect this vertex to the camera: a path of `bounces` bounces.
+        if (!m.is_delta()) {
+            if (const auto k = camera.connect(sp.p)) {
+                const Vec3f wo = sp.frame.to_local(k->wi);
+                const Rgb f = m.eval(sp, sp.wi, wo);
+                const float camera_pdf = faults_.drop_camera_geometry ? 1.0f : k->pdfW;
+                if (!is_black(f) && !scene.occluded(spawn_segment(sp.p, sp.ng, camera.position(), Vec3f(0.0f))))
+                    splat(out, camera, k->raster, power * beta * f * (std::abs(wo.z) * k->We / camera_pdf), invalid);
+            }
+        }
+        if (!rules_.may_bounce(bounces)) return;
+        const auto s = m.sample(sp, sp.wi, sampler.next2d());
+        if (!s) return;
+        beta *= s->f * (std::abs(s->wo.z) / s->pdfW);
+        if (!rules_.survive_roulette(bounces, beta, sampler)) return;
+        ray = sp.spawn(s->wo);
+    }
+}
+
+PassCounters LightTracer::render_passes(const RenderContext& ctx, Film& film, uint64_t first, int count,
+                                        const PassProgress& progress) {
+    const size_t paths = ctx.pixel_count(), per_chunk = chunk_size(paths);
+    const int chunks = int((paths + per_chunk - 1) / per_chunk);
+    std::atomic<uint64_t> rays{0}, invalid{0};
+    for (int k = 0; k < count; ++k) {
+        const uint64_t pass = first + uint64_t(k);
+        pass_.begin(paths, chunks);
+        std::atomic<int> chunks_done{0};
+        tbb::parallel_for(tbb::blocked_range<int>(0, chunks, 1), [&](const tbb::blocked_range<int>& range) {
+            for (int c = range.begin(); c != range.end(); ++c) {
+                const uint64_t rays_before = Scene::rays_traced_by_this_thread();
+                uint64_t chunk_invalid = 0;
+                SplatList& out = pass_.chunk(c);
+                const size_t end = std::min(paths, size_t(c + 1) * per_chunk);
+                for (size_t j = size_t(c) * per_chunk; j < end; ++j) {
+                    Sampler sampler(ctx.seed, j, pass, ctx.sampler);
+                    trace(ctx, sampler, out, chunk_invalid);
+                }
+                rays += Scene::rays_traced_by_this_thread() - rays_before;
+                invalid += chunk_invalid;
+                if (progress) progress((double(k) + double(++chunks_done) / chunks) / count);
+            }
+        });
+        pass_.finish(film);
+    }
+    return {rays.load(), invalid.load()};
+}
+
+std::unique_ptr<Integrator> make_light_tracer(const IntegratorOptions& o) { return std::make_unique<LightTracer>(o); }
+
+}  // namespace pathlab

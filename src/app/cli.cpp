@@ -9,6 +9,7 @@
 #include "job/usage_error.hpp"
 #include "integrators/integrator.hpp"
 #include "scene/builtin_scenes.hpp"
+#include "scenefile/plugin_reference.hpp"
 
 namespace pathlab {
 namespace {
@@ -47,6 +48,8 @@ int run_cli(int argc, const char* const* argv) {
     add_render_options(app, render_opt);
     CLI::App* scenes_cmd = app.add_subcommand("scenes", "List the built-in scenes, one per line");
     CLI::App* algorithms_cmd = app.add_subcommand("algorithms", "List the estimators (--algorithm values)");
+    CLI::App* plugins_cmd =
+        app.add_subcommand("plugins", "The scene-file elements and their parameters (Markdown tables, as in README)");
     CompareOptions compare_opt;
     CLI::App* compare_cmd = add_compare_command(app, compare_opt);
     ReferenceOptions reference_opt;
@@ -84,6 +87,10 @@ int run_cli(int argc, const char* const* argv) {
         }
         if (*algorithms_cmd) {
             print_algorithms();
+            return 0;
+        }
+        if (*plugins_cmd) {
+            fmt::print("{}", plugin_reference_markdown());
             return 0;
         }
         if (*compare_cmd) return run_compare_command(compare_opt);

@@ -71,7 +71,8 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
     app.add_option("--stats", o.stats_path, "Write render statistics as JSON (placeholders as for -o)");
     app.add_option_function<int>("--max-depth", [&o](const int& v) { o.max_depth = v, o.max_depth_given = true; },
                                  "Longest path in bounces (-1: unlimited; default: the scene file's, else -1)");
-    app.add_option("--rr-depth", o.rr_depth, "Bounces before Russian roulette starts")->capture_default_str();
+    app.add_option_function<int>("--rr-depth", [&o](const int& v) { o.rr_depth = v, o.rr_depth_given = true; },
+                                 "Bounces before Russian roulette starts (default: the scene file's, else 3)");
     app.add_flag("-q,--quiet", o.quiet, "No progress line and no summary");
 }
 
@@ -91,8 +92,10 @@ int run_render_command(const RenderCommandOptions& o) {
         request.spp = uint64_t(o.spp);
     }
     if (o.max_depth_given) request.max_depth = o.max_depth;
-    if (o.rr_depth < 0) throw UsageError("--rr-depth must be zero or positive");
-    request.rr_depth = o.rr_depth;
+    if (o.rr_depth_given) {
+        if (o.rr_depth < 0) throw UsageError("--rr-depth must be zero or positive");
+        request.rr_depth = o.rr_depth;
+    }
     parse_resolution_option(o.resolution, request.width, request.height);
     request.time_limit = o.time_limit;
     request.seed = o.seed;

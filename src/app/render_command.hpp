@@ -26,6 +26,7 @@ struct RenderCommandOptions {
     bool max_depth_given = false;
     std::vector<std::string> defines;  // -D name=value, for scene files
     int rr_depth = 3;
+    bool rr_depth_given = false;
     bool quiet = false;
 };
 

@@ -16,6 +16,7 @@
 
 #include "bsdfs/bsdf_sample.hpp"
 #include "bsdfs/fresnel.hpp"
+#include "bsdfs/ior.hpp"
 
 namespace pathlab {
 
@@ -33,5 +34,16 @@ struct ConductorMaterial {
         return BsdfSample{wo, fresnel(wi.z) / wo.z, 1.0f, true, kLobeSpecular | kLobeReflection};
     }
 };
+
+inline const PluginInfo& conductor_plugin() {
+    static const PluginInfo info{"bsdf", "conductor", "a smooth metal: a perfect specular reflector with the conductor's Fresnel reflectance",
+                                 {kConductorMaterialParam, kConductorEtaParam, kConductorKParam,
+                                  {"specular_reflectance", ParamType::Rgb, "1", "scales the reflectance (not physical)", "specularReflectance"}}};
+    return info;
+}
+inline ConductorMaterial read_conductor(Properties& p) {
+    const ComplexIor ior = read_conductor_ior(p);
+    return ConductorMaterial{ior.eta, ior.k, p.get_rgb("specular_reflectance")};
+}
 
 }  // namespace pathlab

@@ -18,6 +18,7 @@
 
 #include "bsdfs/bsdf_sample.hpp"
 #include "bsdfs/fresnel.hpp"
+#include "bsdfs/ior.hpp"
 
 namespace pathlab {
 
@@ -44,5 +45,20 @@ struct DielectricMaterial {
         return BsdfSample{wo, Rgb((1 - F) * scale / cos_t), 1 - F, true, kLobeSpecular | kLobeTransmission};
     }
 };
+
+inline const ParamInfo kIntIorParam{"int_ior", ParamType::FloatOrString, "bk7",
+                                    "interior index of refraction, a number or a name: " + kIorNames, "intIOR"};
+inline const ParamInfo kExtIorParam{"ext_ior", ParamType::FloatOrString, "air", "exterior index of refraction (the normal's side)",
+                                    "extIOR"};
+
+inline const PluginInfo& dielectric_plugin() {
+    static const PluginInfo info{"bsdf", "dielectric", "a smooth interface between two dielectrics (glass, water): Fresnel reflection and refraction",
+                                 {kIntIorParam, kExtIorParam}};
+    return info;
+}
+inline DielectricMaterial read_dielectric(Properties& p) {
+    const float int_ior = read_ior(p, "int_ior"), ext_ior = read_ior(p, "ext_ior");
+    return DielectricMaterial{int_ior, ext_ior};
+}
 
 }  // namespace pathlab

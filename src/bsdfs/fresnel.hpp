@@ -5,8 +5,6 @@
 #pragma once
 
 #include <cmath>
-#include <optional>
-#include <string>
 
 #include "core/vec.hpp"
 
@@ -65,25 +63,5 @@ inline float fresnel_diffuse_reflectance(float eta, int steps = 4096) {
     }
     return float(sum / steps);
 }
-
-// Complex refractive index (eta, k) of a conductor, as RGB.
-struct ComplexIor {
-    Rgb eta, k;
-};
-
-// A few metals by their chemical symbols. The values are RGB averages of measured spectral
-// data (Palik, "Handbook of Optical Constants of Solids", as shipped with pbrt and Mitsuba
-// 0.6), as tabulated by Benedikt Bitterli's Tungsten renderer (src/core/bsdfs/ComplexIorData.hpp).
-// "none" is Mitsuba's perfect reflector: eta = 0, k = 1 gives F = 1 at every angle.
-inline std::optional<ComplexIor> named_conductor(const std::string& name) {
-    if (name == "none") return ComplexIor{Rgb(0.0f), Rgb(1.0f)};
-    if (name == "Au") return ComplexIor{{0.1431190f, 0.3749570f, 1.4424786f}, {3.9831604f, 2.3857207f, 1.6032153f}};
-    if (name == "Ag") return ComplexIor{{0.1552646f, 0.1167233f, 0.1383807f}, {4.8283433f, 3.1222459f, 2.1469504f}};
-    if (name == "Cu") return ComplexIor{{0.2004377f, 0.9240334f, 1.1022120f}, {3.9129485f, 2.4528477f, 2.1421880f}};
-    if (name == "Al") return ComplexIor{{1.6574600f, 0.8803690f, 0.5212287f}, {9.2238692f, 6.2695232f, 4.8370012f}};
-    if (name == "Cr") return ComplexIor{{4.3696829f, 2.9167025f, 1.6547005f}, {5.2064338f, 4.2313645f, 3.7549468f}};
-    return std::nullopt;
-}
-inline const char* kNamedConductors = "none, Au, Ag, Cu, Al, Cr";
 
 }  // namespace pathlab

@@ -18,6 +18,7 @@
 
 #include "bsdfs/bsdf_context.hpp"
 #include "bsdfs/conductor.hpp"
+#include "bsdfs/ior.hpp"
 #include "bsdfs/dielectric.hpp"
 #include "bsdfs/phong.hpp"
 #include "bsdfs/plastic.hpp"

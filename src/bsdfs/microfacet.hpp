@@ -27,7 +27,11 @@
 #include <algorithm>
 #include <cmath>
 #include <utility>
+#include <vector>
 
+#include <fmt/format.h>
+
+#include "core/properties.hpp"
 #include "core/vec.hpp"
 
 namespace pathlab {
@@ -35,7 +39,9 @@ namespace pathlab {
 enum class MicrofacetType : unsigned char { Beckmann, GGX };
 
 struct MicrofacetDistribution {
-    MicrofacetType type = MicrofacetType::GGX;
+    // The scene-file defaults are those of the plugins' parameters (microfacet_params below);
+    // a test checks that these agree with them.
+    MicrofacetType type = MicrofacetType::Beckmann;
     float alpha_u = 0.1f, alpha_v = 0.1f;
 
     // Roughness below this is clamped: D would overflow float.
@@ -145,5 +151,45 @@ private:
         return normalize(Vec3f(float(-sx), float(-sy), 1.0f));
     }
 };
+
+// The parameters of a rough BSDF's microfacet distribution (isotropic ones have no alpha_u,
+// alpha_v), and how they are read.
+inline std::vector<ParamInfo> microfacet_params(bool anisotropic) {
+    std::vector<ParamInfo> p = {
+        {"distribution", ParamType::String, "beckmann", "microfacet distribution: beckmann or ggx"},
+        {"alpha", ParamType::Float, "0.1", "roughness (0.01 is nearly a mirror, 1 very rough)"},
+    };
+    if (anisotropic) {
+        p.push_back({"alpha_u", ParamType::Float, "",
+                     "roughness along the shading frame's tangent (with alpha_v, instead of alpha; without uv the tangent follows from the normal alone)",
+                     "alphaU"});
+        p.push_back({"alpha_v", ParamType::Float, "", "roughness along the bitangent", "alphaV"});
+    }
+    return p;
+}
+inline const ParamInfo kSampleVisibleParam{"sample_visible", ParamType::Boolean, "true",
+                                           "accepted for compatibility; visible normals are always sampled", "sampleVisible"};
+
+inline MicrofacetDistribution read_microfacet(Properties& p, bool anisotropic) {
+    MicrofacetType type = MicrofacetType::Beckmann;
+    const std::string d = p.get_string("distribution");
+    if (d == "ggx") type = MicrofacetType::GGX;
+    else if (d != "beckmann") p.fail("distribution", fmt::format("unsupported distribution '{}'; supported: beckmann, ggx", d));
+    const bool uv = p.has("alpha_u") || p.has("alpha_v") || p.has("alphaU") || p.has("alphaV");
+    if (uv && !anisotropic) {
+        for (const char* n : {"alpha_u", "alpha_v", "alphaU", "alphaV"})
+            if (p.has(n)) p.fail(n, fmt::format("<bsdf type=\"{}\"> is isotropic: give alpha", p.plugin().type));
+    }
+    if (uv && p.has("alpha")) p.fail("alpha", "give either alpha or alpha_u and alpha_v, not both");
+    if (uv && !(p.has("alpha_u") && p.has("alpha_v"))) p.fail("anisotropic roughness needs both alpha_u and alpha_v");
+    const auto roughness = [&](const std::string& name) {
+        const float a = p.get_float(name);
+        if (p.has(name) && !(a >= 0 && a <= 10)) p.fail(name, fmt::format("{} must be between 0 and 10, got {}", name, a));
+        return a;
+    };
+    if (uv) return MicrofacetDistribution(type, roughness("alpha_u"), roughness("alpha_v"));
+    const float a = roughness("alpha");
+    return MicrofacetDistribution(type, a, a);
+}
 
 }  // namespace pathlab

@@ -17,6 +17,7 @@
 #include "core/sampling.hpp"
 #include "core/vec.hpp"
 #include "bsdfs/bsdf_sample.hpp"
+#include "core/properties.hpp"
 
 namespace pathlab {
 
@@ -81,5 +82,29 @@ struct PhongMaterial {
 
     static Vec3f mirror(const Vec3f& w) { return {-w.x, -w.y, w.z}; }
 };
+
+// The scene-file plugins: diffuse (Lambert, Mitsuba 3) and phong (Mitsuba 0.6, the course's
+// normalised Phong).
+inline const PluginInfo& diffuse_plugin() {
+    static const PluginInfo info{"bsdf", "diffuse", "Lambertian reflection rho / pi",
+                                 {{"reflectance", ParamType::Rgb, "0.5", "albedo rho"}}};
+    return info;
+}
+inline PhongMaterial read_diffuse(Properties& p) { return PhongMaterial{p.get_rgb("reflectance"), Rgb(0.0f), 1}; }
+
+inline const PluginInfo& phong_plugin() {
+    static const PluginInfo info{
+        "bsdf", "phong", "the course's normalised Phong: rho_d / pi + rho_s (n + 2) / (2 pi) cos^n of the angle to the mirror direction",
+        {{"diffuse_reflectance", ParamType::Rgb, "0.5", "rho_d", "diffuseReflectance"},
+         {"specular_reflectance", ParamType::Rgb, "0.2", "rho_s", "specularReflectance"},
+         {"exponent", ParamType::Float, "30", "n"}}};
+    return info;
+}
+inline PhongMaterial read_phong(Properties& p) {
+    const Rgb kd = p.get_rgb("diffuse_reflectance"), ks = p.get_rgb("specular_reflectance");
+    const float exponent = p.get_float("exponent");
+    if (!(exponent >= 0)) p.fail("the Phong exponent must not be negative");
+    return PhongMaterial{kd, ks, exponent};
+}
 
 }  // namespace pathlab

@@ -29,6 +29,7 @@
 #include "core/sampling.hpp"
 #include "bsdfs/bsdf_sample.hpp"
 #include "bsdfs/fresnel.hpp"
+#include "bsdfs/ior.hpp"
 
 namespace pathlab {
 
@@ -85,5 +86,26 @@ struct PlasticMaterial {
         return BsdfSample{wo, coat.diffuse(F, wo.z), p, false, kLobeDiffuse | kLobeReflection};
     }
 };
+
+inline std::vector<ParamInfo> coated_diffuse_params() {
+    return {{"diffuse_reflectance", ParamType::Rgb, "0.5", "rho, the albedo of the diffuse base", "diffuseReflectance"},
+            {"specular_reflectance", ParamType::Rgb, "1", "scales the coating's reflection", "specularReflectance"},
+            {"int_ior", ParamType::FloatOrString, "polypropylene", "index of the coating, a number or a name", "intIOR"},
+            {"ext_ior", ParamType::FloatOrString, "air", "index of the outside", "extIOR"},
+            {"nonlinear", ParamType::Boolean, "false",
+             "the base's internal reflections also tint and darken its colour (rho / (1 - rho Fdr) instead of rho / (1 - Fdr))"}};
+}
+inline CoatedDiffuse read_coated_diffuse(Properties& p) {
+    const Rgb kd = p.get_rgb("diffuse_reflectance"), ks = p.get_rgb("specular_reflectance");
+    const float int_ior = read_ior(p, "int_ior"), ext_ior = read_ior(p, "ext_ior");
+    if (int_ior == ext_ior) p.fail("int_ior and ext_ior are equal: the coating would be invisible");
+    return CoatedDiffuse(kd, ks, int_ior, ext_ior, p.get_bool("nonlinear"));
+}
+
+inline const PluginInfo& plastic_plugin() {
+    static const PluginInfo info{"bsdf", "plastic", "a diffuse base under a smooth dielectric coating", coated_diffuse_params()};
+    return info;
+}
+inline PlasticMaterial read_plastic(Properties& p) { return PlasticMaterial{read_coated_diffuse(p)}; }
 
 }  // namespace pathlab

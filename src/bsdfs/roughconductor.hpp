@@ -23,6 +23,7 @@
 #include "bsdfs/bsdf_sample.hpp"
 #include "bsdfs/fresnel.hpp"
 #include "bsdfs/microfacet.hpp"
+#include "bsdfs/ior.hpp"
 
 namespace pathlab {
 
@@ -65,5 +66,23 @@ struct RoughConductorMaterial {
         return BsdfSample{wo, f, p, false, kLobeGlossy | kLobeReflection};
     }
 };
+
+inline const PluginInfo& roughconductor_plugin() {
+    static const PluginInfo info = [] {
+        PluginInfo i{"bsdf", "roughconductor", "a rough metal: Cook-Torrance / Walter et al. microfacet reflection", microfacet_params(true)};
+        i.params.insert(i.params.end(), {kConductorMaterialParam, kConductorEtaParam, kConductorKParam,
+                                         {"specular_reflectance", ParamType::Rgb, "1", "scales the reflectance (not physical)",
+                                          "specularReflectance"},
+                                         kSampleVisibleParam});
+        return i;
+    }();
+    return info;
+}
+inline RoughConductorMaterial read_roughconductor(Properties& p) {
+    const MicrofacetDistribution d = read_microfacet(p, /*anisotropic=*/true);
+    const ComplexIor ior = read_conductor_ior(p);
+    p.get_bool("sample_visible");
+    return RoughConductorMaterial{d, ior.eta, ior.k, p.get_rgb("specular_reflectance")};
+}
 
 }  // namespace pathlab

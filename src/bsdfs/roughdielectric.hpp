@@ -33,6 +33,7 @@
 #include "bsdfs/bsdf_sample.hpp"
 #include "bsdfs/fresnel.hpp"
 #include "bsdfs/microfacet.hpp"
+#include "bsdfs/dielectric.hpp"
 
 namespace pathlab {
 
@@ -123,5 +124,22 @@ struct RoughDielectricMaterial {
         return BsdfSample{wo, f, p, false, kLobeGlossy | (reflect_lobe ? kLobeReflection : kLobeTransmission)};
     }
 };
+
+inline const PluginInfo& roughdielectric_plugin() {
+    static const PluginInfo info = [] {
+        PluginInfo i{"bsdf", "roughdielectric", "a rough interface between two dielectrics (frosted glass): Walter et al. 2007",
+                     microfacet_params(true)};
+        i.params.insert(i.params.end(), {kIntIorParam, kExtIorParam, kSampleVisibleParam});
+        return i;
+    }();
+    return info;
+}
+inline RoughDielectricMaterial read_roughdielectric(Properties& p) {
+    const MicrofacetDistribution d = read_microfacet(p, /*anisotropic=*/true);
+    const float int_ior = read_ior(p, "int_ior"), ext_ior = read_ior(p, "ext_ior");
+    if (int_ior == ext_ior) p.fail("int_ior and ext_ior are equal: the interface would be invisible");
+    p.get_bool("sample_visible");
+    return RoughDielectricMaterial{d, int_ior, ext_ior};
+}
 
 }  // namespace pathlab

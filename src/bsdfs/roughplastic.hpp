@@ -139,4 +139,20 @@ private:
     }
 };
 
+inline const PluginInfo& roughplastic_plugin() {
+    static const PluginInfo info = [] {
+        PluginInfo i{"bsdf", "roughplastic", "a diffuse base under a rough dielectric coating", microfacet_params(false)};
+        for (const ParamInfo& c : coated_diffuse_params()) i.params.push_back(c);
+        i.params.push_back(kSampleVisibleParam);
+        return i;
+    }();
+    return info;
+}
+inline RoughPlasticMaterial read_roughplastic(Properties& p) {
+    const MicrofacetDistribution d = read_microfacet(p, /*anisotropic=*/false);
+    const CoatedDiffuse coat = read_coated_diffuse(p);
+    p.get_bool("sample_visible");
+    return RoughPlasticMaterial(d, coat);
+}
+
 }  // namespace pathlab

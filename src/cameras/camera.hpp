@@ -24,6 +24,7 @@
 
 #include "core/vec.hpp"
 #include "geometry/ray.hpp"
+#include "core/properties.hpp"
 
 namespace pathlab {
 
@@ -138,5 +139,16 @@ private:
     float width_, height_;
     float tan_x_ = 1, tan_y_ = 1;
 };
+
+// The scene-file sensor (Mitsuba 3's perspective; the reader turns to_world into the camera).
+inline const PluginInfo& perspective_plugin() {
+    static const PluginInfo info{
+        "sensor", "perspective", "a pinhole camera",
+        {{"fov", ParamType::Float, "39.3077", "field of view in degrees"},
+         {"fov_axis", ParamType::String, "x",
+          "the axis fov spans: x, y, smaller, larger, or pathlab's each (both axes span fov, as the course's camera)"},
+         {"to_world", ParamType::Transform, "", "placement (usually a lookat); Mitsuba's camera looks along +z, +y up, +x left"}}};
+    return info;
+}
 
 }  // namespace pathlab

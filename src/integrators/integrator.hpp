@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "cameras/camera.hpp"
+#include "core/properties.hpp"
 #include "render/film.hpp"
 #include "samplers/sampler.hpp"
 #include "scene/scene.hpp"
@@ -83,7 +84,11 @@ struct IntegratorInfo {
     // False when pixels whose first camera-side vertex is specular stay black (the light
     // tracer cannot connect through a Dirac lobe to the camera).
     bool sees_specular_from_camera = true;
+    // Its parameters in scene files (<integrator type=...>), Mitsuba's names and depth convention.
+    std::vector<ParamInfo> params;
     std::function<std::unique_ptr<Integrator>(const IntegratorOptions&)> make;
+
+    PluginInfo plugin() const;
 };
 
 const std::vector<IntegratorInfo>& integrators();

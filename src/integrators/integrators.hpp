@@ -1,19 +1,20 @@
-// Factories of the integrators, one per file under src/integrators/<family>/ (declared here for the registry).
+// The integrators, each declared (name, aliases, parameters, factory) next to its code under
+// src/integrators/<family>/ and listed in registry.cpp.
 #pragma once
 
 #include "integrators/integrator.hpp"
 
 namespace pathlab {
 
-std::unique_ptr<Integrator> make_eyelight(const IntegratorOptions&);
-std::unique_ptr<Integrator> make_direct_light(const IntegratorOptions&);
-std::unique_ptr<Integrator> make_direct_uniform(const IntegratorOptions&);
-std::unique_ptr<Integrator> make_direct_cosine(const IntegratorOptions&);
-std::unique_ptr<Integrator> make_direct_brdf(const IntegratorOptions&);
-std::unique_ptr<Integrator> make_direct_mis(const IntegratorOptions&);
-std::unique_ptr<Integrator> make_pt_naive(const IntegratorOptions&);
-std::unique_ptr<Integrator> make_pt_mis3(const IntegratorOptions&);
-std::unique_ptr<Integrator> make_pt_mis(const IntegratorOptions&);
-std::unique_ptr<Integrator> make_light_tracer(const IntegratorOptions&);
+const IntegratorInfo& eyelight_integrator();
+const IntegratorInfo& direct_light_integrator();
+const IntegratorInfo& direct_uniform_integrator();
+const IntegratorInfo& direct_cosine_integrator();
+const IntegratorInfo& direct_brdf_integrator();
+const IntegratorInfo& direct_mis_integrator();
+const IntegratorInfo& pt_naive_integrator();
+const IntegratorInfo& pt_mis3_integrator();
+const IntegratorInfo& pt_mis_integrator();
+const IntegratorInfo& light_tracer_integrator();
 
 }  // namespace pathlab

@@ -17,7 +17,7 @@ RenderJob::RenderJob(SceneChoice scene, const JobRequest& r) : choice_(std::move
     const SceneDescription& d = choice_.description;
     info_ = &integrator_or_usage_error(r.algorithm ? *r.algorithm : d.algorithm.value_or("pt-mis"));
     options_.max_depth = r.max_depth ? *r.max_depth : d.max_depth.value_or(-1);
-    options_.rr_depth = r.rr_depth;
+    options_.rr_depth = r.rr_depth ? *r.rr_depth : d.rr_depth.value_or(3);
     if (options_.max_depth < -1 || options_.max_depth == 0) throw UsageError("--max-depth must be positive, or -1 for unlimited");
     if (r.time_limit < 0 || !std::isfinite(r.time_limit)) throw UsageError("--time must be a positive number of seconds");
     if (r.spp && *r.spp == 0) throw UsageError("--spp must be a positive number of samples");

@@ -5,6 +5,7 @@
 //   spp        the request's, else (without a time budget) the scene file's sample_count,
 //              else the request's default_spp (64 for renders)
 //   max_depth  the request's, else the scene file's, else -1 (unlimited)
+//   rr_depth   the request's, else the scene file's, else 3
 #pragma once
 
 #include <memory>
@@ -22,7 +23,7 @@ struct JobRequest {
     std::optional<std::string> algorithm;
     std::optional<uint64_t> spp;
     std::optional<int> max_depth;
-    int rr_depth = 3;           // -1: no Russian roulette
+    std::optional<int> rr_depth;  // bounces before Russian roulette (-1: none); default: the scene file's, else 3
     int width = 0, height = 0;  // 0: the scene's resolution
     double time_limit = 0;      // seconds; 0: none
     uint64_t seed = 1234;

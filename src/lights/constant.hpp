@@ -15,6 +15,7 @@
 #include "core/frame.hpp"
 #include "core/sampling.hpp"
 #include "lights/light_sample.hpp"
+#include "core/properties.hpp"
 
 namespace pathlab {
 
@@ -48,5 +49,12 @@ struct EnvironmentLight {
     }
     float power(const SceneSphere& s) const { return kPi * s.radius * s.radius * kPi * mean(radiance); }
 };
+
+inline const PluginInfo& constant_plugin() {
+    static const PluginInfo info{"emitter", "constant", "a constant environment: the same radiance from every direction",
+                                 {{"radiance", ParamType::Rgb, "1", "radiance L"}}};
+    return info;
+}
+inline EnvironmentLight read_constant_light(Properties& p) { return EnvironmentLight{p.get_rgb("radiance")}; }
 
 }  // namespace pathlab

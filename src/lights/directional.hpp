@@ -12,6 +12,7 @@
 
 #include "lights/constant.hpp"
 #include "lights/light_sample.hpp"
+#include "core/properties.hpp"
 
 namespace pathlab {
 
@@ -33,5 +34,19 @@ struct DirectionalLight {
     }
     float power(const SceneSphere& s) const { return kPi * s.radius * s.radius * mean(irradiance); }
 };
+
+inline const PluginInfo& directional_plugin() {
+    static const PluginInfo info{"emitter", "directional", "a light infinitely far away, along one direction (the sun)",
+                                 {{"direction", ParamType::Point, "0, 0, 1", "the direction the light travels in (turned by to_world)"},
+                                  {"irradiance", ParamType::Rgb, "1", "irradiance E on a surface facing the light, W/m^2"},
+                                  {"to_world", ParamType::Transform, "", "orientation"}}};
+    return info;
+}
+inline DirectionalLight read_directional_light(Properties& p) {
+    Vec3d dir(p.get_point("direction"));
+    if (const auto t = p.get_transform("to_world")) dir = t->vector(dir);
+    if (!(length(dir) > 0)) p.fail("a directional emitter needs a non-zero direction");
+    return DirectionalLight{Vec3f(normalize(dir)), p.get_rgb("irradiance")};
+}
 
 }  // namespace pathlab

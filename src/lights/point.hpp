@@ -11,6 +11,7 @@
 
 #include "core/sampling.hpp"
 #include "lights/light_sample.hpp"
+#include "core/properties.hpp"
 
 namespace pathlab {
 
@@ -36,5 +37,18 @@ struct PointLight {
     }
     float power(const SceneSphere&) const { return 4 * kPi * mean(intensity); }
 };
+
+inline const PluginInfo& point_plugin() {
+    static const PluginInfo info{"emitter", "point", "an isotropic point light",
+                                 {{"position", ParamType::Point, "0, 0, 0", "where it is (moved by to_world)"},
+                                  {"intensity", ParamType::Rgb, "1", "radiant intensity I, W/sr (power 4 pi I)"},
+                                  {"to_world", ParamType::Transform, "", "placement"}}};
+    return info;
+}
+inline PointLight read_point_light(Properties& p) {
+    Vec3f position = p.get_point("position");
+    if (const auto t = p.get_transform("to_world")) position = Vec3f(t->point(Vec3d(position)));
+    return PointLight{position, p.get_rgb("intensity")};
+}
 
 }  // namespace pathlab

@@ -13,6 +13,7 @@
 
 #include "core/vec.hpp"
 #include "image/image.hpp"
+#include "core/properties.hpp"
 
 namespace pathlab {
 
@@ -52,5 +53,12 @@ private:
     std::vector<Vec3d> sum_, sumsq_;
     std::vector<uint64_t> count_;
 };
+
+// The scene-file film (Mitsuba 3's hdrfilm): pathlab's film is a box filter, one pixel wide.
+inline const PluginInfo& hdrfilm_plugin() {
+    static const PluginInfo info{"film", "hdrfilm", "the image: its size (the outputs' formats come from -o)",
+                                 {{"width", ParamType::Integer, "768", "pixels"}, {"height", ParamType::Integer, "576", "pixels"}}};
+    return info;
+}
 
 }  // namespace pathlab

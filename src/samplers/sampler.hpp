@@ -8,6 +8,7 @@
 #include "core/rng.hpp"
 #include "core/vec.hpp"
 #include "samplers/sobol.hpp"
+#include "core/properties.hpp"
 
 namespace pathlab {
 
@@ -59,5 +60,13 @@ private:
     uint32_t dimension_ = 0;
     uint64_t pixel_hash_;
 };
+
+// The scene-file sampler (Mitsuba 3's independent): its sample count is the render's default spp;
+// pathlab's sampler is chosen with --sampler.
+inline const PluginInfo& independent_plugin() {
+    static const PluginInfo info{"sampler", "independent", "the number of samples per pixel",
+                                 {{"sample_count", ParamType::Integer, "4", "samples per pixel (--spp wins)"}}};
+    return info;
+}
 
 }  // namespace pathlab

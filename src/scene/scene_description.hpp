@@ -9,12 +9,9 @@
 #include "bsdfs/material.hpp"
 #include "cameras/camera.hpp"
 #include "geometry/shape.hpp"
-#include "lights/light.hpp"
+#include "lights/registry.hpp"
 
 namespace pathlab {
-
-// Lights that are not attached to geometry (area emitters come from MeshDesc::emission).
-using FreeLight = std::variant<PointLight, EnvironmentLight, DirectionalLight>;
 
 struct SceneDescription {
     std::string name;
@@ -26,7 +23,7 @@ struct SceneDescription {
     std::vector<FreeLight> lights;
     // Render settings a scene file may suggest; command-line options override them.
     std::optional<std::string> algorithm;
-    std::optional<int> spp, max_depth;
+    std::optional<int> spp, max_depth, rr_depth;  // depths in pathlab's bounces
 };
 
 }  // namespace pathlab

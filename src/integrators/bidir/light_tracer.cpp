@@ -109,6 +109,12 @@ PassCounters LightTracer::render_passes(const RenderContext& ctx, Film& film, ui
     return {rays.load(), invalid.load()};
 }
 
-std::unique_ptr<Integrator> make_light_tracer(const IntegratorOptions& o) { return std::make_unique<LightTracer>(o); }
+const IntegratorInfo& light_tracer_integrator() {
+    static const IntegratorInfo info{"lt", {"ptracer"}, "light tracing: paths from the lights, every vertex connected to the camera",
+                                     false, false, path_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
+                                         return std::make_unique<LightTracer>(o);
+                                     }};
+    return info;
+}
 
 }  // namespace pathlab

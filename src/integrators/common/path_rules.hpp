@@ -17,6 +17,15 @@ namespace pathlab {
 
 inline constexpr int kMaxBounces = 1024;
 
+// The scene-file parameters of every path tracer. Mitsuba counts path segments, pathlab
+// bounces: max_depth 2 is direct illumination, one bounce (the reader converts).
+inline std::vector<ParamInfo> path_params() {
+    return {{"max_depth", ParamType::Integer, "-1",
+             "longest path in Mitsuba's convention: -1 unlimited, 2 direct light only (pathlab's bounces: max_depth - 1)"},
+            {"rr_depth", ParamType::Integer, "4",
+             "path depth at which Russian roulette starts, Mitsuba's convention (pathlab's bounces: rr_depth - 1; --rr-depth wins)"}};
+}
+
 class PathRules {
 public:
     explicit PathRules(const IntegratorOptions& o)

@@ -22,6 +22,12 @@ public:
 
 }  // namespace
 
-std::unique_ptr<Integrator> make_direct_light(const IntegratorOptions&) { return std::make_unique<DirectLight>(); }
+const IntegratorInfo& direct_light_integrator() {
+    static const IntegratorInfo info{"direct-light", {"1"}, "direct illumination by light sampling (one light chosen by power)",
+                                     false, true, {}, [](const IntegratorOptions&) -> std::unique_ptr<Integrator> {
+                                         return std::make_unique<DirectLight>();
+                                     }};
+    return info;
+}
 
 }  // namespace pathlab

@@ -31,6 +31,12 @@ public:
 
 }  // namespace
 
-std::unique_ptr<Integrator> make_direct_mis(const IntegratorOptions&) { return std::make_unique<DirectMis>(); }
+const IntegratorInfo& direct_mis_integrator() {
+    static const IntegratorInfo info{"direct-mis", {"3", "direct"}, "light + BRDF sampling combined by MIS (balance heuristic)",
+                                     false, true, {}, [](const IntegratorOptions&) -> std::unique_ptr<Integrator> {
+                                         return std::make_unique<DirectMis>();
+                                     }};
+    return info;
+}
 
 }  // namespace pathlab

@@ -57,14 +57,26 @@ private:
 
 }  // namespace
 
-std::unique_ptr<Integrator> make_direct_uniform(const IntegratorOptions&) {
-    return std::make_unique<DirectBySampling>(Strategy::UniformHemisphere);
+const IntegratorInfo& direct_uniform_integrator() {
+    static const IntegratorInfo info{"direct-uniform", {"2a"}, "direct illumination by uniform hemisphere sampling", true, true, {},
+                                     [](const IntegratorOptions&) -> std::unique_ptr<Integrator> {
+                                         return std::make_unique<DirectBySampling>(Strategy::UniformHemisphere);
+                                     }};
+    return info;
 }
-std::unique_ptr<Integrator> make_direct_cosine(const IntegratorOptions&) {
-    return std::make_unique<DirectBySampling>(Strategy::CosineHemisphere);
+const IntegratorInfo& direct_cosine_integrator() {
+    static const IntegratorInfo info{"direct-cosine", {"2b"}, "direct illumination by cosine-weighted hemisphere sampling", true,
+                                     true, {}, [](const IntegratorOptions&) -> std::unique_ptr<Integrator> {
+                                         return std::make_unique<DirectBySampling>(Strategy::CosineHemisphere);
+                                     }};
+    return info;
 }
-std::unique_ptr<Integrator> make_direct_brdf(const IntegratorOptions&) {
-    return std::make_unique<DirectBySampling>(Strategy::Brdf);
+const IntegratorInfo& direct_brdf_integrator() {
+    static const IntegratorInfo info{"direct-brdf", {"2c"}, "direct illumination by BRDF importance sampling", true, true, {},
+                                     [](const IntegratorOptions&) -> std::unique_ptr<Integrator> {
+                                         return std::make_unique<DirectBySampling>(Strategy::Brdf);
+                                     }};
+    return info;
 }
 
 }  // namespace pathlab

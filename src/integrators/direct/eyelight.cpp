@@ -16,6 +16,10 @@ public:
 
 }  // namespace
 
-std::unique_ptr<Integrator> make_eyelight(const IntegratorOptions&) { return std::make_unique<EyeLight>(); }
+const IntegratorInfo& eyelight_integrator() {
+    static const IntegratorInfo info{"eyelight", {}, "debug view: |cos| between camera ray and surface normal", false, true, {},
+                                     [](const IntegratorOptions&) -> std::unique_ptr<Integrator> { return std::make_unique<EyeLight>(); }};
+    return info;
+}
 
 }  // namespace pathlab

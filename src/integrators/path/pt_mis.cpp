@@ -62,7 +62,19 @@ private:
 
 }  // namespace
 
-std::unique_ptr<Integrator> make_pt_mis3(const IntegratorOptions& o) { return std::make_unique<PtMis>(o, true); }
-std::unique_ptr<Integrator> make_pt_mis(const IntegratorOptions& o) { return std::make_unique<PtMis>(o, false); }
+const IntegratorInfo& pt_mis3_integrator() {
+    static const IntegratorInfo info{"pt-mis3", {"4b"}, "path tracing, MIS direct lighting at every bounce + a third continuation ray",
+                                     false, true, path_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
+                                         return std::make_unique<PtMis>(o, true);
+                                     }};
+    return info;
+}
+const IntegratorInfo& pt_mis_integrator() {
+    static const IntegratorInfo info{"pt-mis", {"4c", "path"}, "path tracing, MIS direct lighting whose BRDF ray continues the path",
+                                     false, true, path_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
+                                         return std::make_unique<PtMis>(o, false);
+                                     }};
+    return info;
+}
 
 }  // namespace pathlab

@@ -37,6 +37,10 @@ private:
 
 }  // namespace
 
-std::unique_ptr<Integrator> make_pt_naive(const IntegratorOptions& o) { return std::make_unique<PtNaive>(o); }
+const IntegratorInfo& pt_naive_integrator() {
+    static const IntegratorInfo info{"pt-naive", {"4a"}, "path tracing by BRDF sampling, Russian roulette", true, true, path_params(),
+                                     [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> { return std::make_unique<PtNaive>(o); }};
+    return info;
+}
 
 }  // namespace pathlab

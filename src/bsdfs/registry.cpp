@@ -1,0 +1,51 @@
+#include "bsdfs/registry.hpp"
+
+#include <fmt/format.h>
+
+namespace pathlab {
+namespace {
+
+// A model read from its parameters, as a one-sided material (Mitsuba's convention: black from
+// behind unless wrapped in twosided).
+template <typename Model, Model (*read)(Properties&)>
+Material one_sided(Properties& p) {
+    return Material{read(p), false};
+}
+
+}  // namespace
+
+const PluginInfo& twosided_plugin() {
+    static const PluginInfo info{"bsdf", "twosided",
+                                 "shades the back of a surface like its front; wraps exactly one nested BSDF (not a dielectric)",
+                                 {}};
+    return info;
+}
+
+const std::vector<BsdfPlugin>& bsdf_plugins() {
+    static const std::vector<BsdfPlugin> table = {
+        {diffuse_plugin, one_sided<PhongMaterial, read_diffuse>},
+        {phong_plugin, one_sided<PhongMaterial, read_phong>},
+        {conductor_plugin, one_sided<ConductorMaterial, read_conductor>},
+        {roughconductor_plugin, one_sided<RoughConductorMaterial, read_roughconductor>},
+        {dielectric_plugin, one_sided<DielectricMaterial, read_dielectric>},
+        {roughdielectric_plugin, one_sided<RoughDielectricMaterial, read_roughdielectric>},
+        {plastic_plugin, one_sided<PlasticMaterial, read_plastic>},
+        {roughplastic_plugin, one_sided<RoughPlasticMaterial, read_roughplastic>},
+        {twosided_plugin, nullptr},
+    };
+    return table;
+}
+
+const BsdfPlugin* find_bsdf_plugin(const std::string& type) {
+    for (const BsdfPlugin& b : bsdf_plugins())
+        if (b.info().type == type) return &b;
+    return nullptr;
+}
+
+std::string bsdf_type_names() {
+    std::vector<std::string> names;
+    for (const BsdfPlugin& b : bsdf_plugins()) names.push_back(b.info().type);
+    return fmt::format("{}", fmt::join(names, ", "));
+}
+
+}  // namespace pathlab

@@ -1,0 +1,31 @@
+#include "lights/registry.hpp"
+
+#include "lights/area.hpp"
+
+namespace pathlab {
+namespace {
+
+template <typename L, L (*read)(Properties&)>
+FreeLight free_light(Properties& p) {
+    return read(p);
+}
+
+}  // namespace
+
+const std::vector<EmitterPlugin>& emitter_plugins() {
+    static const std::vector<EmitterPlugin> table = {
+        {point_plugin, free_light<PointLight, read_point_light>},
+        {constant_plugin, free_light<EnvironmentLight, read_constant_light>},
+        {directional_plugin, free_light<DirectionalLight, read_directional_light>},
+        {area_plugin, nullptr},
+    };
+    return table;
+}
+
+const EmitterPlugin* find_emitter_plugin(const std::string& type) {
+    for (const EmitterPlugin& e : emitter_plugins())
+        if (e.info().type == type) return &e;
+    return nullptr;
+}
+
+}  // namespace pathlab

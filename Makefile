@@ -21,10 +21,12 @@ render: build
 test: build
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 
-# The performance suite (about 5 minutes on a quiet 2-core machine): throughput, scaling, Embree's bound, scene growth,
-# memory, allocations and pt-mis efficiency; Markdown on stdout, JSON in out/bench/.
+# The performance suite (about 7 minutes on a quiet 2-core machine): throughput, scaling, Embree's bound, scene growth,
+# memory, allocations and pt-mis efficiency; Markdown on stdout, JSON in out/bench/; then light tracing (lt paths/s
+# next to pt-mis, splat accumulation).
 bench: build
 	$(BUILD)/bench/pathlab_bench perf --json out/bench/performance.json
+	$(BUILD)/bench/pathlab_bench lt
 
 # Equal-spp and equal-time RMSE of the course's estimators on the 8 scenes (about 10 minutes).
 bench-estimators: build

@@ -2,21 +2,23 @@
 
 #include <sys/resource.h>
 
-#include "integrators/integrator.hpp"
+#include "job/render_job.hpp"
 
 namespace pathlab::bench {
 
 RenderResult run(const Scene& scene, const std::string& algorithm, int size, int spp, double seconds, uint64_t seed,
                  std::function<void(const Film&, const RenderStats&)> after_pass, SamplerKind sampler) {
-    const auto estimator = find_integrator(algorithm)->make({});
-    RenderSettings rs;
-    rs.width = rs.height = size;
-    rs.spp = spp;
-    rs.time_limit = seconds;
-    rs.seed = seed;
-    rs.after_pass = std::move(after_pass);
-    rs.sampler = sampler;
-    return render(scene, *estimator, rs);
+    JobRequest r;
+    r.algorithm = algorithm;
+    r.width = r.height = size;
+    if (spp > 0) r.spp = uint64_t(spp);
+    r.time_limit = seconds;
+    r.seed = seed;
+    r.sampler = sampler;
+    // The caller's scene, shared without ownership: its BVH is built once for many runs.
+    RenderJob job(scene_choice_of(scene.description()), r, std::shared_ptr<const Scene>(std::shared_ptr<const Scene>(), &scene));
+    job.settings.after_pass = std::move(after_pass);
+    return job.run();
 }
 
 Reference make_reference(const Scene& scene, const std::string& algorithm, int size, int spp) {

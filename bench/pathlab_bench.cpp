@@ -4,9 +4,11 @@
 //                          pt-mis efficiency over time (`make bench`; also writes JSON)
 //   pathlab_bench direct   RMSE of 1, 2a, 2b, 2c, 3 at equal spp and equal time
 //   pathlab_bench pt       the same for the path tracers 4a, 4b, 4c
+//   pathlab_bench lt       light tracing: paths/s next to pt-mis, and splat accumulation
 #include <CLI/CLI.hpp>
 
 #include "estimator_efficiency.hpp"
+#include "light_tracing.hpp"
 #include "performance.hpp"
 
 int main(int argc, char** argv) {
@@ -41,7 +43,14 @@ int main(int argc, char** argv) {
         sub->add_option("--repeats", e.repeats, "Timed runs per cell (median reported)")->capture_default_str();
         sub->add_option("--scenes", e.scenes, "Comma-separated scene indices")->capture_default_str();
     }
+    LightTracingOptions l;
+    CLI::App* lt = app.add_subcommand("lt", "Light tracing: lt paths/s next to pt-mis, and splat accumulation");
+    lt->add_option("--size", l.size, "Image width and height for the throughput table")->capture_default_str();
+    lt->add_option("--seconds", l.seconds, "Seconds per timed render")->capture_default_str();
+    lt->add_option("--repeats", l.repeats, "Timed pairs per scene (median reported)")->capture_default_str();
+    lt->add_option("--scenes", l.scenes, "Scene indices")->delimiter(',')->capture_default_str();
     CLI11_PARSE(app, argc, argv);
+    if (*lt) light_tracing_suite(l);
     if (*perf) performance_suite(p);
     if (*tables[0]) efficiency_table(e, {"direct-light", "direct-uniform", "direct-cosine", "direct-brdf", "direct-mis"}, "direct-mis");
     if (*tables[1]) efficiency_table(e, {"pt-naive", "pt-mis3", "pt-mis"}, "pt-mis");

@@ -122,6 +122,23 @@ TEST_F(Cli, AliasesSelectTheSameEstimator) {
     for (size_t i = 0; i < a.pixel_count(); ++i) ASSERT_EQ(a[i], b[i]);
 }
 
+// Mitsuba's names select pathlab's integrators, on the command line and in scene files.
+TEST_F(Cli, MitsubaNamesSelectTheLightTracerAndThePathTracer) {
+    for (const auto& [mitsuba, name] : {std::pair{"ptracer", "lt"}, std::pair{"path", "pt-mis"}}) {
+        ASSERT_EQ(run({"-s", "4", "-a", mitsuba, "--resolution", "8x8", "--spp", "2", "-q", "-o", path("m.pfm")}).code, 0);
+        ASSERT_EQ(run({"-s", "4", "-a", name, "--resolution", "8x8", "--spp", "2", "-q", "-o", path("p.pfm")}).code, 0);
+        const Image a = read_image(path("m.pfm")), b = read_image(path("p.pfm"));
+        for (size_t i = 0; i < a.pixel_count(); ++i) ASSERT_EQ(a[i], b[i]) << mitsuba;
+    }
+    const std::string scene = path("lt.xml");
+    std::ofstream(scene) << "<scene version=\"3.0.0\"><integrator type=\"ptracer\"><integer name=\"max_depth\" value=\"3\"/>"
+                            "</integrator><shape type=\"rectangle\"/><emitter type=\"constant\"/></scene>";
+    const CliResult r = run({"-s", scene, "--resolution", "8x8", "--spp", "2", "-q", "-o", path("lt.pfm"), "--stats", path("lt.json")});
+    ASSERT_EQ(r.code, 0) << r.err;
+    std::ifstream in(path("lt.json"));
+    EXPECT_EQ(nlohmann::json::parse(in)["algorithm"], "lt");
+}
+
 // Ctrl-C during a long render: the binary writes the passes it finished, normalised by them,
 // so the image equals a one-shot render with that many samples, bit for bit.
 TEST_F(Cli, InterruptedRenderWritesWhatItHasCorrectlyNormalised) {

@@ -130,3 +130,33 @@ TEST(LightTracerDeterminism, ARenderSplitIntoTwoPartsSumsToTheOneShotRender) {
 
 }  // namespace
 }  // namespace pathlab::test
+
+namespace pathlab::test {
+namespace {
+
+// The pixels lt cannot see: none in the course scenes (no specular materials), the mirror,
+// the glass and the plastic cube in specular-box.xml, and nothing else.
+TEST(LightTracerCheck, SpecularFirstVertexMaskMarksMirrorsGlassAndPlasticOnly) {
+    for (int s = 0; s < 8; ++s) {
+        const auto scene = Scene::build(make_builtin_scene(s));
+        EXPECT_EQ(count_marked(specular_first_vertex_mask(*scene, 32, 32)), 0u) << "scene " << s;
+    }
+    const auto scene = Scene::build(scene_of("specular-box.xml"));
+    const std::vector<uint8_t> exact = specular_first_vertex_mask(*scene, 48, 48, 4, false);
+    const std::vector<uint8_t> dilated = specular_first_vertex_mask(*scene, 48, 48, 4, true);
+    const PerspectiveCamera camera(scene->camera(), 48, 48);
+    size_t specular_centres = 0;
+    for (size_t i = 0; i < exact.size(); ++i) {
+        Intersection hit;
+        const bool specular = scene->intersect(camera.generate(float(i % 48) + 0.5f, float(i / 48) + 0.5f), hit) &&
+                              (scene->material(hit.material).lobes() & kLobeSpecular);
+        specular_centres += specular;
+        if (specular) EXPECT_TRUE(exact[i]) << "pixel " << i;  // its centre sees a specular surface
+        if (exact[i]) EXPECT_TRUE(dilated[i]);
+    }
+    EXPECT_GT(specular_centres, 100u);
+    EXPECT_LT(count_marked(dilated), exact.size() / 3);
+}
+
+}  // namespace
+}  // namespace pathlab::test

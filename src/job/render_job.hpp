@@ -40,6 +40,12 @@ public:
     // invalid values are UsageErrors; a scene that cannot be built throws SceneError.
     RenderJob(SceneChoice scene, const JobRequest& request);
     RenderJob(int builtin_scene, const JobRequest& request) : RenderJob(builtin_scene_choice(builtin_scene), request) {}
+    // With a scene already built from scene.description (shared between jobs, as the
+    // benchmarks do to build each BVH once).
+    RenderJob(SceneChoice scene, const JobRequest& request, std::shared_ptr<const Scene> built)
+        : RenderJob(std::move(scene), request) {
+        scene_ = std::move(built);
+    }
 
     const SceneChoice& scene_choice() const { return choice_; }
     const Scene& scene();
@@ -62,7 +68,7 @@ public:
 
 private:
     SceneChoice choice_;
-    std::unique_ptr<Scene> scene_;
+    std::shared_ptr<const Scene> scene_;
     const IntegratorInfo* info_ = nullptr;
     IntegratorOptions options_;
     std::unique_ptr<Integrator> integrator_;

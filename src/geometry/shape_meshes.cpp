@@ -1,6 +1,8 @@
 #include "geometry/shape_meshes.hpp"
 
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 
 #include <tiny_obj_loader.h>
 
@@ -51,8 +53,15 @@ MeshDesc load_obj_mesh(const std::string& path) {
     std::error_code ec;
     if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
         throw MeshLoadError(fmt::format("cannot read mesh '{}': not a regular file", path));
+    // The file is parsed from memory with no material library: ParseFromFile would open any
+    // file a `mtllib` line names (`mtllib ../../dev/zero` hung the loader), and pathlab takes
+    // materials from the scene file, never from .mtl files.
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw MeshLoadError(fmt::format("cannot read mesh '{}': cannot open the file", path));
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (in.bad()) throw MeshLoadError(fmt::format("cannot read mesh '{}': read error", path));
     tinyobj::ObjReader reader;
-    if (!reader.ParseFromFile(path, config)) {
+    if (!reader.ParseFromString(text, "", config)) {
         std::string why = reader.Error();
         while (!why.empty() && (why.back() == '\n' || why.back() == '\r')) why.pop_back();
         throw MeshLoadError(fmt::format("cannot read mesh '{}': {}", path, why.empty() ? "unknown error" : why));

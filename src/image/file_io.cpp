@@ -258,8 +258,8 @@ void write_file_atomically(const std::string& path, const std::function<void(FdW
 void check_image_size(const std::string& name, uint64_t width, uint64_t height, uint64_t max_pixels, unsigned bytes_per_pixel) {
     if (width == 0 || height == 0) throw ImageIoError(fmt::format("{}: the image is {}x{} pixels: empty", name, width, height));
     if (width <= max_pixels && height <= max_pixels && width * height <= max_pixels) return;
-    const double pixels = double(width) * double(height);
-    const double gib = pixels * bytes_per_pixel / double(uint64_t(1) << 30);
+    const long double pixels = static_cast<long double>(width) * static_cast<long double>(height);  // exact below 2^64
+    const double gib = double(pixels) * bytes_per_pixel / double(uint64_t(1) << 30);
     throw ImageIoError(fmt::format("{}: the image is {}x{} = {:.0f} pixels, more than the {} pixels{} pathlab reads; it would need {:.1f} GiB of memory",
                                    name, width, height, pixels, max_pixels, max_pixels == kMaxImagePixels ? " (2^28)" : "", gib));
 }

@@ -432,11 +432,31 @@ Image8 read_png(const io::ByteSource& src, const ImageReadLimits& limits) {
     if (double(src.size()) * 1032 + 4096 < pixel_bytes)
         throw ImageIoError(fmt::format("{}: the PNG file is truncated: {} bytes cannot hold {}x{} pixels", name, src.size(), w, h));
     const io::Bytes bytes(src, src.size());
+    // stb_image passes a null buffer to memcpy for an empty IDAT chunk before the first
+    // non-empty one (undefined behaviour, found by the fuzzer); empty IDAT chunks carry no
+    // data, so they are left out of what stb sees.
+    std::vector<uint8_t> without_empty_idat;
+    const uint8_t* png = bytes.data();
+    size_t png_size = bytes.size();
+    for (size_t pos = 8; png_size - pos >= 12;) {
+        const uint32_t len = be32(png + pos);
+        if (len > png_size - pos - 12) break;  // stb reports it
+        const bool empty_idat = len == 0 && std::memcmp(png + pos + 4, "IDAT", 4) == 0;
+        const bool end = std::memcmp(png + pos + 4, "IEND", 4) == 0;
+        if (empty_idat) {
+            if (without_empty_idat.empty()) without_empty_idat.assign(png, png + png_size);
+            without_empty_idat.erase(without_empty_idat.begin() + ptrdiff_t(pos), without_empty_idat.begin() + ptrdiff_t(pos + 12));
+            png = without_empty_idat.data(), png_size = without_empty_idat.size();
+        } else {
+            pos += 12 + size_t(len);
+        }
+        if (end) break;
+    }
     // Everything stb needs: the compressed data, the inflated rows (up to 8 bytes per pixel
     // plus a filter byte per row and pass), the decoded and the converted image.
     const size_t budget = bytes.size() + size_t(24 * w * h + 16 * h) + (size_t(4) << 20);
     Image8 img;
-    const io::PngDecodeResult r = io::decode_png_rgb8(bytes.data(), bytes.size(), budget, img);
+    const io::PngDecodeResult r = io::decode_png_rgb8(png, png_size, budget, img);
     if (!r.ok) {
         if (r.over_budget)
             throw ImageIoError(fmt::format("{}: cannot read PNG: its compressed data inflate to more than a {}x{} image holds (corrupt?)", name, w, h));

@@ -17,6 +17,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <map>
 #include <string_view>
 #include <vector>
 
@@ -124,6 +125,62 @@ struct ExrLayout {
     int64_t chunk_lines = 1;  // scanlines per chunk, or the tile height
 };
 
+// OpenEXR reads a known attribute type as that type, whatever size the file declares (a box2i
+// is 16 bytes, a channel list ends at its empty name, a string vector is as long as its
+// strings say) and goes on from where it stopped. So that it stops exactly where the declared
+// size says, which is where scan_exr_header goes on, every known type's value must take
+// exactly its declared size; unknown types are read as opaque bytes of that size.
+void check_attribute_value(const io::ByteSource& src, uint64_t pos, const std::string& attr, const std::string& type, uint32_t len) {
+    static const std::map<std::string, uint32_t> kFixed = {
+        {"box2f", 16},  {"box2i", 16},  {"compression", 1}, {"chromaticities", 32}, {"deepImageState", 1}, {"double", 8},
+        {"envmap", 1},  {"float", 4},   {"int", 4},         {"keycode", 28},        {"lineOrder", 1},      {"m33d", 72},
+        {"m33f", 36},   {"m44d", 128},  {"m44f", 64},       {"rational", 8},        {"tiledesc", 9},       {"timecode", 8},
+        {"v2d", 16},    {"v2f", 8},     {"v2i", 8},         {"v3d", 24},            {"v3f", 12},           {"v3i", 12}};
+    const auto bad = [&](const std::string& why) {
+        return ImageIoError(fmt::format("{}: invalid OpenEXR attribute '{}' ({}): {}", src.name(), attr, type, why));
+    };
+    if (const auto fixed = kFixed.find(type); fixed != kFixed.end()) {
+        if (len != fixed->second) throw bad(fmt::format("{} bytes instead of {}", len, fixed->second));
+        return;
+    }
+    if (type == "string") return;
+    if (type == "floatvector") {
+        if (len % 4 != 0) throw bad(fmt::format("{} bytes, not a whole number of floats", len));
+        return;
+    }
+    if (type == "idmanifest") {
+        if (len < 4) throw bad(fmt::format("{} bytes", len));
+        return;
+    }
+    if (type != "chlist" && type != "stringvector" && type != "preview") return;  // opaque: read as `len` bytes
+    if (len > (1u << 24)) throw bad(fmt::format("{} bytes", len));
+    std::vector<uint8_t> v(len);
+    src.read(pos, v.data(), v.size());
+    if (type == "preview") {
+        if (len < 8 || uint64_t(le32(&v[0])) * le32(&v[4]) * 4 != len - 8) throw bad(fmt::format("{} bytes do not hold its pixels", len));
+    } else if (type == "stringvector") {
+        for (size_t q = 0; q < v.size();) {
+            if (v.size() - q < 4) throw bad("a string is cut short");
+            const uint32_t n = le32(&v[q]);
+            if (n > v.size() - q - 4) throw bad(fmt::format("a string of {} bytes runs past the attribute", n));
+            q += 4 + n;
+        }
+    } else {  // chlist: channels of a name (at most 255 characters) and 16 bytes, then an empty name
+        for (size_t q = 0;;) {
+            const void* nul = q < v.size() ? std::memchr(&v[q], 0, std::min<size_t>(256, v.size() - q)) : nullptr;
+            if (!nul) throw bad("a channel name does not end");
+            const size_t name_len = size_t(static_cast<const uint8_t*>(nul) - &v[q]);
+            q += name_len + 1;
+            if (name_len == 0) {
+                if (q != v.size()) throw bad(fmt::format("the channel list ends {} bytes before the attribute", v.size() - q));
+                break;
+            }
+            if (v.size() - q < 16) throw bad("a channel is cut short");
+            q += 16;
+        }
+    }
+}
+
 // Reads the header's structure before OpenEXR does, so that nothing OpenEXR allocates from it
 // (offset tables, chunk and tile buffers, the image) can exceed what the file can hold or what
 // the limits allow: every attribute must lie inside the file, the data window within the pixel
@@ -183,6 +240,7 @@ ExrLayout scan_exr_header(const io::ByteSource& src, const ImageReadLimits& limi
         const int32_t len = int32_t(le32(len_bytes));
         if (len < 0 || uint64_t(len) > size - pos)
             throw bad_attribute(attr, fmt::format("{} bytes, more than the rest of the file ({} bytes)", len, size - pos));
+        check_attribute_value(src, pos, attr, type, uint32_t(len));
         const auto value = [&](size_t expected) {
             if (size_t(len) != expected) throw bad_attribute(attr, fmt::format("{} bytes instead of {}", len, expected));
             std::vector<uint8_t> v(expected);
@@ -438,19 +496,17 @@ Image8 read_png(const io::ByteSource& src, const ImageReadLimits& limits) {
     std::vector<uint8_t> without_empty_idat;
     const uint8_t* png = bytes.data();
     size_t png_size = bytes.size();
-    for (size_t pos = 8; png_size - pos >= 12;) {
+    for (size_t pos = 8; png_size - pos >= 8;) {
         const uint32_t len = be32(png + pos);
-        if (len > png_size - pos - 12) break;  // stb reports it
-        const bool empty_idat = len == 0 && std::memcmp(png + pos + 4, "IDAT", 4) == 0;
-        const bool end = std::memcmp(png + pos + 4, "IEND", 4) == 0;
-        if (empty_idat) {
+        if (len == 0 && std::memcmp(png + pos + 4, "IDAT", 4) == 0) {
             if (without_empty_idat.empty()) without_empty_idat.assign(png, png + png_size);
-            without_empty_idat.erase(without_empty_idat.begin() + ptrdiff_t(pos), without_empty_idat.begin() + ptrdiff_t(pos + 12));
+            const size_t chunk = std::min<size_t>(12, png_size - pos);  // its CRC may be cut off
+            without_empty_idat.erase(without_empty_idat.begin() + ptrdiff_t(pos), without_empty_idat.begin() + ptrdiff_t(pos + chunk));
             png = without_empty_idat.data(), png_size = without_empty_idat.size();
-        } else {
-            pos += 12 + size_t(len);
+            continue;
         }
-        if (end) break;
+        if (std::memcmp(png + pos + 4, "IEND", 4) == 0 || uint64_t(len) + 12 > png_size - pos) break;  // the rest is stb's
+        pos += 12 + size_t(len);
     }
     // Everything stb needs: the compressed data, the inflated rows (up to 8 bytes per pixel
     // plus a filter byte per row and pass), the decoded and the converted image.

@@ -195,11 +195,11 @@ TEST_F(ImageIo, HdrHeaderVariantsAndWhatIsRefused) {
             EXPECT_NE(std::string(e.what()).find("v.hdr"), std::string::npos) << e.what();
         }
     };
-    refused("#?RADIANCE\nFORMAT=32-bit_rle_xyze\n\n-Y 1 +X 4\n", "unsupported HDR pixel format '32-bit_rle_xyze'");
-    refused("#?RADIANCE\n\n+Y 1 +X 4\n", "unsupported HDR orientation '+Y 1 +X 4'");
-    refused("#?RADIANCE\n\n-Y 1 +X 0\n", "invalid HDR resolution line");
+    refused("#?RADIANCE\nFORMAT=32-bit_rle_xyze\n\n-Y 1 +X 4\n", "cannot read HDR: unsupported pixel format '32-bit_rle_xyze'");
+    refused("#?RADIANCE\n\n+Y 1 +X 4\n", "cannot read HDR: unsupported orientation '+Y 1 +X 4'");
+    refused("#?RADIANCE\n\n-Y 1 +X 0\n", "cannot read HDR: invalid resolution line");
     refused("#?RADIANCE\n\n-Y 1 +X 5\n", "truncated");
-    refused("P6\n", "not a Radiance HDR file");
+    refused("P6\n", "cannot read HDR: not a Radiance HDR file");
 }
 
 // Big-endian (positive scale) and greyscale (Pf) files, as other programs write them.

@@ -137,7 +137,7 @@ void check_attribute_value(const io::ByteSource& src, uint64_t pos, const std::s
         {"m33f", 36},   {"m44d", 128},  {"m44f", 64},       {"rational", 8},        {"tiledesc", 9},       {"timecode", 8},
         {"v2d", 16},    {"v2f", 8},     {"v2i", 8},         {"v3d", 24},            {"v3f", 12},           {"v3i", 12}};
     const auto bad = [&](const std::string& why) {
-        return ImageIoError(fmt::format("{}: invalid OpenEXR attribute '{}' ({}): {}", src.name(), attr, type, why));
+        return ImageIoError(fmt::format("{}: invalid attribute '{}' ({}): {}", src.name(), attr, type, why));
     };
     if (const auto fixed = kFixed.find(type); fixed != kFixed.end()) {
         if (len != fixed->second) throw bad(fmt::format("{} bytes instead of {}", len, fixed->second));
@@ -194,18 +194,18 @@ ExrLayout scan_exr_header(const io::ByteSource& src, const ImageReadLimits& limi
     src.read(0, head, 8);
     if (le32(head) != 20000630u) throw ImageIoError(fmt::format("{}: not an OpenEXR file (no magic number)", name));
     const uint32_t version = le32(head + 4);
-    if ((version & 0xff) != 2) throw ImageIoError(fmt::format("{}: unsupported OpenEXR file version {}", name, version & 0xff));
+    if ((version & 0xff) != 2) throw ImageIoError(fmt::format("{}: unsupported file version {}", name, version & 0xff));
     const uint32_t flags = version & ~0xffu;
     constexpr uint32_t kTiled = 0x200, kLongNames = 0x400, kDeep = 0x800, kMultiPart = 0x1000;
     if (flags & ~(kTiled | kLongNames | kDeep | kMultiPart))
-        throw ImageIoError(fmt::format("{}: unsupported OpenEXR flags 0x{:x}", name, flags));
+        throw ImageIoError(fmt::format("{}: unsupported flags 0x{:x}", name, flags));
     if (flags & (kDeep | kMultiPart))
         throw ImageIoError(fmt::format("{}: multi-part and deep OpenEXR files are not supported (only single-part scanline or tiled images)", name));
     const bool tiled = flags & kTiled;
     const size_t max_name = flags & kLongNames ? 255 : 31;
 
     uint64_t pos = 8;
-    const auto truncated_header = [&] { return ImageIoError(fmt::format("{}: the OpenEXR header is truncated", name)); };
+    const auto truncated_header = [&] { return ImageIoError(fmt::format("{}: the header is truncated", name)); };
     const auto read_name = [&](const char* what) {
         char buf[257];
         const size_t n = size_t(std::min<uint64_t>(max_name + 1, size - pos));
@@ -214,14 +214,14 @@ ExrLayout scan_exr_header(const io::ByteSource& src, const ImageReadLimits& limi
         const void* nul = std::memchr(buf, 0, n);
         if (!nul) {
             if (n < max_name + 1) throw truncated_header();
-            throw ImageIoError(fmt::format("{}: invalid OpenEXR header: {} longer than {} characters", name, what, max_name));
+            throw ImageIoError(fmt::format("{}: invalid header: {} longer than {} characters", name, what, max_name));
         }
         std::string s(buf, size_t(static_cast<const char*>(nul) - buf));
         pos += s.size() + 1;
         return s;
     };
     const auto bad_attribute = [&](const std::string& attr, const std::string& why) {
-        return ImageIoError(fmt::format("{}: invalid OpenEXR attribute '{}': {}", name, attr, why));
+        return ImageIoError(fmt::format("{}: invalid attribute '{}': {}", name, attr, why));
     };
 
     bool have_window = false, have_channels = false, have_tiles = false;
@@ -287,14 +287,14 @@ ExrLayout scan_exr_header(const io::ByteSource& src, const ImageReadLimits& limi
         pos += uint64_t(len);
     }
     const uint64_t header_end = pos;
-    if (!have_window) throw ImageIoError(fmt::format("{}: invalid OpenEXR header: no dataWindow", name));
-    if (!have_channels || channel_count == 0) throw ImageIoError(fmt::format("{}: invalid OpenEXR header: no channels", name));
+    if (!have_window) throw ImageIoError(fmt::format("{}: invalid header: no dataWindow", name));
+    if (!have_channels || channel_count == 0) throw ImageIoError(fmt::format("{}: invalid header: no channels", name));
     if (compression < 0 || compression > 9)
-        throw ImageIoError(fmt::format("{}: invalid OpenEXR header: {} compression", name, compression < 0 ? "no" : "unknown"));
+        throw ImageIoError(fmt::format("{}: invalid header: {} compression", name, compression < 0 ? "no" : "unknown"));
     ExrLayout layout;
     layout.min_x = window[0], layout.min_y = window[1];
     const int64_t w = int64_t(window[2]) - window[0] + 1, h = int64_t(window[3]) - window[1] + 1;
-    if (w <= 0 || h <= 0) throw ImageIoError(fmt::format("{}: the OpenEXR data window is empty", name));
+    if (w <= 0 || h <= 0) throw ImageIoError(fmt::format("{}: the data window is empty", name));
     io::check_image_size(name, uint64_t(w), uint64_t(h), limits.max_pixels, sizeof(Rgb));
     layout.width = w, layout.height = h;
 
@@ -303,11 +303,11 @@ ExrLayout scan_exr_header(const io::ByteSource& src, const ImageReadLimits& limi
     double chunks = 0, buffer = 0;
     const double row_bytes = double(w) * double(bytes_per_pixel);
     if (tiled) {
-        if (!have_tiles) throw ImageIoError(fmt::format("{}: invalid OpenEXR header: a tiled file without tiles", name));
+        if (!have_tiles) throw ImageIoError(fmt::format("{}: invalid header: a tiled file without tiles", name));
         if (tile_w == 0 || tile_h == 0 || tile_w > 0x7fffffff || tile_h > 0x7fffffff)
-            throw ImageIoError(fmt::format("{}: invalid OpenEXR tile size {}x{}", name, tile_w, tile_h));
+            throw ImageIoError(fmt::format("{}: invalid tile size {}x{}", name, tile_w, tile_h));
         if ((tile_mode & 0x0f) > 2 || (tile_mode >> 4) > 1)
-            throw ImageIoError(fmt::format("{}: invalid OpenEXR tile mode {}", name, tile_mode));
+            throw ImageIoError(fmt::format("{}: invalid tile mode {}", name, tile_mode));
         chunks = std::ceil(double(w) / tile_w) * std::ceil(double(h) / tile_h);
         buffer = std::max(double(tile_w) * double(tile_h) * double(bytes_per_pixel), row_bytes * double(tile_h));
         layout.chunk_lines = std::min<int64_t>(tile_h, h);
@@ -319,12 +319,12 @@ ExrLayout scan_exr_header(const io::ByteSource& src, const ImageReadLimits& limi
     }
     const double after_header = double(size - header_end);
     if (chunks * 8 > after_header)
-        throw ImageIoError(fmt::format("{}: the OpenEXR file is truncated: its header announces {:.0f} chunks, whose offset table "
+        throw ImageIoError(fmt::format("{}: truncated: the header announces {:.0f} chunks, whose offset table "
                                        "alone takes {:.0f} bytes, but {:.0f} bytes follow the header",
                                        name, chunks, chunks * 8, after_header));
     const double max_buffer = std::max(double(sizeof(Rgb)) * double(limits.max_pixels), double(64 << 20));
     if (buffer > max_buffer)
-        throw ImageIoError(fmt::format("{}: an OpenEXR chunk of this file would take {:.1f} MiB to decode ({} channels, {} bytes "
+        throw ImageIoError(fmt::format("{}: a chunk of this file would take {:.1f} MiB to decode ({} channels, {} bytes "
                                        "per pixel), more than the {:.0f} MiB allowed",
                                        name, buffer / double(1 << 20), channel_count, bytes_per_pixel, max_buffer / double(1 << 20)));
     return layout;
@@ -339,11 +339,11 @@ Image read_exr(const io::ByteSource& src, const ImageReadLimits& limits) {
         const Imath::Box2i dw = file.header().dataWindow();
         if (dw.min.x != layout.min_x || dw.min.y != layout.min_y || int64_t(dw.max.x) - dw.min.x + 1 != layout.width ||
             int64_t(dw.max.y) - dw.min.y + 1 != layout.height)
-            throw ImageIoError(fmt::format("{}: inconsistent OpenEXR header (two data windows?)", name));
+            throw ImageIoError(fmt::format("{}: inconsistent header (two data windows?)", name));
         const Imf::ChannelList& channels = file.header().channels();
         const bool grey = !channels.findChannel("R") && channels.findChannel("Y");
         if (!grey && !(channels.findChannel("R") && channels.findChannel("G") && channels.findChannel("B")))
-            throw ImageIoError(fmt::format("{}: EXR has no R,G,B (or Y) channels", name));
+            throw ImageIoError(fmt::format("{}: no R, G, B (or Y) channels", name));
         const int64_t w = layout.width, h = layout.height;
         // Read in bands of whole chunks, so that memory grows with the pixels actually decoded:
         // a file that claims a large image but holds few chunks fails before taking much.
@@ -369,7 +369,7 @@ Image read_exr(const io::ByteSource& src, const ImageReadLimits& limits) {
     } catch (const ImageIoError&) {
         throw;
     } catch (const std::exception& e) {
-        throw ImageIoError(fmt::format("{}: cannot read EXR: {}", name, e.what()));
+        throw ImageIoError(fmt::format("{}: {}", name, e.what()));
     }
 }
 
@@ -397,11 +397,11 @@ Image read_pfm(const io::ByteSource& src, const ImageReadLimits& limits) {
         const size_t start = pos;
         while (pos < n && !space(head[pos]) && pos - start <= max_len) ++pos;
         if (pos == start || pos == n) {
-            if (n < kMaxHeader) throw ImageIoError(fmt::format("{}: not a valid PFM file: the header ends before its {}", name, what));
-            throw ImageIoError(fmt::format("{}: not a valid PFM file: no {} in its first {} bytes", name, what, kMaxHeader));
+            if (n < kMaxHeader) throw ImageIoError(fmt::format("{}: the header ends before its {}", name, what));
+            throw ImageIoError(fmt::format("{}: no {} in the first {} bytes", name, what, kMaxHeader));
         }
         if (pos - start > max_len)
-            throw ImageIoError(fmt::format("{}: not a valid PFM file: its {} is longer than {} characters", name, what, max_len));
+            throw ImageIoError(fmt::format("{}: the header's {} is longer than {} characters", name, what, max_len));
         return std::string(head + start, pos - start);
     };
     if (n < 3 || head[0] != 'P' || (head[1] != 'F' && head[1] != 'f') || !space(head[2]))
@@ -411,7 +411,7 @@ Image read_pfm(const io::ByteSource& src, const ImageReadLimits& limits) {
     const auto dimension = [&](const char* what) {
         const std::string t = token(what, 9);
         if (!std::all_of(t.begin(), t.end(), [](char c) { return c >= '0' && c <= '9'; }) || std::stol(t) == 0)
-            throw ImageIoError(fmt::format("{}: not a valid PFM file: {} '{}' is not a positive number", name, what, t));
+            throw ImageIoError(fmt::format("{}: {} '{}' is not a positive number", name, what, t));
         return std::stol(t);
     };
     const long w = dimension("width"), h = dimension("height");
@@ -420,13 +420,13 @@ Image read_pfm(const io::ByteSource& src, const ImageReadLimits& limits) {
     errno = 0;
     const double scale = std::strtod(scale_text.c_str(), &end);
     if (end != scale_text.c_str() + scale_text.size() || !std::isfinite(scale) || scale == 0)
-        throw ImageIoError(fmt::format("{}: not a valid PFM file: scale '{}' is not a non-zero number", name, scale_text));
+        throw ImageIoError(fmt::format("{}: scale '{}' is not a non-zero number", name, scale_text));
     ++pos;  // the single white-space byte before the raster (token() stopped on it)
     io::check_image_size(name, uint64_t(w), uint64_t(h), limits.max_pixels, sizeof(Rgb));
     const uint64_t row_bytes = uint64_t(w) * uint64_t(channels) * sizeof(float);
     const uint64_t raster = row_bytes * uint64_t(h);
     if (src.size() - pos < raster)
-        throw ImageIoError(fmt::format("{}: the PFM raster is truncated: the header says {}x{} ({} bytes of pixels) but {} bytes "
+        throw ImageIoError(fmt::format("{}: truncated: the header says {}x{} ({} bytes of pixels) but {} bytes "
                                        "follow it",
                                        name, w, h, raster, src.size() - pos));
     const bool file_little = scale < 0;
@@ -472,23 +472,23 @@ Image8 read_png(const io::ByteSource& src, const ImageReadLimits& limits) {
     if (src.size() < 8) throw ImageIoError(fmt::format("{}: not a PNG file (it is {} bytes long)", name, src.size()));
     src.read(0, head, 8);
     if (std::memcmp(head, kSignature, 8) != 0) throw ImageIoError(fmt::format("{}: not a PNG file (no PNG signature)", name));
-    if (src.size() < sizeof head) throw ImageIoError(fmt::format("{}: the PNG file is truncated in its header", name));
+    if (src.size() < sizeof head) throw ImageIoError(fmt::format("{}: truncated in its header", name));
     src.read(0, head, sizeof head);
     if (be32(head + 8) != 13 || std::memcmp(head + 12, "IHDR", 4) != 0)
-        throw ImageIoError(fmt::format("{}: invalid PNG: it does not begin with an IHDR chunk", name));
+        throw ImageIoError(fmt::format("{}: it does not begin with an IHDR chunk", name));
     const uint64_t w = be32(head + 16), h = be32(head + 20);
     const unsigned depth = head[24], colour = head[25];
     io::check_image_size(name, w, h, limits.max_pixels, 3);
     static const unsigned kChannels[7] = {1, 0, 3, 1, 2, 0, 4};
     const unsigned channels = colour <= 6 ? kChannels[colour] : 0;
     if (channels == 0 || !(depth == 1 || depth == 2 || depth == 4 || depth == 8 || depth == 16))
-        throw ImageIoError(fmt::format("{}: invalid PNG: colour type {} at {} bits", name, colour, depth));
-    if (src.size() > uint64_t(INT32_MAX)) throw ImageIoError(fmt::format("{}: PNG files over 2 GiB are not read", name));
+        throw ImageIoError(fmt::format("{}: invalid colour type {} at {} bits", name, colour, depth));
+    if (src.size() > uint64_t(INT32_MAX)) throw ImageIoError(fmt::format("{}: files over 2 GiB are not read", name));
     // Deflate expands at most 1032 times (a 258-byte match in 2 bits), so the file must hold
     // at least 1/1032 of the pixel data; otherwise it cannot be complete.
     const double pixel_bytes = double(w) * double(h) * channels * depth / 8;
     if (double(src.size()) * 1032 + 4096 < pixel_bytes)
-        throw ImageIoError(fmt::format("{}: the PNG file is truncated: {} bytes cannot hold {}x{} pixels", name, src.size(), w, h));
+        throw ImageIoError(fmt::format("{}: truncated: {} bytes cannot hold {}x{} pixels", name, src.size(), w, h));
     const io::Bytes bytes(src, src.size());
     // stb_image passes a null buffer to memcpy for an empty IDAT chunk before the first
     // non-empty one (undefined behaviour, found by the fuzzer); empty IDAT chunks carry no
@@ -515,20 +515,36 @@ Image8 read_png(const io::ByteSource& src, const ImageReadLimits& limits) {
     const io::PngDecodeResult r = io::decode_png_rgb8(png, png_size, budget, img);
     if (!r.ok) {
         if (r.over_budget)
-            throw ImageIoError(fmt::format("{}: cannot read PNG: its compressed data inflate to more than a {}x{} image holds (corrupt?)", name, w, h));
-        throw ImageIoError(fmt::format("{}: cannot read PNG: {}", name, r.error));
+            throw ImageIoError(fmt::format("{}: its compressed data inflate to more than a {}x{} image holds (corrupt?)", name, w, h));
+        throw ImageIoError(fmt::format("{}: {}", name, r.error));
     }
     return img;
 }
 
+// Runs a reader, giving each of its errors as "NAME: cannot read FORMAT: reason".
+template <typename Read>
+auto reading(const io::ByteSource& src, const char* format, Read&& read) -> decltype(read()) {
+    try {
+        return read();
+    } catch (const ImageIoError& e) {
+        const std::string what = e.what(), prefix = src.name() + ": ";
+        if (what.rfind(prefix, 0) != 0) throw;
+        throw ImageIoError(fmt::format("{}cannot read {}: {}", prefix, format, what.substr(prefix.size())));
+    }
+}
+
 Image read_from(ImageFormat format, const io::ByteSource& src, const ImageReadLimits& limits) {
     switch (format) {
-        case ImageFormat::Exr: return read_exr(src, limits);
-        case ImageFormat::Hdr: return io::read_rgbe(src, limits);
-        case ImageFormat::Pfm: return read_pfm(src, limits);
+        case ImageFormat::Exr: return reading(src, "EXR", [&] { return read_exr(src, limits); });
+        case ImageFormat::Hdr: return reading(src, "HDR", [&] { return io::read_rgbe(src, limits); });
+        case ImageFormat::Pfm: return reading(src, "PFM", [&] { return read_pfm(src, limits); });
         case ImageFormat::Png: break;
     }
     throw ImageIoError(fmt::format("{}: PNG is 8-bit display data, not a linear HDR image (use .exr, .hdr or .pfm)", src.name()));
+}
+
+Image8 read_png8_from(const io::ByteSource& src, const ImageReadLimits& limits) {
+    return reading(src, "PNG", [&] { return read_png(src, limits); });
 }
 
 void write_encoded(const Image& img, ImageFormat format, io::FdWriter& out, const std::string& name, float png_exposure) {
@@ -595,14 +611,14 @@ Image read_image(const std::string& path, const ImageReadLimits& limits) {
     return read_from(image_format_for(path), src, limits);
 }
 
-Image8 read_png8(const std::string& path, const ImageReadLimits& limits) { return read_png(io::FileSource(path), limits); }
+Image8 read_png8(const std::string& path, const ImageReadLimits& limits) { return read_png8_from(io::FileSource(path), limits); }
 
 Image read_image_from_memory(ImageFormat format, const void* data, size_t size, const std::string& name, const ImageReadLimits& limits) {
     return read_from(format, io::MemorySource(data, size, name), limits);
 }
 
 Image8 read_png8_from_memory(const void* data, size_t size, const std::string& name, const ImageReadLimits& limits) {
-    return read_png(io::MemorySource(data, size, name), limits);
+    return read_png8_from(io::MemorySource(data, size, name), limits);
 }
 
 }  // namespace pathlab

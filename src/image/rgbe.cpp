@@ -45,8 +45,8 @@ RgbeHeader parse_header(const uint8_t* data, size_t size, uint64_t file_size, co
         return true;
     };
     const auto unterminated = [&](const char* what) {
-        if (size < file_size) return ImageIoError(fmt::format("{}: the HDR header is longer than {} KiB ({})", name, kMaxHeaderBytes >> 10, what));
-        return ImageIoError(fmt::format("{}: the HDR file is truncated in its header ({})", name, what));
+        if (size < file_size) return ImageIoError(fmt::format("{}: its header is longer than {} KiB ({})", name, kMaxHeaderBytes >> 10, what));
+        return ImageIoError(fmt::format("{}: truncated in its header ({})", name, what));
     };
     if (size < 2 || text[0] != '#' || text[1] != '?')
         throw ImageIoError(fmt::format("{}: not a Radiance HDR file (it must begin with #?RADIANCE)", name));
@@ -60,7 +60,7 @@ RgbeHeader parse_header(const uint8_t* data, size_t size, uint64_t file_size, co
             while (!format.empty() && is_blank(format.back())) format.remove_suffix(1);
             while (!format.empty() && is_blank(format.front())) format.remove_prefix(1);
             if (format != "32-bit_rle_rgbe")
-                throw ImageIoError(fmt::format("{}: unsupported HDR pixel format '{}' (only 32-bit_rle_rgbe is read)", name,
+                throw ImageIoError(fmt::format("{}: unsupported pixel format '{}' (only 32-bit_rle_rgbe is read)", name,
                                                std::string(format.substr(0, 64))));
         }
     }
@@ -75,11 +75,11 @@ RgbeHeader parse_header(const uint8_t* data, size_t size, uint64_t file_size, co
     RgbeHeader h;
     const std::string shown(line.substr(0, 64));
     if (tokens.size() != 4 || tokens[0].size() != 2 || tokens[2].size() != 2)
-        throw ImageIoError(fmt::format("{}: invalid HDR resolution line '{}' (expected -Y height +X width)", name, shown));
+        throw ImageIoError(fmt::format("{}: invalid resolution line '{}' (expected -Y height +X width)", name, shown));
     if (tokens[0] != "-Y" || tokens[2] != "+X")
-        throw ImageIoError(fmt::format("{}: unsupported HDR orientation '{}' (only -Y height +X width, top row first, is read)", name, shown));
+        throw ImageIoError(fmt::format("{}: unsupported orientation '{}' (only -Y height +X width, top row first, is read)", name, shown));
     if (!parse_dimension(tokens[1], h.height) || !parse_dimension(tokens[3], h.width))
-        throw ImageIoError(fmt::format("{}: invalid HDR resolution line '{}' (sizes must be positive numbers)", name, shown));
+        throw ImageIoError(fmt::format("{}: invalid resolution line '{}' (sizes must be positive numbers)", name, shown));
     h.data_start = pos;
     return h;
 }
@@ -101,12 +101,12 @@ public:
 private:
     template <typename... Args>
     [[noreturn]] void corrupt(fmt::format_string<Args...> what, Args&&... args) const {
-        throw ImageIoError(fmt::format("{}: corrupt HDR data in scanline {} of {}: {}", name_, y_ + 1, h_,
+        throw ImageIoError(fmt::format("{}: corrupt data in scanline {} of {}: {}", name_, y_ + 1, h_,
                                        fmt::format(what, std::forward<Args>(args)...)));
     }
     void need(size_t k) const {
         if (n_ - pos_ < k)
-            throw ImageIoError(fmt::format("{}: the HDR file is truncated: it ends in scanline {} of {} ({} bytes)", name_, y_ + 1, h_, n_));
+            throw ImageIoError(fmt::format("{}: truncated: the file ends in scanline {} of {} ({} bytes)", name_, y_ + 1, h_, n_));
     }
 
     void decode_run_length(uint8_t* out) {

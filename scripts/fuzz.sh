@@ -64,6 +64,9 @@ for t in "${targets[@]}"; do
             max_len=4096
             ;;
         obj)
+            # tinyobjloader triangulates a polygon in time quadratic in its size: long inputs
+            # are mostly slow, not new.
+            max_len=4096
             corpus=build-fuzz/corpus-obj
             mkdir -p "$corpus"
             make_seeds

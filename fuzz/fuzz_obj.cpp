@@ -28,8 +28,16 @@ std::string input_path() {
 
 }  // namespace
 
+const std::string& input_file() {
+    static const std::string path = [] {
+        std::atexit([] { std::remove(input_path().c_str()); });  // libFuzzer ends with exit()
+        return input_path();
+    }();
+    return path;
+}
+
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-    static const std::string path = input_path();
+    const std::string& path = input_file();
     FILE* f = std::fopen(path.c_str(), "wb");
     if (!f) std::abort();
     if (size && std::fwrite(data, 1, size, f) != size) std::abort();

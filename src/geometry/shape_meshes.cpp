@@ -1,6 +1,8 @@
 #include "geometry/shape_meshes.hpp"
 
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 
 #include <tiny_obj_loader.h>
 
@@ -42,6 +44,34 @@ MeshDesc disk_mesh(int segments) {
     return m;
 }
 
+namespace {
+
+// Two inputs on which tinyobjloader 2.0.0rc10 has undefined behaviour (found by fuzz_obj):
+// a skin-weight line ("vw", a tinyobjloader extension) converts its joint index from float
+// to int unchecked (inf, 1e10), and a number's exponent of exactly 2147483648 or 2147483649
+// overflows an int. pathlab does not use skin weights: those lines become comments. No mesh
+// needs an exponent of 10 digits: such a number is refused.
+void avoid_tinyobj_undefined_behaviour(std::string& text, const std::string& path) {
+    const auto digit = [](char c) { return c >= '0' && c <= '9'; };
+    for (size_t i = 0; i < text.size(); ++i) {
+        if (i == 0 || text[i - 1] == '\n' || text[i - 1] == '\r') {  // a line starts (tinyobjloader's line ends)
+            size_t j = i;
+            while (j < text.size() && (text[j] == ' ' || text[j] == '\t')) ++j;
+            if (j + 2 < text.size() && text[j] == 'v' && text[j + 1] == 'w' && (text[j + 2] == ' ' || text[j + 2] == '\t')) text[j] = '#';
+        }
+        if ((text[i] == 'e' || text[i] == 'E') && i > 0 && (digit(text[i - 1]) || text[i - 1] == '.')) {
+            size_t j = i + 1;
+            if (j < text.size() && (text[j] == '+' || text[j] == '-')) ++j;
+            while (j < text.size() && text[j] == '0') ++j;
+            size_t digits = 0;
+            while (j + digits < text.size() && digit(text[j + digits])) ++digits;
+            if (digits >= 10) throw MeshLoadError(fmt::format("cannot read mesh '{}': a number with an exponent of {} digits", path, digits));
+        }
+    }
+}
+
+}  // namespace
+
 MeshDesc load_obj_mesh(const std::string& path) {
     tinyobj::ObjReaderConfig config;
     config.triangulate = true;
@@ -51,8 +81,16 @@ MeshDesc load_obj_mesh(const std::string& path) {
     std::error_code ec;
     if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
         throw MeshLoadError(fmt::format("cannot read mesh '{}': not a regular file", path));
+    // The file is parsed from memory with no material library: ParseFromFile would open any
+    // file a `mtllib` line names (`mtllib ../../dev/zero` hung the loader), and pathlab takes
+    // materials from the scene file, never from .mtl files.
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw MeshLoadError(fmt::format("cannot read mesh '{}': cannot open the file", path));
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (in.bad()) throw MeshLoadError(fmt::format("cannot read mesh '{}': read error", path));
+    avoid_tinyobj_undefined_behaviour(text, path);
     tinyobj::ObjReader reader;
-    if (!reader.ParseFromFile(path, config)) {
+    if (!reader.ParseFromString(text, "", config)) {
         std::string why = reader.Error();
         while (!why.empty() && (why.back() == '\n' || why.back() == '\r')) why.pop_back();
         throw MeshLoadError(fmt::format("cannot read mesh '{}': {}", path, why.empty() ? "unknown error" : why));

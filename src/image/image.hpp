@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "core/vec.hpp"
@@ -13,6 +14,8 @@ public:
     Image() = default;
     Image(int width, int height, Rgb fill = Rgb(0.0f))
         : width_(width), height_(height), pixels_(size_t(width) * size_t(height), fill) {}
+    // Takes `pixels` (width * height of them, top row first) without copying them.
+    Image(int width, int height, std::vector<Rgb>&& pixels) : width_(width), height_(height), pixels_(std::move(pixels)) {}
 
     int width() const { return width_; }
     int height() const { return height_; }

@@ -27,6 +27,22 @@ std::string slug(const std::string& name) {
     return out;
 }
 
+// A relative path as a URL path: every byte but the unreserved characters (RFC 3986) and '/'
+// percent-encoded, so that '#', '?', '%', spaces and quotes in file names neither break links
+// nor reach the page as markup.
+std::string url_path(const std::string& path) {
+    std::string out;
+    for (const char c : path) {
+        const unsigned char u = static_cast<unsigned char>(c);
+        if (std::isalnum(u) || c == '-' || c == '.' || c == '_' || c == '~' || c == '/') {
+            out += c;
+        } else {
+            out += fmt::format("%{:02X}", unsigned(u));
+        }
+    }
+    return out;
+}
+
 std::string exposure_tag(int stops) { return stops == 0 ? "0" : fmt::format("{}{}", stops > 0 ? 'p' : 'm', std::abs(stops)); }
 
 std::string utc_now() {
@@ -142,19 +158,20 @@ std::string report_files_dir(const std::string& html_path) {
 
 std::vector<std::string> write_html_report(const ReportData& data, const std::string& html_path) {
     const fs::path files_dir = report_files_dir(html_path);
-    const std::string files_rel = files_dir.filename().string();
+    // Links to the images: relative, percent-encoded (and, in attributes, HTML-escaped).
+    const std::string files_rel = url_path(files_dir.filename().string());
     const int w = data.reference.width(), h = data.reference.height();
     std::vector<std::string> written{html_path};
     const auto write_png = [&](const Image8& img, const std::string& name) {
         write_png8(img, (files_dir / name).string());
         written.push_back((files_dir / name).string());
-        return files_rel + "/" + name;
+        return files_rel + "/" + url_path(name);
     };
     // Every tone-mapped image at every exposure; returns the stem for data-stem.
     const auto write_exposures = [&](const Image& img, const std::string& name) {
         for (int e = kReportMinExposure; e <= kReportMaxExposure; ++e)
             write_png(to_srgb8(img, float(e)), fmt::format("{}_e{}.png", name, exposure_tag(e)));
-        return files_rel + "/" + name;
+        return files_rel + "/" + url_path(name);
     };
 
     // Statistics, and the error images on one shared scale: the largest of the renders'
@@ -255,7 +272,7 @@ reference's own noise.</p>
         fmt::arg("w", w), fmt::arg("h", h), fmt::arg("reference_note", xml_escape(data.reference_note)),
         fmt::arg("version", PATHLAB_VERSION), fmt::arg("date", utc_now()), fmt::arg("command", xml_escape(data.command)),
         fmt::arg("notes", notes), fmt::arg("emin", kReportMinExposure), fmt::arg("emax", kReportMaxExposure),
-        fmt::arg("images", images), fmt::arg("scale", scale), fmt::arg("bar", bar), fmt::arg("errors", errors),
+        fmt::arg("images", images), fmt::arg("scale", scale), fmt::arg("bar", xml_escape(bar)), fmt::arg("errors", errors),
         fmt::arg("rmse_note", data.reference_se.pixel_count() ? " with the reference's own noise (its mean squared standard error) removed" : ""),
         fmt::arg("table", table), fmt::arg("svg", svg), fmt::arg("script", kScript));
     write_text_file(html_path, html);

@@ -1,0 +1,136 @@
+// Writes the seed corpora of the reader fuzz targets, from files pathlab (and the libraries it
+// links) can make itself: small images in every format and variant the readers know, and OBJ
+// meshes. Usage: fuzz_make_seeds DIR  (creates DIR/exr, DIR/hdr, DIR/pfm, DIR/png, DIR/obj).
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfOutputFile.h>
+#include <ImfTiledOutputFile.h>
+#include <stb_image_write.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "image/image_io.hpp"
+
+namespace fs = std::filesystem;
+using pathlab::Image;
+using pathlab::Rgb;
+
+namespace {
+
+Image pattern(int w, int h) {
+    Image img(w, h);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            img.at(x, y) = Rgb(float(x) / float(w), float(y) / float(h), std::exp2(float((x * 7 + y * 3) % 20) - 10.0f));
+    if (w > 2) img.at(1, 0) = Rgb(0.0f);
+    return img;
+}
+
+void write_exr_variant(const std::string& file, const Image& img, Imf::Compression c, bool tiled, bool half_type, bool grey) {
+    const int w = img.width(), h = img.height();
+    const Imath::Box2i window(Imath::V2i(-3, 2), Imath::V2i(-3 + w - 1, 2 + h - 1));
+    Imf::Header header(window, window);
+    header.compression() = c;
+    const Imf::PixelType type = half_type ? Imf::HALF : Imf::FLOAT;
+    const std::vector<std::string> names = grey ? std::vector<std::string>{"Y"} : std::vector<std::string>{"R", "G", "B"};
+    for (const std::string& n : names) header.channels().insert(n, Imf::Channel(type));
+    std::vector<float> f(size_t(w) * h * 3);
+    std::vector<half> hf(f.size());
+    for (size_t i = 0; i < img.pixel_count(); ++i)
+        for (int k = 0; k < 3; ++k) f[i * 3 + k] = img[i][k], hf[i * 3 + k] = half(img[i][k]);
+    Imf::FrameBuffer fb;
+    for (size_t k = 0; k < names.size(); ++k) {
+        char* base = half_type ? reinterpret_cast<char*>(hf.data() + k) : reinterpret_cast<char*>(f.data() + k);
+        const size_t s = half_type ? sizeof(half) : sizeof(float);
+        fb.insert(names[k], Imf::Slice::Make(type, base, window, 3 * s, 3 * s * size_t(w)));
+    }
+    if (tiled) {
+        header.setTileDescription(Imf::TileDescription(4, 4, Imf::MIPMAP_LEVELS));
+        Imf::TiledOutputFile out(file.c_str(), header);
+        out.setFrameBuffer(fb);
+        for (int level = 0; level < out.numLevels(); ++level) out.writeTiles(0, out.numXTiles(level) - 1, 0, out.numYTiles(level) - 1, level);
+    } else {
+        Imf::OutputFile out(file.c_str(), header);
+        out.setFrameBuffer(fb);
+        out.writePixels(h);
+    }
+}
+
+void write_bytes(const fs::path& file, const std::string& bytes) { std::ofstream(file, std::ios::binary) << bytes; }
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    if (argc != 2) {
+        std::fprintf(stderr, "usage: %s DIR\n", argv[0]);
+        return 2;
+    }
+    const fs::path dir = argv[1];
+    for (const char* sub : {"exr", "hdr", "pfm", "png", "obj"}) fs::create_directories(dir / sub);
+
+    // pathlab's own writers, at sizes around the readers' special cases (HDR run-length
+    // encoding needs widths of 8 or more).
+    for (const auto& [w, h] : {std::pair{1, 1}, std::pair{5, 3}, std::pair{16, 8}, std::pair{37, 4}}) {
+        const Image img = pattern(w, h);
+        const std::string stem = std::to_string(w) + "x" + std::to_string(h);
+        for (const char* ext : {"exr", "hdr", "pfm", "png"}) pathlab::write_image(img, (dir / ext / (stem + "." + ext)).string());
+    }
+
+    // EXR: every compression; tiled with mipmaps; half and grey channels.
+    const Image small = pattern(9, 7);
+    int n = 0;
+    for (const Imf::Compression c : {Imf::NO_COMPRESSION, Imf::RLE_COMPRESSION, Imf::ZIPS_COMPRESSION, Imf::ZIP_COMPRESSION,
+                                     Imf::PIZ_COMPRESSION, Imf::PXR24_COMPRESSION, Imf::B44_COMPRESSION, Imf::B44A_COMPRESSION,
+                                     Imf::DWAA_COMPRESSION, Imf::DWAB_COMPRESSION}) {
+        const bool lossy_half = c == Imf::B44_COMPRESSION || c == Imf::B44A_COMPRESSION;
+        write_exr_variant((dir / "exr" / ("c" + std::to_string(n++) + ".exr")).string(), small, c, false, lossy_half, false);
+    }
+    write_exr_variant((dir / "exr" / "tiled.exr").string(), small, Imf::ZIP_COMPRESSION, true, false, false);
+    write_exr_variant((dir / "exr" / "tiled-half-y.exr").string(), small, Imf::RLE_COMPRESSION, true, true, true);
+    write_exr_variant((dir / "exr" / "half-y.exr").string(), small, Imf::PIZ_COMPRESSION, false, true, true);
+
+    // HDR: a header without FORMAT and the old Radiance run-length encoding (1,1,1,n repeats).
+    {
+        std::string old = "#?RGBE\nEXPOSURE=2\n\n-Y 2 +X 12\n";
+        const auto pixel = [&](int r, int g, int b, int e) { old += {char(r), char(g), char(b), char(e)}; };
+        pixel(128, 64, 32, 129), pixel(1, 1, 1, 5), pixel(200, 1, 1, 120), pixel(1, 1, 1, 5);
+        for (int x = 0; x < 12; ++x) pixel(x * 20, 100, 3, 128 + x % 3);
+        write_bytes(dir / "hdr" / "old-rle.hdr", old);
+    }
+
+    // PFM: greyscale and big-endian.
+    {
+        std::string pf = "Pf\n3 2\n1.0\n";
+        for (int i = 0; i < 6; ++i) {
+            const float v = float(i) * 0.25f;
+            uint32_t u;
+            std::memcpy(&u, &v, 4);
+            u = __builtin_bswap32(u);
+            pf.append(reinterpret_cast<const char*>(&u), 4);
+        }
+        write_bytes(dir / "pfm" / "grey-big-endian.pfm", pf);
+    }
+
+    // PNG: 1 to 4 channels (grey, grey + alpha, RGB, RGBA) from stb's writer.
+    {
+        std::vector<unsigned char> px(6 * 5 * 4);
+        for (size_t i = 0; i < px.size(); ++i) px[i] = (unsigned char)(i * 37 % 256);
+        for (int comp = 1; comp <= 4; ++comp)
+            stbi_write_png((dir / "png" / ("comp" + std::to_string(comp) + ".png")).string().c_str(), 6, 5, comp, px.data(), 6 * comp);
+    }
+
+    // OBJ: normals, texture coordinates, quads and polygons, negative indices, groups.
+    write_bytes(dir / "obj" / "quad-normals.obj",
+                "# a quad with normals and uvs\no quad\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 1\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+                "g front\ns 1\nf 1/1/1 2/2/1 3/3/1 4/4/1\n");
+    write_bytes(dir / "obj" / "negative.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf -4 -3 -2\nf -1 -3 -2\nusemtl red\nf 1//1 2 3\n");
+    write_bytes(dir / "obj" / "polygon.obj", "v 0 0 0\nv 2 0 0\nv 3 1 0\nv 2 2 0\nv 0 2 0\nv -1 1 0\nf 1 2 3 4 5 6\nl 1 2\np 3\n");
+    return 0;
+}

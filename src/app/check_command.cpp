@@ -140,7 +140,7 @@ int run_check_command(const CheckOptions& o) {
             seconds = r.stats.seconds;
             if (r.stats.interrupted) {
                 fmt::print(stderr, "pathlab: interrupted\n");
-                return 130;
+                return interrupted_exit_code();
             }
             // Pixels the integrator leaves black by design (a light tracer behind mirrors and glass).
             std::vector<uint8_t> black;

@@ -136,7 +136,7 @@ int run_reference_command(const ReferenceOptions& o) {
         if (!o.quiet)
             fmt::print(stderr, "{}: {} spp in {:.2f}s{} -> {}\n", stem, r.stats.spp, r.stats.seconds,
                        r.stats.interrupted ? " (interrupted)" : "", exr.string());
-        if (r.stats.interrupted) return 130;
+        if (r.stats.interrupted) return interrupted_exit_code();
     }
     return 0;
 }

@@ -153,7 +153,7 @@ int run_render_command(const RenderCommandOptions& o) {
                        fmt::join(job.outputs, ", "));
         if (s.interrupted) {
             if (j + 1 < jobs.size()) fmt::print(stderr, "pathlab: interrupted; {} scene(s) not rendered\n", jobs.size() - j - 1);
-            return 130;
+            return interrupted_exit_code();
         }
     }
     return 0;

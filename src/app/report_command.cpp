@@ -194,7 +194,7 @@ int run_report_command(const ReportOptions& o) {
 
     const std::vector<std::string> files = write_html_report(data, o.output);
     if (!o.quiet) fmt::print(stderr, "{} ({} files in {})\n", o.output, files.size() - 1, report_files_dir(o.output));
-    return interrupted ? 130 : 0;
+    return interrupted ? interrupted_exit_code() : 0;
 }
 
 }  // namespace pathlab

@@ -17,6 +17,7 @@
 #include "app/tool_commands.hpp"
 #include "job/usage_error.hpp"
 #include "image/image_io.hpp"
+#include "job/output_paths.hpp"
 #include "job/render_job.hpp"
 #include "scene/builtin_scenes.hpp"
 #include "judge/check.hpp"
@@ -57,7 +58,7 @@ CLI::App* add_check_command(CLI::App& app, CheckOptions& o) {
     cmd->add_option("--resolution", o.resolution, "Image size WxH (default: the reference's)");
     cmd->add_option("--seed", o.seed, "Random seed (if a reference has the same one, the next is used)")->capture_default_str();
     cmd->add_option("--max-depth", o.max_depth, "Longest path in bounces (-1: unlimited)")->capture_default_str();
-    cmd->add_option("--threads", o.threads, "Worker threads (default: all cores)");
+    add_threads_option(*cmd, o.threads);
     cmd->add_option("--json", o.json_path, "Also write the verdicts as JSON to this file");
     cmd->add_flag("-q,--quiet", o.quiet, "Only the per-scene verdicts");
     return cmd;
@@ -65,6 +66,7 @@ CLI::App* add_check_command(CLI::App& app, CheckOptions& o) {
 
 int run_check_command(const CheckOptions& o) {
     const IntegratorInfo* info = &integrator_or_usage_error(o.algorithm);
+    const uint64_t seed = parse_seed_option(o.seed);
     if (!fs::is_directory(o.references)) throw UsageError(fmt::format("--references {}: no such directory", o.references));
     std::map<int, std::string> mapping;
     if (!o.mapping.empty()) {
@@ -79,24 +81,25 @@ int run_check_command(const CheckOptions& o) {
     parse_resolution_option(o.resolution, width, height);
     if (o.spp <= 0) throw UsageError(fmt::format("--spp must be a positive number of samples, got {}", o.spp));
     if (o.max_depth < -1 || o.max_depth == 0) throw UsageError("--max-depth must be positive, or -1 for unlimited");
-    if (o.threads < 0) throw UsageError("--threads must be positive");
     if (!o.json_path.empty()) {
-        try {
-            write_text_file(o.json_path, "{}\n");
-        } catch (const std::exception& e) {
-            throw UsageError(fmt::format("--json {}: {}", o.json_path, e.what()));
-        }
+        // The references (every file of the directory) and the mapping are inputs: --json must
+        // not overwrite them, and nothing is written before the verdicts are in.
+        OutputPaths paths;
+        for (const auto& entry : fs::directory_iterator(o.references))
+            if (entry.is_regular_file()) paths.input(entry.path().string(), "a file of --references");
+        if (!o.mapping.empty()) paths.input(o.mapping, "--mapping");
+        paths.output(o.json_path, "--json", /*image=*/false);
     }
 
     std::optional<tbb::global_control> thread_limit;
-    if (o.threads > 0) thread_limit.emplace(tbb::global_control::max_allowed_parallelism, size_t(o.threads));
+    if (o.threads != 0) thread_limit.emplace(tbb::global_control::max_allowed_parallelism, thread_count_or_cap(o.threads));
     const bool show_progress = !o.quiet && isatty(STDERR_FILENO);
     const std::map<int, uint64_t> ref_seeds = reference_seeds(o.references);
     JobRequest request;
     request.algorithm = info->name;
     request.spp = uint64_t(o.spp);
     request.max_depth = o.max_depth;
-    request.seed = o.seed;
+    request.seed = seed;
 
     fmt::print("check {} at {} spp against {}\n", info->name, o.spp, o.references);
     InterruptGuard interrupt;
@@ -133,26 +136,33 @@ int run_check_command(const CheckOptions& o) {
             rs.width = width > 0 ? width : loaded->width();
             rs.height = height > 0 ? height : loaded->height();
             const auto it = ref_seeds.find(index);
-            if (it != ref_seeds.end() && it->second == o.seed) ++rs.seed;  // independent of the reference's samples
+            if (it != ref_seeds.end() && it->second == seed) ++rs.seed;  // independent of the reference's samples
             rs.progress = show_progress;
             rs.cancel = &InterruptGuard::flag();
-            const RenderResult r = job.run();
-            seconds = r.stats.seconds;
-            if (r.stats.interrupted) {
-                fmt::print(stderr, "pathlab: interrupted\n");
-                return interrupted_exit_code();
+            std::optional<RenderResult> r;
+            try {
+                r = job.run();
+            } catch (const std::exception& e) {  // a film too large for memory: this scene fails, the others go on
+                v = {Verdict::Error, e.what()};
             }
-            // Pixels the integrator leaves black by design (a light tracer behind mirrors and glass).
-            std::vector<uint8_t> black;
-            if (!info->sees_specular_from_camera) black = specular_first_vertex_mask(job.scene(), rs.width, rs.height);
-            const size_t left_out = count_marked(black);
-            v = left_out == black.size() && left_out > 0
-                    ? SceneVerdict{Verdict::BlackByDesign,
-                                   fmt::format("{} sees no pixel: all show specular surfaces first", info->name)}
-                    : judge_render(r.film.mean(), r.film.standard_error(), *loaded, left_out ? &black : nullptr);
-            if (left_out && v.verdict != Verdict::BlackByDesign)
-                v.detail += fmt::format("; {} pixels ({:.1f}%) left out: black by design for {} (their first surface is specular)",
-                                        left_out, 100.0 * double(left_out) / double(black.size()), info->name);
+            if (r) {
+                seconds = r->stats.seconds;
+                if (r->stats.interrupted) {
+                    fmt::print(stderr, "pathlab: interrupted\n");
+                    return interrupted_exit_code();
+                }
+                // Pixels the integrator leaves black by design (a light tracer behind mirrors and glass).
+                std::vector<uint8_t> black;
+                if (!info->sees_specular_from_camera) black = specular_first_vertex_mask(job.scene(), rs.width, rs.height);
+                const size_t left_out = count_marked(black);
+                v = left_out == black.size() && left_out > 0
+                        ? SceneVerdict{Verdict::BlackByDesign,
+                                       fmt::format("{} sees no pixel: all show specular surfaces first", info->name)}
+                        : judge_render(r->film.mean(), r->film.standard_error(), *loaded, left_out ? &black : nullptr);
+                if (left_out && v.verdict != Verdict::BlackByDesign)
+                    v.detail += fmt::format("; {} pixels ({:.1f}%) left out: black by design for {} (their first surface is specular)",
+                                            left_out, 100.0 * double(left_out) / double(black.size()), info->name);
+            }
             if (v.verdict == Verdict::Ok || v.verdict == Verdict::Fail) ++compared;
         }
         if (v.verdict == Verdict::Fail || v.verdict == Verdict::Error) ++failed;
@@ -164,7 +174,7 @@ int run_check_command(const CheckOptions& o) {
     const bool ok = failed == 0 && compared > 0;
     if (!o.quiet)
         fmt::print("{}: {} compared, {} failed{}\n", ok ? "PASSED" : "FAILED", compared, failed,
-                   compared == 0 ? " (no scene had a reference)" : "");
+                   compared == 0 && failed == 0 ? " (no scene had a reference)" : "");
     if (!o.json_path.empty())
         write_text_file(o.json_path, nlohmann::json{{"pathlab_version", PATHLAB_VERSION}, {"algorithm", info->name},
                                                     {"spp", o.spp}, {"references", o.references}, {"scenes", results},

@@ -62,20 +62,20 @@ CLI::App* add_reference_command(CLI::App& app, ReferenceOptions& o) {
     cmd->add_option("--resolution", o.resolution, "Image size WxH (default: the scene's, 512x512)");
     cmd->add_option("--seed", o.seed, "Random seed (differs from the renderer's default, so that checks are independent)")->capture_default_str();
     cmd->add_option("--max-depth", o.max_depth, "Longest path in bounces (-1: unlimited)")->capture_default_str();
-    cmd->add_option("--threads", o.threads, "Worker threads (default: all cores)");
+    add_threads_option(*cmd, o.threads);
     cmd->add_flag("-q,--quiet", o.quiet, "No progress line and no summary");
     return cmd;
 }
 
 int run_reference_command(const ReferenceOptions& o) {
     const IntegratorInfo* info = &integrator_or_usage_error(o.algorithm);
+    const uint64_t seed = parse_seed_option(o.seed);
     const std::vector<int> scenes = parse_builtin_scene_list(o.scenes);
     int width = 0, height = 0;
     parse_resolution_option(o.resolution, width, height);
     if (o.spp < 0) throw UsageError(fmt::format("--spp must be a positive number of samples, got {}", o.spp));
     if (o.time_limit < 0 || !std::isfinite(o.time_limit)) throw UsageError("--time must be a positive number of seconds");
     if (o.max_depth < -1 || o.max_depth == 0) throw UsageError("--max-depth must be positive, or -1 for unlimited");
-    if (o.threads < 0) throw UsageError("--threads must be positive");
     const fs::path dir(o.out_dir);
     try {
         check_writable_image_path((dir / "probe.exr").string());
@@ -84,7 +84,7 @@ int run_reference_command(const ReferenceOptions& o) {
     }
 
     std::optional<tbb::global_control> thread_limit;
-    if (o.threads > 0) thread_limit.emplace(tbb::global_control::max_allowed_parallelism, size_t(o.threads));
+    if (o.threads != 0) thread_limit.emplace(tbb::global_control::max_allowed_parallelism, thread_count_or_cap(o.threads));
     const bool show_progress = !o.quiet && isatty(STDERR_FILENO);
     const fs::path manifest_path = dir / "manifest.json";
     nlohmann::json entries = previous_entries(manifest_path);
@@ -98,7 +98,7 @@ int run_reference_command(const ReferenceOptions& o) {
     request.width = width;
     request.height = height;
     request.time_limit = o.time_limit;
-    request.seed = o.seed;
+    request.seed = seed;
     for (const int index : scenes) {
         const BuiltinSceneInfo& s = builtin_scenes()[size_t(index)];
         RenderJob job(index, request);
@@ -124,7 +124,7 @@ int run_reference_command(const ReferenceOptions& o) {
                            {"max_depth", o.max_depth},
                            {"resolution", {r.film.width(), r.film.height()}},
                            {"spp", r.stats.spp},
-                           {"seed", o.seed},
+                           {"seed", seed},
                            {"seconds", r.stats.seconds},
                            {"invalid_samples", r.stats.invalid_samples},
                            {"interrupted", r.stats.interrupted},

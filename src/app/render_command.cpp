@@ -11,6 +11,7 @@
 #include "app/interrupt.hpp"
 #include "job/usage_error.hpp"
 #include "image/image_io.hpp"
+#include "job/output_paths.hpp"
 #include "job/render_job.hpp"
 
 
@@ -58,12 +59,13 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
                                  fmt::format("Samples per pixel (default {}, or unlimited with --time)", kDefaultSpp));
     app.add_option("--time", o.time_limit, "Time budget in seconds per scene (stops at --spp if that comes first)");
     app.add_option("--resolution", o.resolution, "Image size WxH (default: the scene's, 512x512 for the course)");
-    app.add_option("--seed", o.seed, "Random seed; the image is a pure function of it")->capture_default_str();
+    app.add_option("--seed", o.seed, "Random seed, 0 to 18446744073709551615; the image is a pure function of it")
+        ->capture_default_str();
     app.add_option("--sampler", o.sampler,
                    "Random numbers: 'independent' (PCG32; the course's setting, exact per-pixel standard errors) or "
                    "'sobol' (scrambled low-discrepancy points: lower error at equal time)")
         ->capture_default_str();
-    app.add_option("--threads", o.threads, "Worker threads (default: all cores)");
+    add_threads_option(app, o.threads);
     app.add_option("-o,--output", o.outputs,
                    "Output file, repeatable; format by extension: .exr .hdr .pfm .png. Placeholders {scene} {index} "
                    "{algorithm}. Default: out/{index}-{scene}-{algorithm}.exr and .png");
@@ -98,52 +100,60 @@ int run_render_command(const RenderCommandOptions& o) {
     }
     parse_resolution_option(o.resolution, request.width, request.height);
     request.time_limit = o.time_limit;
-    request.seed = o.seed;
+    request.seed = parse_seed_option(o.seed);
     if (o.sampler != "independent" && o.sampler != "sobol")
         throw UsageError(fmt::format("unknown sampler '{}'. Valid samplers: independent, sobol", o.sampler));
     request.sampler = o.sampler == "sobol" ? SamplerKind::Sobol : SamplerKind::Independent;
     request.default_spp = kDefaultSpp;
-    if (o.threads < 0) throw UsageError("--threads must be positive");
 
     std::vector<RenderJob> jobs;
     for (SceneChoice& choice : resolve_scenes(o.scene, defines)) jobs.emplace_back(std::move(choice), request);
 
     std::vector<std::string> patterns(o.outputs.begin(), o.outputs.end());
     if (patterns.empty()) patterns.assign(std::begin(kDefaultOutputs), std::end(kDefaultOutputs));
-    // Check every output before the first render starts.
+    // Check every output before the first render starts: writable, not an input, not another output.
+    OutputPaths paths;
+    for (const RenderJob& job : jobs)
+        if (!job.scene_choice().file.empty()) paths.input(job.scene_choice().file, "the scene file");
     for (size_t j = 0; j < jobs.size(); ++j) {
-        for (const std::string& p : patterns) {
-            const std::string path = jobs[j].expand(p);
-            try {
-                check_writable_image_path(path);
-            } catch (const ImageIoError& e) {
-                throw UsageError(e.what());
-            }
-            jobs[j].outputs.push_back(path);
-        }
+        for (const std::string& p : patterns) jobs[j].outputs.push_back(jobs[j].expand(p));
         for (size_t k = 0; k < j; ++k)
             for (const std::string& path : jobs[j].outputs)
                 if (std::find(jobs[k].outputs.begin(), jobs[k].outputs.end(), path) != jobs[k].outputs.end())
                     throw UsageError(fmt::format("scenes {} and {} would both write {}: add {{scene}} or {{index}} to -o",
                                                  jobs[k].scene_choice().name, jobs[j].scene_choice().name, path));
+        for (const std::string& path : jobs[j].outputs) paths.output(path, "the output", /*image=*/true);
+        if (!o.stats_path.empty()) paths.output(jobs[j].expand(o.stats_path), "--stats", /*image=*/false);
     }
 
     std::optional<tbb::global_control> thread_limit;
-    if (o.threads > 0) thread_limit.emplace(tbb::global_control::max_allowed_parallelism, size_t(o.threads));
+    if (o.threads != 0) thread_limit.emplace(tbb::global_control::max_allowed_parallelism, thread_count_or_cap(o.threads));
     const int threads = int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
 
     const bool show_progress = !o.quiet && isatty(STDERR_FILENO);
 
     InterruptGuard interrupt;
+    // A scene that fails (too large for memory, a full disk) is reported and the others still
+    // render; the exit code is then 1.
+    size_t failed = 0;
     for (size_t j = 0; j < jobs.size(); ++j) {
         RenderJob& job = jobs[j];
         job.settings.progress = show_progress;
         job.settings.cancel = &InterruptGuard::flag();
         const std::string& name = job.scene_choice().name;
         if (show_progress) fmt::print(stderr, "{} / {}\n", name, job.integrator_info().name);
-        const RenderResult result = job.run();
-        job.write_outputs(result, o.exposure);
-        if (!o.stats_path.empty()) write_stats(job.expand(o.stats_path), job, result, threads);
+        RenderResult result;
+        try {
+            result = job.run();
+            job.write_outputs(result, o.exposure);
+            if (!o.stats_path.empty()) write_stats(job.expand(o.stats_path), job, result, threads);
+        } catch (const UsageError&) {
+            throw;
+        } catch (const std::exception& e) {
+            fmt::print(stderr, "pathlab: error: {}: {}\n", name, e.what());
+            ++failed;
+            continue;
+        }
         const RenderStats& s = result.stats;
         if (!o.quiet)
             fmt::print(stderr, "{}: {} spp in {:.2f}s ({:.2f} Msamples/s, {:.2f} Mrays/s){} -> {}\n", name, s.spp,
@@ -156,7 +166,8 @@ int run_render_command(const RenderCommandOptions& o) {
             return interrupted_exit_code();
         }
     }
-    return 0;
+    if (failed && jobs.size() > 1) fmt::print(stderr, "pathlab: {} of {} scenes failed\n", failed, jobs.size());
+    return failed ? 1 : 0;
 }
 
 }  // namespace pathlab

@@ -16,7 +16,7 @@ struct RenderCommandOptions {
     bool spp_given = false;  // otherwise 64, or unlimited when --time is given
     double time_limit = 0;
     std::string resolution;  // "WxH"; empty: the scene's own
-    uint64_t seed = 1234;
+    std::string seed = "1234";
     std::string sampler = "independent";
     int threads = 0;
     std::vector<std::string> outputs;

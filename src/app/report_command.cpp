@@ -13,6 +13,7 @@
 #include "app/tool_commands.hpp"
 #include "job/usage_error.hpp"
 #include "image/image_io.hpp"
+#include "job/output_paths.hpp"
 #include "job/render_job.hpp"
 #include "scene/builtin_scenes.hpp"
 #include "judge/html_report.hpp"
@@ -57,13 +58,14 @@ CLI::App* add_report_command(CLI::App& app, ReportOptions& o) {
     cmd->add_option("--resolution", o.resolution, "Image size WxH (default: the reference's, else the scene's)");
     cmd->add_option("--seed", o.seed, "Random seed of the compared renders")->capture_default_str();
     cmd->add_option("--max-depth", o.max_depth, "Longest path in bounces (-1: unlimited)")->capture_default_str();
-    cmd->add_option("--threads", o.threads, "Worker threads (default: all cores)");
+    add_threads_option(*cmd, o.threads);
     cmd->add_flag("-q,--quiet", o.quiet, "No progress line and no summary");
     return cmd;
 }
 
 int run_report_command(const ReportOptions& o) {
     // Validate everything before the first render.
+    const uint64_t seed = parse_seed_option(o.seed);
     const std::vector<int> scene_list = parse_builtin_scene_list(o.scene);
     if (scene_list.size() != 1 || o.scene == "all") throw UsageError("report takes one --scene");
     const int scene_index = scene_list.front();
@@ -78,7 +80,6 @@ int run_report_command(const ReportOptions& o) {
     if (o.time_limit < 0 || o.spp < 0 || !std::isfinite(o.time_limit)) throw UsageError("--time and --spp must be positive");
     if (o.reference_spp <= 0) throw UsageError("--reference-spp must be positive");
     if (o.max_depth < -1 || o.max_depth == 0) throw UsageError("--max-depth must be positive, or -1 for unlimited");
-    if (o.threads < 0) throw UsageError("--threads must be positive");
     int width = 0, height = 0;
     parse_resolution_option(o.resolution, width, height);
     const size_t direct = size_t(std::count_if(infos.begin(), infos.end(), [](const IntegratorInfo* e) { return is_direct_illumination(*e); }));
@@ -87,9 +88,15 @@ int run_report_command(const ReportOptions& o) {
         throw UsageError("direct-illumination and global estimators converge to different images: compare them separately, "
                          "or give --reference");
     if (fs::path(o.output).extension() != ".html") throw UsageError(fmt::format("-o {}: the report is an .html file", o.output));
+    OutputPaths paths;
+    if (!o.reference.empty()) {
+        paths.input(o.reference, "--reference");
+        paths.input(stderr_path_for(o.reference), "the reference's standard errors");
+    }
+    paths.output(o.output, "-o", /*image=*/false);
+    paths.output((fs::path(o.output).replace_extension(".png")).string(), "the report's picture", /*image=*/true);
     try {
         check_writable_image_path((fs::path(report_files_dir(o.output)) / "probe.png").string());
-        check_writable_image_path((fs::path(o.output).replace_extension(".png")).string());
     } catch (const ImageIoError& e) {
         throw UsageError(fmt::format("-o {}: {}", o.output, e.what()));
     }
@@ -113,7 +120,7 @@ int run_report_command(const ReportOptions& o) {
     }
 
     std::optional<tbb::global_control> thread_limit;
-    if (o.threads > 0) thread_limit.emplace(tbb::global_control::max_allowed_parallelism, size_t(o.threads));
+    if (o.threads != 0) thread_limit.emplace(tbb::global_control::max_allowed_parallelism, thread_count_or_cap(o.threads));
     const bool show_progress = !o.quiet && isatty(STDERR_FILENO);
     const BuiltinSceneInfo& info = builtin_scenes()[size_t(scene_index)];
     data.title = fmt::format("scene {} {}", info.index, info.name);
@@ -130,7 +137,7 @@ int run_report_command(const ReportOptions& o) {
         ref_request.width = width;
         ref_request.height = height;
         ref_request.spp = uint64_t(o.reference_spp);
-        ref_request.seed = o.seed + 1000003;  // independent of the compared renders
+        ref_request.seed = seed + 1000003;  // independent of the compared renders
         RenderJob ref_job(scene_index, ref_request);
         ref_job.settings.progress = show_progress;
         ref_job.settings.cancel = &InterruptGuard::flag();
@@ -163,7 +170,7 @@ int run_report_command(const ReportOptions& o) {
         request.height = data.reference.height();
         if (o.spp > 0) request.spp = uint64_t(o.spp);
         request.time_limit = o.time_limit;
-        request.seed = o.seed;
+        request.seed = seed;
         RenderJob job(scene_index, request);
         ReportRender entry{e->name, {}, {}, {}};
         double next_checkpoint = 0;

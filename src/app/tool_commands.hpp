@@ -31,7 +31,7 @@ struct ReferenceOptions {
     int spp = 0;  // 0: the default (kDefaultReferenceSpp), unless --time
     double time_limit = 0;
     std::string resolution;
-    uint64_t seed = 4321;  // not the renderer's default 1234, so `check` renders independent samples
+    std::string seed = "4321";  // not the renderer's default 1234, so `check` renders independent samples
     int max_depth = -1;
     int threads = 0;
     bool quiet = false;
@@ -46,7 +46,7 @@ struct CheckOptions {
     std::string scenes = "all";
     int spp = 64;
     std::string resolution;
-    uint64_t seed = 1234;
+    std::string seed = "1234";
     int max_depth = -1;
     int threads = 0;
     std::string json_path;
@@ -66,7 +66,7 @@ struct ReportOptions {
     std::string reference;
     int reference_spp = 1024;
     std::string resolution;
-    uint64_t seed = 1234;
+    std::string seed = "1234";
     int max_depth = -1;
     int threads = 0;
     bool quiet = false;

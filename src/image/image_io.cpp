@@ -575,6 +575,11 @@ void check_writable_image_path(const std::string& path) {
     io::probe_writable(path);
 }
 
+void check_writable_path(const std::string& path) {
+    if (fs::is_directory(path)) throw ImageIoError(fmt::format("{}: is a directory, not a file name", path));
+    io::probe_writable(path);
+}
+
 void write_png8(const Image8& img, const std::string& path) {
     io::write_file_atomically(path, [&](io::FdWriter& out) { write_png(img, out, path); });
 }

@@ -49,6 +49,8 @@ ImageFormat image_format_for(const std::string& path);
 // missing parent directories and a temporary file there, then removes it.
 void check_writable_image_path(const std::string& path);
 
+// The same for a text output (--stats, --json): not a directory, and a file can be made there.
+void check_writable_path(const std::string& path);
 void write_image(const Image& img, const std::string& path, float png_exposure = 0.0f);
 void write_png8(const Image8& img, const std::string& path);
 

@@ -9,6 +9,7 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <stdexcept>
 
 #include "integrators/integrator.hpp"
 #include "render/film.hpp"
@@ -43,8 +44,16 @@ struct RenderResult {
     RenderStats stats;
 };
 
+// A render whose film does not fit in memory (FilmTooLarge says how much it needs).
+struct FilmTooLarge : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+// What a render holds per pixel: the film's sums, squares and count (56 bytes), a pass image
+// for splatting integrators (24) and the mean and standard-error images written at the end (24).
+constexpr uint64_t kRenderBytesPerPixel = 104;
+
 // Throws std::invalid_argument for a non-positive resolution, or when neither spp nor a time
-// limit bounds the render.
+// limit bounds the render, and FilmTooLarge before allocating a film that does not fit.
 RenderResult render(const Scene& scene, Integrator& integrator, const RenderSettings& settings);
 inline RenderResult render(const Scene& scene, Integrator&& integrator, const RenderSettings& settings) {
     return render(scene, integrator, settings);

@@ -19,6 +19,15 @@ void Film::merge(const Film& other) {
     }
 }
 
+Film Film::from_sums(int width, int height, std::vector<Vec3d> sum, std::vector<Vec3d> sumsq, std::vector<uint64_t> count) {
+    const size_t n = size_t(width) * size_t(height);
+    if (sum.size() != n || sumsq.size() != n || count.size() != n) throw std::invalid_argument("Film::from_sums: sizes differ");
+    Film f;
+    f.width_ = width, f.height_ = height;
+    f.sum_ = std::move(sum), f.sumsq_ = std::move(sumsq), f.count_ = std::move(count);
+    return f;
+}
+
 Image Film::mean() const {
     Image img(width_, height_);
     for (size_t i = 0; i < sum_.size(); ++i)

@@ -43,6 +43,9 @@ public:
 
     // Adds another film's samples (another range of sample indices of the same render).
     void merge(const Film& other);
+    // A film with the given sums, squares and counts (a saved render taken up again); throws
+    // std::invalid_argument when the sizes disagree.
+    static Film from_sums(int width, int height, std::vector<Vec3d> sum, std::vector<Vec3d> sumsq, std::vector<uint64_t> count);
 
     Image mean() const;
     // Standard error of each pixel's mean, sqrt(s^2 / n) with the unbiased sample variance s^2.

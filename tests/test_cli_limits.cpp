@@ -1,0 +1,132 @@
+// Numbers, outputs and sizes that used to go wrong silently (the hardening issue): seeds and
+// resolutions that wrapped, thread counts that exhausted memory, outputs that overwrote the
+// inputs, films too large for memory, 32-bit sample counters.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <unistd.h>
+
+#include "cli_runner.hpp"
+#include "render/film.hpp"
+
+namespace pathlab::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+class CliLimits : public ::testing::Test {
+protected:
+    void SetUp() override {
+        dir_ = fs::temp_directory_path() / ("pathlab-limits-" + std::to_string(::getpid()));
+        fs::create_directories(dir_);
+    }
+    void TearDown() override { fs::remove_all(dir_); }
+    std::string path(const std::string& name) const { return (dir_ / name).string(); }
+    static std::string read(const std::string& p) {
+        std::ifstream in(p, std::ios::binary);
+        std::stringstream ss;
+        ss << in.rdbuf();
+        return ss.str();
+    }
+    fs::path dir_;
+};
+
+TEST_F(CliLimits, SeedsOutOfRangeAreUsageErrorsNotWrappedNumbers) {
+    for (const char* seed : {"-1", "18446744073709551616", "1e23", "12abc", "", " 5"}) {
+        const CliResult r = run({"-s", "0", "--resolution", "4x4", "--spp", "1", "--seed", seed, "-q", "-o", path("s.pfm")});
+        EXPECT_EQ(r.code, 2) << "--seed '" << seed << "'";
+        EXPECT_TRUE(contains(r.err, "invalid --seed")) << r.err;
+        EXPECT_FALSE(fs::exists(path("s.pfm")));
+    }
+    EXPECT_EQ(run({"-s", "0", "--resolution", "4x4", "--spp", "1", "--seed", "18446744073709551615", "-q", "-o", path("s.pfm")}).code, 0);
+    EXPECT_EQ(run({"check", "-a", "1", "--references", path(""), "--seed", "-1"}).code, 2);
+}
+
+TEST_F(CliLimits, ResolutionsOutOfRangeAreUsageErrors) {
+    for (const char* res : {"4294967312x16", "16x4294967312", "32769x16", "0x16", "-16x16", "16x16x", "16 x16", "1e3x16"}) {
+        const CliResult r = run({"-s", "0", "--resolution", res, "--spp", "1", "-q", "-o", path("r.pfm")});
+        EXPECT_EQ(r.code, 2) << res << ": " << r.err;
+        EXPECT_TRUE(contains(r.err, "invalid --resolution")) << r.err;
+    }
+}
+
+TEST_F(CliLimits, HugeThreadCountsAreCappedWithAMessage) {
+    const CliResult r = run({"-s", "0", "--resolution", "8x8", "--spp", "1", "--threads", "2147483647", "-q", "-o", path("t.pfm")});
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(contains(r.err, "--threads 2147483647 is more than 8 x the")) << r.err;
+    EXPECT_EQ(run({"-s", "0", "--resolution", "8x8", "--spp", "1", "--threads", "-3", "-q", "-o", path("t.pfm")}).code, 2);
+}
+
+TEST_F(CliLimits, OutputsNeverOverwriteInputsOrEachOther) {
+    const std::string scene = path("scene.xml");
+    const std::string text = "<scene version=\"3.0.0\"><shape type=\"rectangle\"/><emitter type=\"constant\"/></scene>\n";
+    std::ofstream(scene) << text;
+    // --stats onto the scene file, through another spelling of its path too.
+    for (const std::string& stats : {scene, (dir_ / "." / "scene.xml").string()}) {
+        const CliResult r = run({"-s", scene, "--resolution", "4x4", "--spp", "1", "-q", "-o", path("a.exr"), "--stats", stats});
+        EXPECT_EQ(r.code, 2) << r.err;
+        EXPECT_TRUE(contains(r.err, "is the scene file")) << r.err;
+        EXPECT_EQ(read(scene), text);
+    }
+    // --stats onto the image, and one image twice.
+    CliResult r = run({"-s", "0", "--resolution", "4x4", "--spp", "1", "-q", "-o", path("a.exr"), "--stats", path("a.exr")});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_TRUE(contains(r.err, "is also the output")) << r.err;
+    r = run({"-s", "0", "--resolution", "4x4", "--spp", "1", "-q", "-o", path("a.exr"), "-o", path("a.exr")});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_FALSE(fs::exists(path("a.exr")));
+    // check --json onto a reference, before it is read.
+    fs::create_directories(path("refs"));
+    ASSERT_EQ(run({"-s", "0", "--resolution", "8x8", "--spp", "1", "-q", "-o", path("refs/0.pfm")}).code, 0);
+    const std::string ref = read(path("refs/0.pfm"));
+    r = run({"check", "-a", "1", "-s", "0", "--references", path("refs"), "--spp", "1", "--json", path("refs/0.pfm")});
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_TRUE(contains(r.err, "is a file of --references")) << r.err;
+    EXPECT_EQ(read(path("refs/0.pfm")), ref);
+}
+
+uint64_t available_memory() {
+    std::ifstream in("/proc/meminfo");
+    std::string key, unit;
+    uint64_t kib = 0;
+    while (in >> key >> kib >> unit)
+        if (key == "MemAvailable:") return kib * 1024;
+    return 0;
+}
+
+// A film too large for memory is refused before it is allocated, saying how much it needs;
+// the other scenes of the command still render, and `check` goes on too.
+TEST_F(CliLimits, AFilmTooLargeForMemoryFailsThatSceneOnly) {
+    if (available_memory() == 0 || available_memory() > (uint64_t(90) << 30))
+        GTEST_SKIP() << "this machine could allocate a 32768x32768 film (or does not say how much memory it has)";
+    const std::string huge = path("huge.xml");
+    std::ofstream(huge) << "<scene version=\"3.0.0\"><sensor type=\"perspective\"><film type=\"hdrfilm\">"
+                           "<integer name=\"width\" value=\"32768\"/><integer name=\"height\" value=\"32768\"/></film></sensor>"
+                           "<shape type=\"rectangle\"/></scene>\n";
+    const CliResult r = run({"-s", "0," + huge, "--spp", "1", "-q", "-o", path("{scene}.pfm")});
+    EXPECT_EQ(r.code, 1) << r.err;
+    EXPECT_TRUE(contains(r.err, "a 32768x32768 render needs 104.0 GiB of memory")) << r.err;
+    EXPECT_TRUE(fs::exists(path("point-diffuse.pfm"))) << "the other scene must still render";
+    EXPECT_FALSE(fs::exists(path("huge.pfm")));
+    const CliResult c = run({"check", "-a", "1", "-s", "0,1", "--references", std::string(PATHLAB_SHARED_DIR) + "/npgr010-refs/direct",
+                             "--spp", "1", "--resolution", "32768x32768"});
+    EXPECT_EQ(c.code, 1);
+    EXPECT_EQ(std::count(c.out.begin(), c.out.end(), '\n'), 4) << c.out;  // header, two scenes, the summary
+    EXPECT_TRUE(contains(c.out, "1 point-glossy     ERROR")) << c.out;
+}
+
+// Sample counts are 64-bit: a pixel past 2^32 samples keeps counting and averaging.
+TEST(FilmCounters, CountsPassTwoToThe32) {
+    const uint64_t n = (uint64_t(1) << 32) - 1;
+    Film film = Film::from_sums(1, 1, {Vec3d(double(n))}, {Vec3d(double(n))}, {n});
+    film.add(0, Rgb(1.0f));
+    film.add(0, Rgb(1.0f));
+    EXPECT_EQ(film.count(0), n + 2);
+    EXPECT_EQ(film.mean()[0], Rgb(1.0f));
+}
+
+}  // namespace
+}  // namespace pathlab::test

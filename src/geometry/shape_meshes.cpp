@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <map>
+#include <tuple>
 
 #include <fmt/format.h>
 
@@ -99,11 +100,14 @@ MeshDesc load_obj_mesh(const std::string& path) {
     MeshDesc m;
     m.name = path;
     const size_t vertex_count = a.vertices.size() / 3;
-    bool all_normals = !a.normals.empty();
+    bool all_normals = !a.normals.empty(), all_uvs = !a.texcoords.empty();
     size_t faces = 0;
     for (const tinyobj::shape_t& s : reader.GetShapes()) {
         faces += s.mesh.num_face_vertices.size();
-        for (const tinyobj::index_t& i : s.mesh.indices) all_normals = all_normals && i.normal_index >= 0;
+        for (const tinyobj::index_t& i : s.mesh.indices) {
+            all_normals = all_normals && i.normal_index >= 0;
+            all_uvs = all_uvs && i.texcoord_index >= 0;
+        }
     }
     if (faces == 0) throw MeshLoadError(fmt::format("mesh '{}' has no faces", path));
     for (size_t v = 0; v < vertex_count; ++v) {
@@ -111,25 +115,39 @@ MeshDesc load_obj_mesh(const std::string& path) {
         if (!is_finite(p)) throw MeshLoadError(fmt::format("mesh '{}': vertex {} is not finite", path, v + 1));
     }
 
-    // Without normals the file's vertex list is used as it is; with them, one vertex per
-    // distinct (position, normal) pair.
-    std::map<std::pair<int, int>, uint32_t> remap;
+    // Without normals and texture coordinates the file's vertex list is used as it is; with
+    // them, one vertex per distinct (position, normal, uv) triple. Texture coordinates are used
+    // when every face has them, with v flipped (v' = 1 - v), as Mitsuba reads OBJ files.
+    const bool split = all_normals || all_uvs;
+    std::map<std::tuple<int, int, int>, uint32_t> remap;
     const auto vertex = [&](const tinyobj::index_t& i) -> uint32_t {
         if (i.vertex_index < 0 || size_t(i.vertex_index) >= vertex_count)
             throw MeshLoadError(fmt::format("mesh '{}' refers to a vertex that does not exist", path));
-        if (!all_normals) return uint32_t(i.vertex_index);
-        const auto key = std::make_pair(i.vertex_index, i.normal_index);
+        if (!split) return uint32_t(i.vertex_index);
+        const auto key = std::make_tuple(i.vertex_index, all_normals ? i.normal_index : -1, all_uvs ? i.texcoord_index : -1);
         const auto [it, added] = remap.emplace(key, uint32_t(m.positions.size()));
         if (added) {
-            const size_t v = size_t(i.vertex_index), n = size_t(i.normal_index);
-            if (3 * n + 2 >= a.normals.size())
-                throw MeshLoadError(fmt::format("mesh '{}' refers to a normal that does not exist", path));
+            const size_t v = size_t(i.vertex_index);
             m.positions.push_back({a.vertices[3 * v], a.vertices[3 * v + 1], a.vertices[3 * v + 2]});
-            m.normals.push_back({a.normals[3 * n], a.normals[3 * n + 1], a.normals[3 * n + 2]});
+            if (all_normals) {
+                const size_t n = size_t(i.normal_index);
+                if (3 * n + 2 >= a.normals.size())
+                    throw MeshLoadError(fmt::format("mesh '{}' refers to a normal that does not exist", path));
+                m.normals.push_back({a.normals[3 * n], a.normals[3 * n + 1], a.normals[3 * n + 2]});
+            }
+            if (all_uvs) {
+                const size_t t = size_t(i.texcoord_index);
+                if (2 * t + 1 >= a.texcoords.size())
+                    throw MeshLoadError(fmt::format("mesh '{}' refers to a texture coordinate that does not exist", path));
+                const Vec2f uv(a.texcoords[2 * t], 1 - a.texcoords[2 * t + 1]);
+                if (!std::isfinite(uv.x) || !std::isfinite(uv.y))
+                    throw MeshLoadError(fmt::format("mesh '{}' has a non-finite texture coordinate", path));
+                m.uvs.push_back(uv);
+            }
         }
         return it->second;
     };
-    if (!all_normals)
+    if (!split)
         for (size_t v = 0; v < vertex_count; ++v) m.positions.push_back({a.vertices[3 * v], a.vertices[3 * v + 1], a.vertices[3 * v + 2]});
     for (const tinyobj::shape_t& s : reader.GetShapes()) {
         size_t offset = 0;

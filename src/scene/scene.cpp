@@ -122,6 +122,7 @@ bool Scene::intersect(const Ray& ray, Intersection& hit) const {
     if (!accel_.intersect(ray, raw)) return false;
     const GeometryRecord& rec = geometry_[raw.geom_id];
     hit.t = raw.t;
+    hit.uv = Vec2f(0.0f, 0.0f);
     if (rec.is_sphere) {
         const SphereDesc& sp = desc_.spheres[rec.index];
         // Project the hit back onto the sphere in double precision.

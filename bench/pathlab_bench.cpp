@@ -5,8 +5,10 @@
 //   pathlab_bench direct   RMSE of 1, 2a, 2b, 2c, 3 at equal spp and equal time
 //   pathlab_bench pt       the same for the path tracers 4a, 4b, 4c
 //   pathlab_bench lt       light tracing: paths/s next to pt-mis, and splat accumulation
+//   pathlab_bench bdpt     bdpt against pt-mis: equal-time RMSE, and samples per second
 #include <CLI/CLI.hpp>
 
+#include "bidirectional.hpp"
 #include "estimator_efficiency.hpp"
 #include "light_tracing.hpp"
 #include "performance.hpp"
@@ -49,7 +51,15 @@ int main(int argc, char** argv) {
     lt->add_option("--seconds", l.seconds, "Seconds per timed render")->capture_default_str();
     lt->add_option("--repeats", l.repeats, "Timed pairs per scene (median reported)")->capture_default_str();
     lt->add_option("--scenes", l.scenes, "Scene indices")->delimiter(',')->capture_default_str();
+    BidirectionalOptions b;
+    CLI::App* bd = app.add_subcommand("bdpt", "bdpt against pt-mis: equal-time RMSE, and samples per second");
+    bd->add_option("--size", b.size, "Image width and height for the equal-time table")->capture_default_str();
+    bd->add_option("--seconds", b.seconds, "Seconds per timed render")->capture_default_str();
+    bd->add_option("--repeats", b.repeats, "Timed pairs per scene (median reported)")->capture_default_str();
+    bd->add_option("--ref-spp", b.ref_spp, "Samples per pixel of each reference (bdpt)")->capture_default_str();
+    bd->add_option("--scenes", b.scenes, "Course scene indices and scene files of scenes/")->delimiter(',')->capture_default_str();
     CLI11_PARSE(app, argc, argv);
+    if (*bd) bidirectional_suite(b);
     if (*lt) light_tracing_suite(l);
     if (*perf) performance_suite(p);
     if (*tables[0]) efficiency_table(e, {"direct-light", "direct-uniform", "direct-cosine", "direct-brdf", "direct-mis"}, "direct-mis");

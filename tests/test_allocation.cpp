@@ -1,9 +1,11 @@
-// The hot path allocates nothing: every estimator's radiance() for thousands of samples, and
-// the light tracer's paths once its splat list has the size of a pass, make no heap
-// allocation (counted by replacing operator new in this test binary).
+// The hot path allocates nothing: every estimator's radiance() for thousands of samples, the
+// light tracer's paths once its splat list has the size of a pass, and bdpt's subpaths and
+// connections, make no heap allocation (counted by
+// replacing operator new in this test binary).
 #include <gtest/gtest.h>
 
 #include "instrument/allocation_counter.hpp"
+#include "integrators/bidir/bdpt.hpp"
 #include "integrators/bidir/light_tracer.hpp"
 #include "job/renderer.hpp"
 #include "scene/builtin_scenes.hpp"
@@ -54,6 +56,30 @@ TEST(Allocation, NoEstimatorAllocatesPerSample) {
                 }
                 EXPECT_EQ(allocations_by_this_thread() - before, 0u) << info.name << " on scene " << index;
                 EXPECT_GT(splats.splats().size(), 100u) << "the light paths must reach the camera";
+                continue;
+            }
+            if (const auto* bdpt = dynamic_cast<const Bdpt*>(integrator.get())) {
+                // Subpaths and every connection allocate nothing.
+                const RenderContext ctx{*scene, camera, 64, 64, 7, SamplerKind::Independent, 32};
+                std::vector<PathVertex> cam, light;  // as long as a path can be: growth is not per sample
+                cam.reserve(size_t(bdpt->max_camera_vertices()));
+                light.reserve(size_t(bdpt->max_light_vertices()));
+                const auto sample = [&](uint64_t j, uint64_t pass) {
+                    Sampler sampler(7, j, pass);
+                    bdpt->camera_subpath(ctx, size_t(j % 4096), sampler, cam);
+                    bdpt->light_subpath(ctx, sampler, light);
+                    float sum = 0;
+                    for (int t = 1; t <= int(cam.size()); ++t)
+                        for (int s = 0; s <= std::max(1, int(light.size())); ++s)
+                            if (s + t >= 2 && !(s == 1 && t == 1)) sum += bdpt->connect(ctx, light, s, cam, t, sampler).weight;
+                    return sum;
+                };
+                float weights = 0;
+                for (uint64_t j = 0; j < 4096; ++j) weights += sample(j, 0);
+                const uint64_t before = allocations_by_this_thread();
+                for (uint64_t j = 0; j < 4096; ++j) weights += sample(j, 1);
+                EXPECT_EQ(allocations_by_this_thread() - before, 0u) << info.name << " on scene " << index;
+                EXPECT_GT(weights, 100.0f) << "the strategies must connect";
                 continue;
             }
             const auto* estimator = dynamic_cast<const PixelIntegrator*>(integrator.get());

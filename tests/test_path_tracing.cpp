@@ -1,4 +1,4 @@
-// The three path tracers: furnace scenes with closed-form answers, equivalence with direct-mis
+// The path tracers (and bdpt): furnace scenes with closed-form answers, equivalence with direct-mis
 // at one bounce, agreement with each other, and unbiased Russian roulette.
 #include <gtest/gtest.h>
 
@@ -10,7 +10,7 @@ namespace {
 
 const AgreementOptions kAgreement{1e-3, 1e-4};
 constexpr int kGlobalSpp = 8192;
-const std::vector<std::string> kPathTracers = {"pt-naive", "pt-mis3", "pt-mis"};
+const std::vector<std::string> kPathTracers = {"pt-naive", "pt-mis3", "pt-mis", "bdpt"};
 
 // A closed cube seen from inside: every wall emits Le (towards the inside) and reflects
 // diffusely with albedo rho. Radiance is the same everywhere: L = Le + rho L, so

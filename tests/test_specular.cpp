@@ -115,7 +115,7 @@ TEST_P(SpecularFurnace, GlassAndMirrorStayUniform) {
     EXPECT_TRUE(a.agree) << a.describe();
     EXPECT_EQ(r.stats.invalid_samples, 0u);
 }
-INSTANTIATE_TEST_SUITE_P(PathTracers, SpecularFurnace, ::testing::Values("pt-naive", "pt-mis3", "pt-mis"),
+INSTANTIATE_TEST_SUITE_P(PathTracers, SpecularFurnace, ::testing::Values("pt-naive", "pt-mis3", "pt-mis", "bdpt"),
                          [](const auto& info) {
                              std::string n = info.param;
                              std::replace(n.begin(), n.end(), '-', '_');

@@ -5,6 +5,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <filesystem>
+
 #include <fmt/format.h>
 
 #include "app/command_arguments.hpp"
@@ -75,6 +77,11 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
                                  "Longest path in bounces (-1: unlimited; default: the scene file's, else -1)");
     app.add_option_function<int>("--rr-depth", [&o](const int& v) { o.rr_depth = v, o.rr_depth_given = true; },
                                  "Bounces before Russian roulette starts (default: the scene file's, else 3)");
+    app.add_option("--mis", o.mis, "bdpt: the MIS heuristic, balance or power")->capture_default_str();
+    app.add_option("--strategies", o.strategies_dir,
+                   "bdpt: also write one image per strategy (s, t), weighted and unweighted, and montages, into this directory "
+                   "(placeholders as for -o)");
+    app.add_option("--strategies-depth", o.strategies_depth, "bdpt: ... for paths of up to this many bounces")->capture_default_str();
     app.add_flag("-q,--quiet", o.quiet, "No progress line and no summary");
 }
 
@@ -105,6 +112,10 @@ int run_render_command(const RenderCommandOptions& o) {
         throw UsageError(fmt::format("unknown sampler '{}'. Valid samplers: independent, sobol", o.sampler));
     request.sampler = o.sampler == "sobol" ? SamplerKind::Sobol : SamplerKind::Independent;
     request.default_spp = kDefaultSpp;
+    if (o.mis != "balance" && o.mis != "power")
+        throw UsageError(fmt::format("unknown MIS heuristic '{}'. Valid heuristics: balance, power", o.mis));
+    request.mis_power = o.mis == "power";
+    request.strategies_depth = o.strategies_depth;
 
     std::vector<RenderJob> jobs;
     for (SceneChoice& choice : resolve_scenes(o.scene, defines)) jobs.emplace_back(std::move(choice), request);
@@ -124,6 +135,15 @@ int run_render_command(const RenderCommandOptions& o) {
                                                  jobs[k].scene_choice().name, jobs[j].scene_choice().name, path));
         for (const std::string& path : jobs[j].outputs) paths.output(path, "the output", /*image=*/true);
         if (!o.stats_path.empty()) paths.output(jobs[j].expand(o.stats_path), "--stats", /*image=*/false);
+        if (o.mis == "power" && jobs[j].integrator_info().name != "bdpt")
+            throw UsageError(fmt::format("--mis chooses the heuristic of bdpt; {} has its own", jobs[j].integrator_info().name));
+        if (!o.strategies_dir.empty()) {
+            if (jobs[j].integrator_info().name != "bdpt")
+                throw UsageError(fmt::format("--strategies writes the strategies of bdpt, not of {}", jobs[j].integrator_info().name));
+            const std::string dir = jobs[j].expand(o.strategies_dir);
+            paths.output((std::filesystem::path(dir) / "montage-weighted.png").string(), "--strategies", /*image=*/true);
+            jobs[j].integrator_options().strategies_dir = dir;
+        }
     }
 
     std::optional<tbb::global_control> thread_limit;

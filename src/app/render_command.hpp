@@ -28,6 +28,9 @@ struct RenderCommandOptions {
     int rr_depth = 3;
     bool rr_depth_given = false;
     bool quiet = false;
+    std::string mis = "balance";
+    std::string strategies_dir;
+    int strategies_depth = 4;
 };
 
 void add_render_options(CLI::App& app, RenderCommandOptions& opt);

@@ -32,6 +32,12 @@ namespace pathlab {
 struct IntegratorOptions {
     int max_depth = -1;  // longest path in bounces (1 = direct illumination only); -1 = unlimited
     int rr_depth = 3;    // bounces before Russian roulette may end a path
+    // Only paths of exactly this many bounces count (-1: all); pt-mis and bdpt honour it, so
+    // that strategies can be compared with path tracing one length at a time.
+    int only_length = -1;
+    bool mis_power = false;        // bdpt: the power heuristic (beta = 2) instead of the balance heuristic
+    std::string strategies_dir;    // bdpt: write one image per strategy (s, t) there ("" for none)
+    int strategies_depth = 4;      // bdpt: ... for paths of up to this many bounces
 };
 
 // What every pass of one render sees; fixed for the whole render.
@@ -62,6 +68,8 @@ public:
     virtual void prepare(const RenderContext&) {}
     virtual PassCounters render_passes(const RenderContext& ctx, Film& film, uint64_t first, int count,
                                        const PassProgress& progress) = 0;
+    // Called once after the last pass (also of an interrupted render): extra outputs.
+    virtual void finish(const RenderContext&) {}
 };
 
 // Today's per-pixel estimators: one Monte Carlo estimate of the radiance arriving along a

@@ -16,5 +16,6 @@ const IntegratorInfo& pt_naive_integrator();
 const IntegratorInfo& pt_mis3_integrator();
 const IntegratorInfo& pt_mis_integrator();
 const IntegratorInfo& light_tracer_integrator();
+const IntegratorInfo& bdpt_integrator();
 
 }  // namespace pathlab

@@ -18,10 +18,13 @@ RenderJob::RenderJob(SceneChoice scene, const JobRequest& r) : choice_(std::move
     info_ = &integrator_or_usage_error(r.algorithm ? *r.algorithm : d.algorithm.value_or("pt-mis"));
     options_.max_depth = r.max_depth ? *r.max_depth : d.max_depth.value_or(-1);
     options_.rr_depth = r.rr_depth ? *r.rr_depth : d.rr_depth.value_or(3);
+    options_.mis_power = r.mis_power;
+    options_.strategies_dir = r.strategies_dir;
+    options_.strategies_depth = r.strategies_depth;
+    if (r.strategies_depth < 0) throw UsageError("--strategies-depth must be zero or positive");
     if (options_.max_depth < -1 || options_.max_depth == 0) throw UsageError("--max-depth must be positive, or -1 for unlimited");
     if (r.time_limit < 0 || !std::isfinite(r.time_limit)) throw UsageError("--time must be a positive number of seconds");
     if (r.spp && *r.spp == 0) throw UsageError("--spp must be a positive number of samples");
-    integrator_ = info_->make(options_);
 
     settings.width = r.width;
     settings.height = r.height;
@@ -36,9 +39,14 @@ const Scene& RenderJob::scene() {
     return *scene_;
 }
 
-RenderResult RenderJob::run() { return render(scene(), *integrator_, settings); }
+Integrator& RenderJob::integrator() {
+    if (!integrator_) integrator_ = info_->make(options_);
+    return *integrator_;
+}
 
-RenderStats RenderJob::run_into(Film& film) { return render_into(scene(), *integrator_, settings, film); }
+RenderResult RenderJob::run() { return render(scene(), integrator(), settings); }
+
+RenderStats RenderJob::run_into(Film& film) { return render_into(scene(), integrator(), settings, film); }
 
 std::string RenderJob::expand(const std::string& pattern) const {
     try {

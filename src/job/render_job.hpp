@@ -29,6 +29,9 @@ struct JobRequest {
     uint64_t seed = 1234;
     SamplerKind sampler = SamplerKind::Independent;
     uint64_t default_spp = 64;
+    bool mis_power = false;        // --mis power (bdpt)
+    std::string strategies_dir;    // --strategies DIR (bdpt)
+    int strategies_depth = 4;      // --strategies-depth N (bdpt)
 };
 
 // The integrator `name` (or an alias); a UsageError listing them all otherwise.
@@ -50,8 +53,10 @@ public:
     const SceneChoice& scene_choice() const { return choice_; }
     const Scene& scene();
     const IntegratorInfo& integrator_info() const { return *info_; }
-    Integrator& integrator() { return *integrator_; }
+    // The integrator is made when first needed, so its options may still be changed before.
+    Integrator& integrator();
     const IntegratorOptions& integrator_options() const { return options_; }
+    IntegratorOptions& integrator_options() { return options_; }
     // Progress, cancellation, callbacks and the size may be adjusted before run().
     RenderSettings settings;
     // Output files (patterns already expanded), written by write_outputs().

@@ -111,6 +111,7 @@ RenderStats render_into(const Scene& scene, Integrator& integrator, const Render
         if (batch_seconds < 0.05 && batch < (1u << 20)) batch *= 2;
     }
     progress.finish();
+    integrator.finish(ctx);
     return st;
 }
 

@@ -5,9 +5,9 @@
 
 namespace pathlab {
 
-void Film::add_pass(const std::vector<Vec3d>& values) {
-    if (values.size() != sum_.size()) throw std::invalid_argument("Film::add_pass: the pass has another size");
-    for (size_t i = 0; i < values.size(); ++i) add(i, values[i]);
+void Film::add_pass(const Vec3d* values, size_t count) {
+    if (count != sum_.size()) throw std::invalid_argument("Film::add_pass: the pass has another size");
+    for (size_t i = 0; i < count; ++i) add(i, values[i]);
 }
 
 void Film::merge(const Film& other) {

@@ -35,7 +35,8 @@ public:
         ++count_[pixel];
     }
     // One sample of every pixel: values[p] is pixel p's estimate from one pass.
-    void add_pass(const std::vector<Vec3d>& values);
+    void add_pass(const std::vector<Vec3d>& values) { add_pass(values.data(), values.size()); }
+    void add_pass(const Vec3d* values, size_t count);
 
     uint64_t count(size_t pixel) const { return count_[pixel]; }
     const Vec3d& sum(size_t pixel) const { return sum_[pixel]; }

@@ -26,6 +26,12 @@ inline std::vector<ParamInfo> path_params() {
              "path depth at which Russian roulette starts, Mitsuba's convention (pathlab's bounces: rr_depth - 1; --rr-depth wins)"}};
 }
 
+// The options with max_depth cut to only_length when only paths of that length count.
+inline IntegratorOptions limited_to_length(IntegratorOptions o) {
+    if (o.only_length >= 0 && (o.max_depth < 0 || o.max_depth > o.only_length)) o.max_depth = std::max(1, o.only_length);
+    return o;
+}
+
 class PathRules {
 public:
     explicit PathRules(const IntegratorOptions& o)

@@ -17,22 +17,27 @@ namespace {
 
 class PtMis final : public PixelIntegrator {
 public:
-    PtMis(const IntegratorOptions& o, bool separate_continuation) : rules_(o), three_rays_(separate_continuation) {}
+    PtMis(const IntegratorOptions& o, bool separate_continuation)
+        : rules_(limited_to_length(o)), three_rays_(separate_continuation), only_length_(o.only_length) {}
 
     Rgb radiance(const Scene& scene, const Ray& camera_ray, Sampler& sampler) const override {
         Intersection hit;
-        if (!scene.intersect(camera_ray, hit)) return scene.escaped_radiance(camera_ray.d);
+        if (!scene.intersect(camera_ray, hit)) return counts(0) ? scene.escaped_radiance(camera_ray.d) : Rgb(0.0f);
         Vec3f dir = camera_ray.d;
-        Rgb L = emitted_radiance(scene, hit, -dir);
+        Rgb L = counts(0) ? emitted_radiance(scene, hit, -dir) : Rgb(0.0f);
         Rgb beta(1.0f);
         for (int bounces = 0; rules_.may_bounce(bounces); ++bounces) {
             const ShadingPoint sp = make_shading_point(scene, hit, dir);
             if (sp.material->is_black()) break;
             // Paths of bounces + 1 bounces ending on a light: the MIS pair.
-            L += beta * estimate_light_sample(scene, sp, sampler, /*mis=*/true);
+            const Rgb direct = estimate_light_sample(scene, sp, sampler, /*mis=*/true);
+            if (counts(bounces + 1)) L += beta * direct;
             const auto s = sp.material->sample(sp, sp.wi, sampler.next2d());
             EmitterHit found;
-            if (s) L += beta * estimate_bsdf_sample_mis(scene, sp, *s, found);
+            if (s) {
+                const Rgb found_emission = estimate_bsdf_sample_mis(scene, sp, *s, found);
+                if (counts(bounces + 1)) L += beta * found_emission;
+            }
             if (!rules_.may_bounce(bounces + 1)) break;
 
             // Continue the path: with the same BSDF sample (pt-mis) or a fresh one (pt-mis3).
@@ -56,8 +61,11 @@ public:
     }
 
 private:
+    bool counts(int length) const { return only_length_ < 0 || only_length_ == length; }
+
     PathRules rules_;
     bool three_rays_;
+    int only_length_;
 };
 
 }  // namespace

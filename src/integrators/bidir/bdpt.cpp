@@ -1,0 +1,345 @@
+#include "integrators/bidir/bdpt.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <atomic>
+
+#include "integrators/bidir/strategy_images.hpp"
+#include "integrators/integrators.hpp"
+
+namespace pathlab {
+namespace {
+
+// The BSDF of surface vertex v for light leaving towards the world direction w (the mode of v's
+// subpath: radiance on the camera side, importance on the light side).
+// Also the solid-angle density with which v's BSDF samples w (which the MIS weight needs).
+Rgb bsdf_towards(const PathVertex& v, const Vec3f& w, float& pdfW) {
+    return v.sp.material->eval_and_pdf(v.sp, v.sp.wi, v.sp.frame.to_local(w), pdfW);
+}
+
+// |cos| at v of the world direction w, with the shading normal (1 for points).
+float cos_at(const PathVertex& v, const Vec3f& w) {
+    return v.kind == VertexKind::Surface ? std::abs(dot(v.sp.frame.n, w)) : (v.has_normal() ? std::abs(dot(v.n, w)) : 1.0f);
+}
+
+// The random numbers of one sample come from separate streams: the camera subpath (the stream
+// a pixel integrator would use), the light subpath, and the connections of each camera vertex
+// t (next-event estimation draws there). So a subpath's vertices, and the light points s = 1
+// samples, are the same whichever strategies are evaluated: a render restricted to one path
+// length (or to a lower depth) is made of the same paths as the full one.
+uint64_t sample_stream(size_t pixel, uint64_t stream) { return uint64_t(pixel) + (stream << 40); }
+
+// Pixels per chunk of a pass: a function of the image size only (see the light tracer).
+size_t chunk_size(size_t pixels) { return std::max<size_t>(16, pixels / 64); }
+
+}  // namespace
+
+Bdpt::Bdpt(const IntegratorOptions& options, BdptFaults faults)
+    : options_(limited_to_length(options)), faults_(faults),
+      max_bounces_(options_.max_depth < 0 ? kMaxBounces : std::min(options_.max_depth, kMaxBounces)) {
+    if (!options.strategies_dir.empty())
+        strategies_ = std::make_unique<StrategyImages>(std::min(options.strategies_depth, max_bounces_), options.strategies_dir);
+}
+
+Bdpt::~Bdpt() = default;
+
+void Bdpt::random_walk(const RenderContext& ctx, Ray ray, Sampler& sampler, Rgb beta, float pdfW, int max_vertices,
+                       TransportMode mode, std::vector<PathVertex>& path) const {
+    const Scene& scene = ctx.scene;
+    Rgb scatter(1.0f);  // the throughput of the scattering alone, for Russian roulette
+    for (int bounces = 0;; ++bounces) {
+        if (int(path.size()) >= max_vertices) return;
+        const size_t prev = path.size() - 1;
+        Intersection hit;
+        if (!scene.intersect(ray, hit)) {
+            // A camera ray that escapes reaches the environment: a light vertex at infinity.
+            if (mode == TransportMode::Radiance && scene.environment_light() >= 0) {
+                PathVertex v;
+                v.kind = VertexKind::Light;
+                v.infinite = true;
+                v.dir = normalize(ray.d);
+                v.light = scene.environment_light();
+                v.beta = beta;
+                v.pdf_fwd = pdfW;  // per unit solid angle
+                path.push_back(v);
+            }
+            return;
+        }
+        PathVertex v;
+        v.kind = VertexKind::Surface;
+        v.sp = make_shading_point(scene, hit, normalize(ray.d), mode);
+        v.p = hit.p;
+        v.n = v.sp.ng;
+        v.emitter_n = hit.ng;
+        v.light = hit.light;
+        v.beta = beta;
+        v.pdf_fwd = to_area_density(pdfW, path[prev], v);
+        path.push_back(v);
+        PathVertex& cur = path.back();
+        if (cur.sp.material->is_black() || int(path.size()) >= max_vertices) return;
+
+        cur.sp.reverse_pdf = true;
+        const auto s = cur.sp.material->sample(cur.sp, cur.sp.wi, sampler.next2d());
+        cur.sp.reverse_pdf = false;
+        if (!s) return;
+        const Rgb weight = s->f * (std::abs(s->wo.z) / s->pdfW);
+        beta *= weight;
+        scatter *= weight;
+        pdfW = s->pdfW;
+        float pdf_rev = s->pdf_rev;
+        if (s->delta) {
+            cur.delta = true;
+            pdfW = pdf_rev = 0;
+        }
+        // The reverse density of the previous vertex: cur's sampling of it.
+        if (!(faults_.specular_pdf_rev_missing && path[prev].delta)) path[prev].pdf_rev = to_area_density(pdf_rev, cur, path[prev]);
+        // Russian roulette after rr_depth bounces, as in the path tracers.
+        if (options_.rr_depth >= 0 && bounces + 1 >= options_.rr_depth) {
+            const float q = std::clamp(max_component(scatter), 0.05f, 1.0f);
+            if (sampler.next1d() >= q) return;
+            beta /= q;
+            scatter /= q;
+        }
+        ray = cur.sp.spawn(s->wo);
+    }
+}
+
+void Bdpt::camera_subpath(const RenderContext& ctx, size_t pixel, Sampler& sampler, std::vector<PathVertex>& path) const {
+    path.clear();
+    PathVertex c;
+    c.kind = VertexKind::Camera;
+    c.p = ctx.camera.position();
+    c.beta = Rgb(1.0f);
+    c.pdf_fwd = 1;
+    path.push_back(c);
+    const Vec2f jitter = sampler.next2d();
+    const float x = float(pixel % size_t(ctx.width)), y = float(pixel / size_t(ctx.width));
+    const Ray ray = ctx.camera.generate(x + jitter.x, y + jitter.y);
+    // We cos / (pdfA pdfW) = 1 for the pinhole: the camera path starts with throughput 1.
+    random_walk(ctx, ray, sampler, Rgb(1.0f), ctx.camera.pdf_direction(ray.d), max_camera_vertices(), TransportMode::Radiance, path);
+}
+
+void Bdpt::light_subpath(const RenderContext& ctx, Sampler& sampler, std::vector<PathVertex>& path) const {
+    path.clear();
+    const Scene& scene = ctx.scene;
+    const LightChoice choice = scene.choose_light(sampler.next1d());
+    const Vec2f u_pos = sampler.next2d(), u_dir = sampler.next2d();
+    if (choice.index < 0) return;
+    const Light& light = scene.lights()[size_t(choice.index)];
+    const auto es = sample_emission(light, u_pos, u_dir, scene.scene_sphere());
+    if (!es || is_black(es->Le) || !(es->pdfA > 0) || !(es->pdfW > 0)) return;
+    const uint32_t flags = light_flags(light);
+    PathVertex l;
+    l.kind = VertexKind::Light;
+    l.p = es->origin;
+    l.infinite = (flags & kLightInfinite) != 0;
+    l.delta_light = is_delta_light(light);
+    l.dir = -es->direction;
+    l.n = (flags & kLightSurface) ? es->normal : Vec3f(0.0f);
+    l.emitter_n = es->normal;
+    l.light = choice.index;
+    l.beta = es->Le;
+    l.pdf_fwd = choice.pmf * es->pdfA;
+    path.push_back(l);
+    const Rgb beta = es->Le * (es->cos / (choice.pmf * es->pdfA * es->pdfW));
+    const Ray ray = (flags & kLightSurface) ? spawn_ray(es->origin, es->normal, es->direction) : Ray{es->origin, es->direction, kInf};
+    random_walk(ctx, ray, sampler, beta, es->pdfW, max_light_vertices(), TransportMode::Importance, path);
+    if (l.infinite) {
+        // From infinity the first hit's density is that of the entry disk, projected; the light
+        // vertex's own density is that of its direction under light sampling.
+        if (path.size() > 1) path[1].pdf_fwd = es->pdfA * (path[1].has_normal() ? std::abs(dot(path[1].n, es->direction)) : 1.0f);
+        path[0].pdf_fwd = pdf_light_origin(scene, path[0], path[0]);
+    }
+}
+
+float Bdpt::mis_weight(const RenderContext& ctx, std::vector<PathVertex>& light, int s, std::vector<PathVertex>& camera, int t,
+                       const PathVertex& sampled, const EdgeDensities& known) const {
+    if (s + t == 2) return 1.0f;
+    const Scene& scene = ctx.scene;
+    // The strategy's own vertices: the sampled endpoint (y_0 for s = 1, z_0 for t = 1: the only
+    // vertex of its side the walk reads), and the densities across the new edge.
+    PathVertex end = sampled;
+    PathVertex* const ys = s == 1 ? &end : light.data();
+    PathVertex* const zs = t == 1 ? &end : camera.data();
+    PathVertex* qs = s > 0 ? &ys[s - 1] : nullptr;
+    PathVertex* pt = &zs[t - 1];
+    PathVertex* qs_minus = s > 1 ? &ys[s - 2] : nullptr;
+    PathVertex* pt_minus = t > 1 ? &zs[t - 2] : nullptr;
+    struct Saved {
+        PathVertex* v;
+        float pdf_rev;
+        bool delta;
+    };
+    Saved saved[4] = {{qs, 0, false}, {pt, 0, false}, {qs_minus, 0, false}, {pt_minus, 0, false}};
+    for (Saved& x : saved)
+        if (x.v) x.pdf_rev = x.v->pdf_rev, x.delta = x.v->delta;
+    // The connected vertices are not Dirac here (the connection evaluated their BSDFs).
+    pt->delta = false;
+    if (qs) qs->delta = false;
+    if (s == 0) pt->pdf_rev = pdf_light_origin(scene, *pt, *pt_minus);
+    else if (known.qs_to_pt >= 0) pt->pdf_rev = to_area_density(known.qs_to_pt, *qs, *pt);
+    else pt->pdf_rev = pdf_next(scene, ctx.camera, qs_minus, *qs, *pt);
+    if (pt_minus) pt_minus->pdf_rev = s > 0 ? pdf_next(scene, ctx.camera, qs, *pt, *pt_minus) : pdf_light_emission(scene, *pt, *pt_minus);
+    if (qs) qs->pdf_rev = known.pt_to_qs >= 0 ? to_area_density(known.pt_to_qs, *pt, *qs) : pdf_next(scene, ctx.camera, pt_minus, *pt, *qs);
+    if (qs_minus) qs_minus->pdf_rev = pdf_next(scene, ctx.camera, pt, *qs, *qs_minus);
+
+    float w = 0;
+    if (faults_.drop_nee_strategy && s != 1) {
+        // The faulty weight: the same walk without the s = 1 term.
+        const auto remap0 = [](float f) { return f != 0 ? double(f) : 1.0; };
+        double sum = 0, ri = 1;
+        for (int i = t - 1; i > 0; --i) {
+            ri *= remap0(zs[i].pdf_rev) / remap0(zs[i].pdf_fwd);
+            if (!zs[i].delta && !zs[i - 1].delta && s + (t - i) != 1) sum += ri;
+        }
+        ri = 1;
+        for (int i = s - 1; i >= 0; --i) {
+            ri *= remap0(ys[i].pdf_rev) / remap0(ys[i].pdf_fwd);
+            const bool delta_before = i > 0 ? ys[i - 1].delta : ys[0].delta_light;
+            if (!ys[i].delta && !delta_before && i != 1) sum += ri;
+        }
+        w = float(1 / (1 + sum));
+    } else {
+        w = mis_weight_ratio_walk(ys, s, zs, t, options_.mis_power);
+    }
+
+    for (Saved& x : saved)
+        if (x.v) x.v->pdf_rev = x.pdf_rev, x.v->delta = x.delta;
+    return w;
+}
+
+StrategyResult Bdpt::connect(const RenderContext& ctx, std::vector<PathVertex>& light, int s, std::vector<PathVertex>& camera, int t,
+                             Sampler& sampler) const {
+    const Scene& scene = ctx.scene;
+    StrategyResult r;
+    PathVertex sampled;
+    EdgeDensities known;  // the BSDF densities across the new edge, from the evaluations below
+    const PathVertex& pt = camera[size_t(t - 1)];
+    // A camera subpath that escaped ends at infinity: only s = 0 can use that vertex.
+    if (t > 1 && s != 0 && pt.kind == VertexKind::Light) return r;
+    if (s == 0) {
+        if (pt.kind == VertexKind::Light) {
+            r.L = pt.beta * scene.escaped_radiance(pt.dir);
+        } else if (pt.light >= 0) {
+            const Vec3f w = normalize(camera[size_t(t - 2)].p - pt.p);
+            if (dot(pt.emitter_n, w) > 0) r.L = pt.beta * surface_radiance(scene.lights()[size_t(pt.light)]);
+        }
+    } else if (t == 1) {
+        const PathVertex& qs = light[size_t(s - 1)];
+        if (!qs.connectible() || qs.kind != VertexKind::Surface) return r;
+        const auto k = ctx.camera.connect(qs.p);
+        if (!k) return r;
+        sampled.kind = VertexKind::Camera;
+        sampled.p = ctx.camera.position();
+        sampled.beta = Rgb(k->We / k->pdfW);
+        r.L = qs.beta * bsdf_towards(qs, k->wi, known.qs_to_pt) * sampled.beta * cos_at(qs, k->wi);
+        if (is_black(r.L) || scene.occluded(qs.segment_to(sampled))) return StrategyResult{};
+        r.splat = true;
+        r.raster = k->raster;
+    } else if (s == 1) {
+        if (!pt.connectible()) return r;
+        const LightChoice choice = scene.choose_light(sampler.next1d());
+        const Vec2f u = sampler.next2d();
+        if (choice.index < 0) return r;
+        const Light& l = scene.lights()[size_t(choice.index)];
+        const auto ls = sample_light(l, pt.p, u);
+        if (!ls || is_black(ls->Le) || !(ls->pdfW > 0)) return r;
+        const uint32_t flags = light_flags(l);
+        sampled.kind = VertexKind::Light;
+        sampled.infinite = (flags & kLightInfinite) != 0;
+        sampled.delta_light = is_delta_light(l);
+        sampled.dir = ls->wi;
+        sampled.p = std::isinf(ls->distance) ? pt.p + ls->wi : ls->point;
+        sampled.n = (flags & kLightSurface) ? ls->normal : Vec3f(0.0f);
+        sampled.emitter_n = ls->normal;
+        sampled.light = choice.index;
+        sampled.beta = ls->Le / (choice.pmf * ls->pdfW);
+        sampled.pdf_fwd = pdf_light_origin(scene, sampled, pt);
+        r.L = pt.beta * bsdf_towards(pt, ls->wi, known.pt_to_qs) * sampled.beta * cos_at(pt, ls->wi);
+        if (is_black(r.L) || scene.occluded(pt.segment_to(sampled))) return StrategyResult{};
+    } else {
+        const PathVertex& qs = light[size_t(s - 1)];
+        if (!qs.connectible() || !pt.connectible() || qs.kind != VertexKind::Surface) return r;
+        const Vec3f d = qs.p - pt.p;
+        const float dist2 = dot(d, d);
+        if (!(dist2 > 0)) return r;
+        const Vec3f w = d / std::sqrt(dist2);  // from pt towards qs
+        const float G = cos_at(pt, w) * cos_at(qs, w) / dist2;
+        r.L = qs.beta * bsdf_towards(qs, -w, known.qs_to_pt) * bsdf_towards(pt, w, known.pt_to_qs) * pt.beta * G;
+        if (is_black(r.L) || scene.occluded(pt.segment_to(qs))) return StrategyResult{};
+    }
+    if (is_black(r.L)) return r;
+    r.weight = mis_weight(ctx, light, s, camera, t, sampled, known);
+    return r;
+}
+
+PassCounters Bdpt::render_passes(const RenderContext& ctx, Film& film, uint64_t first, int count, const PassProgress& progress) {
+    const size_t pixels = ctx.pixel_count(), per_chunk = chunk_size(pixels);
+    const int chunks = int((pixels + per_chunk - 1) / per_chunk);
+    const int strategies_depth = strategies_ ? strategies_->max_length() : -1;
+    std::atomic<uint64_t> rays{0}, invalid{0};
+    for (int k = 0; k < count; ++k) {
+        const uint64_t pass = first + uint64_t(k);
+        pass_.begin(pixels, chunks);
+        if (strategies_) strategies_->begin_pass(ctx.width, ctx.height, chunks);
+        std::atomic<int> chunks_done{0};
+        tbb::parallel_for(tbb::blocked_range<int>(0, chunks, 1), [&](const tbb::blocked_range<int>& range) {
+            // Each thread's subpath vectors keep their capacity from pass to pass.
+            auto& [camera, light] = subpaths_.local();
+            for (int c = range.begin(); c != range.end(); ++c) {
+                const uint64_t rays_before = Scene::rays_traced_by_this_thread();
+                uint64_t chunk_invalid = 0;
+                SplatList& splats = pass_.chunk(c);
+                for (size_t pixel = size_t(c) * per_chunk; pixel < std::min(pixels, size_t(c + 1) * per_chunk); ++pixel) {
+                    Sampler camera_sampler(ctx.seed, pixel, pass, ctx.sampler);
+                    Sampler light_sampler(ctx.seed, sample_stream(pixel, 1), pass, ctx.sampler);
+                    camera_subpath(ctx, pixel, camera_sampler, camera);
+                    light_subpath(ctx, light_sampler, light);
+                    for (int t = 1; t <= int(camera.size()); ++t) {
+                        Sampler sampler(ctx.seed, sample_stream(pixel, 1 + uint64_t(t)), pass, ctx.sampler);
+                        // s = 1 samples its own light point: it exists even when the light
+                        // subpath does not (an emission sample that failed).
+                        for (int s = 0; s <= std::max(1, int(light.size())); ++s) {
+                            const int depth = s + t - 2;
+                            if ((s == 1 && t == 1) || depth < 0 || depth > max_bounces_) continue;
+                            if (options_.only_length >= 0 && depth != options_.only_length) continue;
+                            const StrategyResult r = connect(ctx, light, s, camera, t, sampler);
+                            if (is_black(r.L)) continue;
+                            const Rgb value = r.L * r.weight;
+                            if (!is_finite(value)) {
+                                ++chunk_invalid;
+                                continue;
+                            }
+                            const uint32_t target = r.splat ? uint32_t(ctx.camera.pixel_of(r.raster)) : uint32_t(pixel);
+                            if (r.splat) splats.add(target, value);
+                            else pass_.pixel(pixel) += Vec3d(value);
+                            if (depth <= strategies_depth)
+                                strategies_->chunk(c).push_back({target, uint16_t(StrategyImages::index(s, t)), value, r.L});
+                        }
+                    }
+                }
+                rays += Scene::rays_traced_by_this_thread() - rays_before;
+                invalid += chunk_invalid;
+                if (progress) progress((double(k) + double(++chunks_done) / chunks) / count);
+            }
+        });
+        pass_.finish(film);
+        if (strategies_) strategies_->finish_pass();
+    }
+    return {rays.load(), invalid.load()};
+}
+
+void Bdpt::finish(const RenderContext&) {
+    if (strategies_) strategies_->write();
+}
+
+const IntegratorInfo& bdpt_integrator() {
+    static const IntegratorInfo info{"bdpt", {"bpt"}, "bidirectional path tracing: every connection strategy (s, t), combined by MIS",
+                                     false, true, path_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
+                                         return std::make_unique<Bdpt>(o);
+                                     }};
+    return info;
+}
+
+}  // namespace pathlab

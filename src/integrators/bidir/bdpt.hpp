@@ -1,0 +1,105 @@
+// bdpt (alias bpt): bidirectional path tracing (Veach's thesis, ch. 10). Each pixel sample
+// traces a camera subpath z_0 (the pinhole), z_1, ... and a light subpath y_0 (on a light),
+// y_1, ..., and joins them by every strategy (s, t): the first s light vertices and the first t
+// camera vertices, connected by one edge between y_{s-1} and z_{t-1} (t >= 1; the pinhole cannot
+// be hit, so t = 0 does not exist):
+//   s = 0   the camera subpath hits an emitter (or escapes to the environment) by itself;
+//   s = 1   next-event estimation: a light point (or direction) sampled from z_{t-1};
+//   t = 1   light tracing: y_{s-1} connected to the camera, splatted onto its pixel;
+//   else    an inner connection with a shadow ray.
+// s = t = 1 (a light connected to the camera) is not used: emitters seen directly come from
+// s = 0, t = 2 alone. The strategies that produce one path are combined by multiple importance
+// sampling, the balance heuristic by default or the power heuristic (`--mis power`), with the
+// weights computed by Veach's ratio walk over the densities stored on the vertices
+// (path_vertex.hpp), as pbrt formulates it. Dirac lobes (mirrors, glass, the coating of
+// plastic), delta lights (point, directional), the constant environment and one-sided emitters
+// each enter the densities as path_vertex.hpp says.
+//
+// Depth: a path of s + t vertices has s + t - 2 bounces, counted as the path tracers count
+// them, so `--max-depth` means the same and bdpt converges to pt-mis's image at every depth.
+// Russian roulette acts on each subpath's scattering throughput after --rr-depth bounces, by
+// the path tracers' rule; it divides the throughput by the survival probability and leaves the
+// MIS densities alone (any weights that sum to one keep the estimator unbiased).
+//
+// One pass is one sample per pixel; pixels are processed in fixed chunks, each pixel's own
+// contributions (t >= 2) go to it directly and light-tracing splats (t = 1) to the chunk's
+// list, merged in chunk order: bit-identical for any thread count.
+//
+// `--strategies DIR` also writes, for paths of up to --strategies-depth bounces, one image per
+// strategy, weighted and unweighted (strategy_images.hpp).
+#pragma once
+
+#include <tbb/enumerable_thread_specific.h>
+
+#include <memory>
+#include <vector>
+
+#include "integrators/bidir/path_vertex.hpp"
+#include "integrators/common/path_rules.hpp"
+#include "integrators/integrator.hpp"
+#include "render/pass_image.hpp"
+
+namespace pathlab {
+
+class StrategyImages;
+
+// Deliberate faults, for the tests that must be able to fail (never set by pathlab itself).
+struct BdptFaults {
+    bool drop_nee_strategy = false;      // MIS weights leave the s = 1 strategies out of their sums
+    bool specular_pdf_rev_missing = false;  // a Dirac vertex's reverse density left unset (0)
+};
+
+// What one strategy gives for one sample: the unweighted contribution, its MIS weight, and for
+// t = 1 the raster position it lands on.
+struct StrategyResult {
+    Rgb L{0.0f};
+    float weight = 0;
+    bool splat = false;
+    Vec2f raster;
+};
+
+// Solid-angle BSDF densities across a connection's new edge that the caller already has
+// (negative: not known, computed from the vertices).
+struct EdgeDensities {
+    float pt_to_qs = -1;  // z_{t-1}'s BSDF sampling the direction to y_{s-1}
+    float qs_to_pt = -1;  // y_{s-1}'s BSDF sampling the direction to z_{t-1}
+};
+
+class Bdpt final : public Integrator {
+public:
+    explicit Bdpt(const IntegratorOptions& options, BdptFaults faults = {});
+    ~Bdpt() override;
+
+    PassCounters render_passes(const RenderContext& ctx, Film& film, uint64_t first, int count,
+                               const PassProgress& progress) override;
+    void finish(const RenderContext& ctx) override;
+
+    // The subpaths of one sample (for the tests and the per-pixel loop).
+    void camera_subpath(const RenderContext& ctx, size_t pixel, Sampler& sampler, std::vector<PathVertex>& path) const;
+    void light_subpath(const RenderContext& ctx, Sampler& sampler, std::vector<PathVertex>& path) const;
+    // Strategy (s, t) on the subpaths (which it may modify temporarily).
+    StrategyResult connect(const RenderContext& ctx, std::vector<PathVertex>& light, int s, std::vector<PathVertex>& camera, int t,
+                           Sampler& sampler) const;
+    // The MIS weight of strategy (s, t); `sampled` replaces y_0 (s = 1) or z_0 (t = 1).
+    float mis_weight(const RenderContext& ctx, std::vector<PathVertex>& light, int s, std::vector<PathVertex>& camera, int t,
+                     const PathVertex& sampled, const EdgeDensities& known = {}) const;
+
+    // The per-strategy films (null without --strategies).
+    const StrategyImages* strategy_images() const { return strategies_.get(); }
+
+    int max_camera_vertices() const { return max_bounces_ + 2; }
+    int max_light_vertices() const { return max_bounces_ + 1; }
+
+private:
+    void random_walk(const RenderContext& ctx, Ray ray, Sampler& sampler, Rgb beta, float pdfW, int max_vertices,
+                     TransportMode mode, std::vector<PathVertex>& path) const;
+
+    IntegratorOptions options_;
+    BdptFaults faults_;
+    int max_bounces_;
+    PassImage pass_;
+    tbb::enumerable_thread_specific<std::pair<std::vector<PathVertex>, std::vector<PathVertex>>> subpaths_;  // camera, light
+    std::unique_ptr<StrategyImages> strategies_;
+};
+
+}  // namespace pathlab

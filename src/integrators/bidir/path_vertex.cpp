@@ -1,0 +1,98 @@
+#include "integrators/bidir/path_vertex.hpp"
+
+#include <cmath>
+
+namespace pathlab {
+
+Ray PathVertex::segment_to(const PathVertex& to) const {
+    const Vec3f offset_n = kind == VertexKind::Surface ? sp.ng : n;
+    if (to.infinite) return is_black(offset_n) ? Ray{p, to.dir, kInf} : spawn_ray(p, offset_n, to.dir);
+    return spawn_segment(p, offset_n, to.p, to.kind == VertexKind::Surface ? to.sp.ng : to.n);
+}
+
+float to_area_density(float pdfW, const PathVertex& from, const PathVertex& to) {
+    if (to.infinite) return pdfW;
+    const Vec3f d = to.p - from.p;
+    const float dist2 = dot(d, d);
+    if (!(dist2 > 0)) return 0.0f;
+    float pdf = pdfW / dist2;
+    if (to.has_normal()) pdf *= std::abs(dot(to.n, d)) / std::sqrt(dist2);
+    return pdf;
+}
+
+namespace {
+
+// The unit direction from `from` towards `to` (for a vertex at infinity, its direction).
+Vec3f direction(const PathVertex& from, const PathVertex& to) { return to.infinite ? to.dir : normalize(to.p - from.p); }
+
+}  // namespace
+
+float pdf_next(const Scene& scene, const PerspectiveCamera& camera, const PathVertex* prev, const PathVertex& cur,
+               const PathVertex& next) {
+    if (cur.kind == VertexKind::Light) return pdf_light_emission(scene, cur, next);
+    const Vec3f wn = direction(cur, next);
+    float pdfW = 0;
+    if (cur.kind == VertexKind::Camera) {
+        pdfW = camera.pdf_direction(wn);
+    } else {
+        if (!prev) return 0.0f;
+        const Vec3f wp = direction(cur, *prev);
+        pdfW = cur.sp.material->pdf(cur.sp.frame.to_local(wp), cur.sp.frame.to_local(wn));
+    }
+    return to_area_density(pdfW, cur, next);
+}
+
+float pdf_light_emission(const Scene& scene, const PathVertex& v, const PathVertex& next) {
+    if (v.light < 0) return 0.0f;
+    const SceneSphere sphere = scene.scene_sphere();
+    if (v.infinite) {
+        // An origin on the entry disk, then straight on: area density at `next` by projection.
+        float pdf = entry_disk_pdfA(sphere);
+        if (next.has_normal()) pdf *= std::abs(dot(next.n, v.dir));
+        return pdf;
+    }
+    const Vec3f d = next.p - v.p;
+    const float dist2 = dot(d, d);
+    if (!(dist2 > 0)) return 0.0f;
+    const Vec3f w = d / std::sqrt(dist2);
+    const EmissionPdf e = pdf_emission(scene.lights()[size_t(v.light)], v.p, v.emitter_n, w, sphere);
+    float pdf = e.pdfW / dist2;
+    if (next.has_normal()) pdf *= std::abs(dot(next.n, w));
+    return pdf;
+}
+
+float pdf_light_origin(const Scene& scene, const PathVertex& v, const PathVertex& from) {
+    if (v.light < 0) return 0.0f;
+    const Light& light = scene.lights()[size_t(v.light)];
+    if (v.infinite) {
+        // Light sampling picks directions at infinity: only the environment has a density.
+        if (const auto* env = std::get_if<EnvironmentLight>(&light)) return scene.light_pmf(v.light) * env->pdf_li(v.dir);
+        return 0.0f;
+    }
+    const Vec3f w = normalize(from.p - v.p);
+    return scene.light_pmf(v.light) * pdf_emission(light, v.p, v.emitter_n, w, scene.scene_sphere()).pdfA;
+}
+
+float mis_weight_ratio_walk(const PathVertex* light, int s, const PathVertex* camera, int t, bool power) {
+    if (s + t == 2) return 1.0f;  // a light seen directly: only s = 0 samples it (s = t = 1 is not used)
+    // A density of 0 marks a Dirac lobe: those strategies are left out, and the ratio passes
+    // through the vertex unchanged.
+    const auto remap0 = [](float f) { return f != 0 ? double(f) : 1.0; };
+    const auto h = [power](double r) { return power ? r * r : r; };
+    double sum = 0, ri = 1;
+    // Strategies with fewer light vertices: the camera subpath's vertices, taken from the light side.
+    for (int i = t - 1; i > 0; --i) {
+        ri *= remap0(camera[i].pdf_rev) / remap0(camera[i].pdf_fwd);
+        if (!camera[i].delta && !camera[i - 1].delta) sum += h(ri);
+    }
+    // Strategies with more light vertices.
+    ri = 1;
+    for (int i = s - 1; i >= 0; --i) {
+        ri *= remap0(light[i].pdf_rev) / remap0(light[i].pdf_fwd);
+        const bool delta_before = i > 0 ? light[i - 1].delta : light[0].delta_light;
+        if (!light[i].delta && !delta_before) sum += h(ri);
+    }
+    return float(1 / (1 + sum));
+}
+
+}  // namespace pathlab

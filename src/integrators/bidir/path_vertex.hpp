@@ -1,0 +1,73 @@
+// Vertices of bidirectional subpaths and the densities that multiple importance sampling needs.
+//
+// A vertex stores the density with which it was sampled from its predecessor on its own
+// subpath (pdf_fwd) and the density with which the next vertex of the subpath would have
+// sampled it, had the path been traced the other way (pdf_rev). Both are per unit area at the
+// vertex (Veach's thesis, ch. 10), except for vertices at infinity (a camera ray that escaped to
+// the environment, or the light vertex of an environment or directional light), whose density
+// is per unit solid angle of their direction. A Dirac scattering (mirror, glass, the coating of
+// plastic) makes both 0 and sets `delta`: no strategy may connect there.
+//
+// These are the pieces of Veach's ratio form of the MIS weight (pbrt's formulation): for a
+// path of n + 1 vertices sampled by strategy (s, t), the weight is 1 / sum_i (p_i / p_s)^beta,
+// and the ratios p_{i+1} / p_i of neighbouring strategies are pdf_rev / pdf_fwd of one vertex.
+#pragma once
+
+#include <vector>
+
+#include "integrators/common/shading.hpp"
+
+namespace pathlab {
+
+enum class VertexKind : unsigned char { Camera, Light, Surface };
+
+struct PathVertex {
+    VertexKind kind = VertexKind::Surface;
+    Vec3f p;                 // position (on the entry disk for a light at infinity)
+    Vec3f n{0.0f};           // geometric normal for the G term (zero: a point, e.g. the pinhole)
+    Vec3f emitter_n{0.0f};   // the emitter's own normal (its emitting side), where it is one
+    Vec3f dir{0.0f};         // at infinity: the unit direction from the scene towards the light
+    ShadingPoint sp;         // surface vertices: material, frame, arrival direction, mode
+    Rgb beta{0.0f};          // throughput of the subpath up to and including this vertex
+    float pdf_fwd = 0, pdf_rev = 0;
+    bool delta = false;      // scattered by a Dirac lobe here
+    bool infinite = false;   // a light at infinity
+    bool delta_light = false;  // a point or directional light
+    int light = -1;          // the light of a light vertex, or of the emitter a surface lies on
+
+    bool has_normal() const { return !is_black(n); }
+    // Whether a strategy may connect a new edge here.
+    bool connectible() const {
+        switch (kind) {
+            case VertexKind::Camera: return true;
+            case VertexKind::Light: return !(delta_light && infinite);  // not a directional light
+            case VertexKind::Surface: return !sp.material->is_delta();
+        }
+        return false;
+    }
+    // Where a connecting ray leaves this vertex for `to` (offset off its surface).
+    Ray segment_to(const PathVertex& to) const;
+};
+
+// The solid-angle density pdfW at `from` of the direction to `to`, as an area density at `to`
+// (kept in solid angle if `to` is at infinity).
+float to_area_density(float pdfW, const PathVertex& from, const PathVertex& to);
+
+// The density with which `cur` samples `next`, having been reached from `prev` (null for the
+// first vertex of a subpath); per unit area at `next`.
+float pdf_next(const Scene& scene, const PerspectiveCamera& camera, const PathVertex* prev, const PathVertex& cur,
+               const PathVertex& next);
+// The density with which the light at vertex `v` (a light vertex, or a surface on an emitter)
+// emits towards `next`, per unit area at `next`.
+float pdf_light_emission(const Scene& scene, const PathVertex& v, const PathVertex& next);
+// The density with which light sampling chooses and samples `v` as a light's origin (its
+// position for finite lights, its direction for lights at infinity), looking from `from`.
+float pdf_light_origin(const Scene& scene, const PathVertex& v, const PathVertex& from);
+
+// The balance (power = false) or power heuristic weight of strategy (s, t) for the path made
+// of light[0..s) and camera[0..t), from their stored densities: Veach's ratio walk. `light`
+// and `camera` hold the subpaths with the connecting vertices' densities already updated for
+// this strategy (see Bdpt::mis_weight); vertices are left unchanged.
+float mis_weight_ratio_walk(const PathVertex* light, int s, const PathVertex* camera, int t, bool power);
+
+}  // namespace pathlab

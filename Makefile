@@ -28,6 +28,7 @@ bench: build
 	$(BUILD)/bench/pathlab_bench perf --json out/bench/performance.json
 	$(BUILD)/bench/pathlab_bench lt
 	$(BUILD)/bench/pathlab_bench bdpt
+	$(BUILD)/bench/pathlab_bench pm
 
 # Equal-spp and equal-time RMSE of the course's estimators on the 8 scenes (about 10 minutes).
 bench-estimators: build

@@ -6,11 +6,13 @@
 //   pathlab_bench pt       the same for the path tracers 4a, 4b, 4c
 //   pathlab_bench lt       light tracing: paths/s next to pt-mis, and splat accumulation
 //   pathlab_bench bdpt     bdpt against pt-mis: equal-time RMSE, and samples per second
+//   pathlab_bench pm       photons per second; hashed grid against k-d tree (build, query)
 #include <CLI/CLI.hpp>
 
 #include "bidirectional.hpp"
 #include "estimator_efficiency.hpp"
 #include "light_tracing.hpp"
+#include "photon_mapping.hpp"
 #include "performance.hpp"
 
 int main(int argc, char** argv) {
@@ -58,7 +60,13 @@ int main(int argc, char** argv) {
     bd->add_option("--repeats", b.repeats, "Timed pairs per scene (median reported)")->capture_default_str();
     bd->add_option("--ref-spp", b.ref_spp, "Samples per pixel of each reference (bdpt)")->capture_default_str();
     bd->add_option("--scenes", b.scenes, "Course scene indices and scene files of scenes/")->delimiter(',')->capture_default_str();
+    PhotonMappingOptions pm;
+    CLI::App* pmc = app.add_subcommand("pm", "Photons per second; hashed grid against k-d tree");
+    pmc->add_option("--light-paths", pm.light_paths, "Light paths traced per scene")->capture_default_str();
+    pmc->add_option("--size", pm.size, "Queries: one per pixel of a size x size image")->capture_default_str();
+    pmc->add_option("--repeats", pm.repeats, "Timed repeats (median reported)")->capture_default_str();
     CLI11_PARSE(app, argc, argv);
+    if (*pmc) photon_mapping_suite(pm);
     if (*bd) bidirectional_suite(b);
     if (*lt) light_tracing_suite(l);
     if (*perf) performance_suite(p);

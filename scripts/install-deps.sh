@@ -8,7 +8,7 @@ set -euo pipefail
 packages=(
   build-essential cmake pkg-config
   libembree-dev libtbb-dev libopenexr-dev libstb-dev
-  libcli11-dev libfmt-dev nlohmann-json3-dev libpugixml-dev libtinyobjloader-dev
+  libcli11-dev libfmt-dev nlohmann-json3-dev libpugixml-dev libtinyobjloader-dev libnanoflann-dev
   libgtest-dev libbenchmark-dev
   chromium
 )

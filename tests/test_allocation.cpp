@@ -1,12 +1,14 @@
 // The hot path allocates nothing: every estimator's radiance() for thousands of samples, the
 // light tracer's paths once its splat list has the size of a pass, and bdpt's subpaths and
-// connections, make no heap allocation (counted by
+// connections, and sppm's iterations (but a few), make no heap allocation (counted by
 // replacing operator new in this test binary).
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include "instrument/allocation_counter.hpp"
 #include "integrators/bidir/bdpt.hpp"
 #include "integrators/bidir/light_tracer.hpp"
+#include "integrators/photon/sppm.hpp"
 #include "job/renderer.hpp"
 #include "scene/builtin_scenes.hpp"
 
@@ -80,6 +82,20 @@ TEST(Allocation, NoEstimatorAllocatesPerSample) {
                 for (uint64_t j = 0; j < 4096; ++j) weights += sample(j, 1);
                 EXPECT_EQ(allocations_by_this_thread() - before, 0u) << info.name << " on scene " << index;
                 EXPECT_GT(weights, 100.0f) << "the strategies must connect";
+                continue;
+            }
+            if (auto* sppm = dynamic_cast<Sppm*>(integrator.get())) {
+                // Iterations: after two (which size the photon and grid arrays), an iteration
+                // of 4096 light paths makes no allocation per photon.
+                // One thread: the counter sees this thread's allocations only.
+                tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+                const RenderContext ctx{*scene, camera, 64, 64, 7, SamplerKind::Independent, 32};
+                Film film(64, 64);
+                sppm->render_passes(ctx, film, 0, 2, {});
+                const uint64_t before = allocations_by_this_thread();
+                sppm->render_passes(ctx, film, 2, 1, {});
+                // (a chunk's photon list that outgrows its capacity, at most once per chunk)
+                EXPECT_LT(allocations_by_this_thread() - before, 64u) << info.name << " on scene " << index;
                 continue;
             }
             const auto* estimator = dynamic_cast<const PixelIntegrator*>(integrator.get());

@@ -168,6 +168,23 @@ TEST_F(Cli, BdptOptionsAreCheckedAndTheStrategiesWritten) {
     EXPECT_TRUE(differ) << "the power heuristic weighs the same paths differently";
 }
 
+// sppm's options: only with sppm, in range; a render with them runs.
+TEST_F(Cli, SppmOptionsAreChecked) {
+    CliResult r = run({"-s", "2", "-a", "pt-mis", "--photons", "1000", "-o", path("x.exr")});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_TRUE(contains(r.err, "--photons, --radius and --alpha set sppm's photons; pt-mis has none")) << r.err;
+    r = run({"-s", "2", "-a", "sppm", "--alpha", "1.5", "-o", path("x.exr")});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_TRUE(contains(r.err, "--alpha must be in (0, 1]")) << r.err;
+    r = run({"-s", "2", "-a", "sppm", "--radius", "-1", "-o", path("x.exr")});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_TRUE(contains(r.err, "--radius must be zero")) << r.err;
+    r = run({"-s", "2", "-a", "sppm", "--photons", "2000", "--radius", "0.05", "--alpha", "0.5", "--resolution", "8x8", "--spp", "3",
+             "-q", "-o", path("s.pfm")});
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(read_image(path("s.pfm")).pixel_count(), 64u);
+}
+
 // Ctrl-C during a long render: the binary writes the passes it finished, normalised by them,
 // so the image equals a one-shot render with that many samples, bit for bit.
 TEST_F(Cli, InterruptedRenderWritesWhatItHasCorrectlyNormalised) {

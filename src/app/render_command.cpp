@@ -82,6 +82,10 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
                    "bdpt: also write one image per strategy (s, t), weighted and unweighted, and montages, into this directory "
                    "(placeholders as for -o)");
     app.add_option("--strategies-depth", o.strategies_depth, "bdpt: ... for paths of up to this many bounces")->capture_default_str();
+    app.add_option("--photons", o.photons, "sppm: light paths per iteration (0: one per pixel)")->capture_default_str();
+    app.add_option("--radius", o.photon_radius, "sppm: the first iteration's photon radius (0: 0.5% of the scene's radius)")
+        ->capture_default_str();
+    app.add_option("--alpha", o.photon_alpha, "sppm: the radius reduction, in (0, 1]")->capture_default_str();
     app.add_flag("-q,--quiet", o.quiet, "No progress line and no summary");
 }
 
@@ -116,6 +120,9 @@ int run_render_command(const RenderCommandOptions& o) {
         throw UsageError(fmt::format("unknown MIS heuristic '{}'. Valid heuristics: balance, power", o.mis));
     request.mis_power = o.mis == "power";
     request.strategies_depth = o.strategies_depth;
+    request.photons = o.photons;
+    request.photon_radius = o.photon_radius;
+    request.photon_alpha = o.photon_alpha;
 
     std::vector<RenderJob> jobs;
     for (SceneChoice& choice : resolve_scenes(o.scene, defines)) jobs.emplace_back(std::move(choice), request);
@@ -135,6 +142,8 @@ int run_render_command(const RenderCommandOptions& o) {
                                                  jobs[k].scene_choice().name, jobs[j].scene_choice().name, path));
         for (const std::string& path : jobs[j].outputs) paths.output(path, "the output", /*image=*/true);
         if (!o.stats_path.empty()) paths.output(jobs[j].expand(o.stats_path), "--stats", /*image=*/false);
+        if ((o.photons != 0 || o.photon_radius != 0 || o.photon_alpha != 2.0 / 3.0) && jobs[j].integrator_info().name != "sppm")
+            throw UsageError(fmt::format("--photons, --radius and --alpha set sppm's photons; {} has none", jobs[j].integrator_info().name));
         if (o.mis == "power" && jobs[j].integrator_info().name != "bdpt")
             throw UsageError(fmt::format("--mis chooses the heuristic of bdpt; {} has its own", jobs[j].integrator_info().name));
         if (!o.strategies_dir.empty()) {

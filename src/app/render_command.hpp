@@ -31,6 +31,9 @@ struct RenderCommandOptions {
     std::string mis = "balance";
     std::string strategies_dir;
     int strategies_depth = 4;
+    int64_t photons = 0;
+    float photon_radius = 0;
+    double photon_alpha = 2.0 / 3.0;
 };
 
 void add_render_options(CLI::App& app, RenderCommandOptions& opt);

@@ -38,6 +38,11 @@ struct IntegratorOptions {
     bool mis_power = false;        // bdpt: the power heuristic (beta = 2) instead of the balance heuristic
     std::string strategies_dir;    // bdpt: write one image per strategy (s, t) there ("" for none)
     int strategies_depth = 4;      // bdpt: ... for paths of up to this many bounces
+    // Photon mapping (sppm): light paths per iteration (0: one per pixel), the first
+    // iteration's radius (0: from the scene's size) and the radius reduction alpha.
+    int64_t photons = 0;
+    float photon_radius = 0;
+    double photon_alpha = 2.0 / 3.0;
 };
 
 // What every pass of one render sees; fixed for the whole render.

@@ -17,5 +17,6 @@ const IntegratorInfo& pt_mis3_integrator();
 const IntegratorInfo& pt_mis_integrator();
 const IntegratorInfo& light_tracer_integrator();
 const IntegratorInfo& bdpt_integrator();
+const IntegratorInfo& sppm_integrator();
 
 }  // namespace pathlab

@@ -1,0 +1,130 @@
+// `pathlab_bench pm` (part of `make bench`): the photons of a few scenes (bdpt's light subpaths
+// at their non-Dirac vertices after one bounce, as sppm stores them), traced per second; then
+// the hashed grid against nanoflann's k-d tree: build time, the time of one radius query per
+// pixel's visible point (the first non-Dirac camera hit), and memory. Medians of repeats.
+#include "photon_mapping.hpp"
+
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <chrono>
+#include <cstdio>
+
+#include <fmt/format.h>
+
+#include "bench_common.hpp"
+#include "integrators/bidir/bdpt.hpp"
+#include "integrators/photon/photon_grid.hpp"
+#include "job/scene_choice.hpp"
+#include "scene/builtin_scenes.hpp"
+#include "scenefile/scene_file.hpp"
+
+namespace pathlab::bench {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+
+SceneDescription scene_of(const std::string& key) {
+    if (looks_like_scene_file(key)) return load_scene_file(std::string(PATHLAB_SOURCE_DIR) + "/scenes/" + key);
+    return make_builtin_scene(std::stoi(key));
+}
+
+std::vector<Photon> trace(const RenderContext& ctx, int paths, double& seconds) {
+    const Bdpt walker({});
+    const auto t0 = Clock::now();
+    const int chunks = 256, per = (paths + chunks - 1) / chunks;
+    std::vector<std::vector<Photon>> out(static_cast<size_t>(chunks));
+    tbb::parallel_for(0, chunks, [&](int c) {
+        std::vector<PathVertex> path;
+        for (int j = c * per; j < std::min(paths, (c + 1) * per); ++j) {
+            Sampler sampler(ctx.seed, uint64_t(j), 0);
+            walker.light_subpath(ctx, sampler, path);
+            for (size_t v = 2; v < path.size(); ++v)
+                if (path[v].kind == VertexKind::Surface && path[v].connectible())
+                    out[size_t(c)].push_back({path[v].p, path[v].sp.frame.to_world(path[v].sp.wi), path[v].beta, uint16_t(v)});
+        }
+    });
+    std::vector<Photon> photons;
+    for (const auto& c : out) photons.insert(photons.end(), c.begin(), c.end());
+    seconds = ms_since(t0) * 1e-3;
+    return photons;
+}
+
+// Each pixel's first non-Dirac camera hit (pixels that see nothing are left out).
+std::vector<Vec3f> visible_points(const RenderContext& ctx) {
+    std::vector<Vec3f> points;
+    for (size_t p = 0; p < ctx.pixel_count(); ++p) {
+        Ray ray = ctx.camera.generate(float(p % size_t(ctx.width)) + 0.5f, float(p / size_t(ctx.width)) + 0.5f);
+        Sampler sampler(1, p, 0);
+        for (int k = 0; k < 8; ++k) {
+            Intersection hit;
+            if (!ctx.scene.intersect(ray, hit)) break;
+            const ShadingPoint sp = make_shading_point(ctx.scene, hit, normalize(ray.d));
+            if (!sp.material->is_delta()) {
+                points.push_back(hit.p);
+                break;
+            }
+            const auto s = sp.material->sample(sp, sp.wi, sampler.next2d());
+            if (!s) break;
+            ray = sp.spawn(s->wo);
+        }
+    }
+    return points;
+}
+
+template <typename Search>
+void time_search(const std::vector<Photon>& photons, const std::vector<Vec3f>& queries, float r, int repeats, double& build_ms,
+                 double& query_ms, double& found) {
+    std::vector<double> builds, queries_ms;
+    for (int k = 0; k < repeats; ++k) {
+        Search s;
+        auto t0 = Clock::now();
+        s.build(photons, r);
+        builds.push_back(ms_since(t0));
+        std::vector<double> sums(queries.size());
+        t0 = Clock::now();
+        tbb::parallel_for(size_t(0), queries.size(), [&](size_t i) {
+            double n = 0;
+            s.for_each_within(queries[i], r, [&](const Photon& ph) { n += double(ph.power.x > -1); });
+            sums[i] = n;
+        });
+        queries_ms.push_back(ms_since(t0));
+        found = 0;
+        for (const double n : sums) found += n;
+        found /= double(std::max<size_t>(1, queries.size()));
+    }
+    build_ms = median(builds), query_ms = median(queries_ms);
+}
+
+}  // namespace
+
+void photon_mapping_suite(const PhotonMappingOptions& o) {
+    const int threads = std::min(2, tbb::this_task_arena::max_concurrency());
+    fmt::print("## Photons: {} light paths per scene; range search at {}x{} visible points, r = {} x the scene's radius "
+               "({} threads, medians of {})\n\n",
+               o.light_paths, o.size, o.size, o.radius_factor, threads, o.repeats);
+    fmt::print("| scene | photons | Mphotons/s | grid build ms | k-d tree build ms | grid query ms | k-d tree query ms | photons per query "
+               "| grid / k-d tree (build + query) |\n|---|---|---|---|---|---|---|---|---|\n");
+    for (const std::string& key : o.scenes) {
+        const auto scene = Scene::build(scene_of(key));
+        const PerspectiveCamera camera(scene->camera(), o.size, o.size);
+        const RenderContext ctx{*scene, camera, o.size, o.size, 5, SamplerKind::Independent, 32};
+        double seconds = 0;
+        const std::vector<Photon> photons = trace(ctx, o.light_paths, seconds);
+        const std::vector<Vec3f> queries = visible_points(ctx);
+        const float r = o.radius_factor * scene->scene_sphere().radius;
+        double gb = 0, gq = 0, gf = 0, kb = 0, kq = 0, kf = 0;
+        time_search<PhotonGrid>(photons, queries, r, o.repeats, gb, gq, gf);
+        time_search<PhotonKdTree>(photons, queries, r, o.repeats, kb, kq, kf);
+        if (gf != kf) fmt::print("(the two searches found different photons: {} against {})\n", gf, kf);
+        fmt::print("| {} | {} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {:.2f} |\n", key, photons.size(),
+                   double(photons.size()) / seconds * 1e-6, gb, kb, gq, kq, gf, (gb + gq) / (kb + kq));
+        std::fflush(stdout);
+    }
+    fmt::print("\nMemory: a photon is {} bytes; the grid adds 8 bytes per photon (cell ends and the sorted order), the k-d tree\n"
+               "its nodes and index (nanoflann: leaves of up to 10 points).\n",
+               sizeof(Photon));
+}
+
+}  // namespace pathlab::bench

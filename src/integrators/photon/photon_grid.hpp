@@ -1,0 +1,86 @@
+// Range search over photons, two ways (issue: measure both and keep the faster, see README):
+//   PhotonGrid    a hashed uniform grid of cells 2r wide (as SmallVCM's HashGrid): photons
+//                 sorted by cell with a counting sort; a query visits the 2 x 2 x 2 cells its
+//                 ball can touch;
+//   PhotonKdTree  nanoflann's k-d tree (a maintained library), radius search with a callback.
+// Both call f(photon) for exactly the photons within distance r of q (|p - q|^2 <= r^2), in an
+// order fixed by the photons' order: results do not depend on threads.
+#pragma once
+
+#include <cmath>
+#include <memory>
+#include <vector>
+
+#include "integrators/photon/photon.hpp"
+
+namespace pathlab {
+
+class PhotonGrid {
+public:
+    // `radius`: the largest query radius to come.
+    void build(const std::vector<Photon>& photons, float radius);
+    template <typename F> void for_each_within(const Vec3f& q, float r, F&& f) const;
+    size_t memory_bytes() const { return cell_ends_.capacity() * sizeof(uint32_t) + order_.capacity() * sizeof(uint32_t); }
+
+private:
+    size_t cell_index(int x, int y, int z) const {
+        return size_t((uint32_t(x) * 73856093u) ^ (uint32_t(y) * 19349663u) ^ (uint32_t(z) * 83492791u)) % cell_ends_.size();
+    }
+    const std::vector<Photon>* photons_ = nullptr;
+    Vec3f lo_{0.0f};
+    float cell_size_ = 1, inv_cell_ = 1;
+    std::vector<uint32_t> cell_ends_;  // photons of cell c: order_[cell_ends_[c-1] .. cell_ends_[c])
+    std::vector<uint32_t> order_;      // photon indices sorted by cell (stable: by index within a cell)
+};
+
+template <typename F> void PhotonGrid::for_each_within(const Vec3f& q, float r, F&& f) const {
+    if (!photons_ || photons_->empty()) return;
+    const float r2 = r * r;
+    // The cell holding q, and the neighbours on the side of q's position within it.
+    const Vec3f c = (q - lo_) * inv_cell_;
+    const int cx = int(std::floor(c.x)), cy = int(std::floor(c.y)), cz = int(std::floor(c.z));
+    const int px = c.x - float(cx) < 0.5f ? cx - 1 : cx, py = c.y - float(cy) < 0.5f ? cy - 1 : cy,
+              pz = c.z - float(cz) < 0.5f ? cz - 1 : cz;
+    // Two grid cells may hash to one table cell: visit each table cell once.
+    size_t visited[8];
+    int n_visited = 0;
+    for (int dz = 0; dz < 2; ++dz)
+        for (int dy = 0; dy < 2; ++dy)
+            for (int dx = 0; dx < 2; ++dx) {
+                const size_t cell = cell_index(px + dx, py + dy, pz + dz);
+                bool seen = false;
+                for (int k = 0; k < n_visited; ++k) seen |= visited[k] == cell;
+                if (seen) continue;
+                visited[n_visited++] = cell;
+                const uint32_t begin = cell == 0 ? 0 : cell_ends_[cell - 1], end = cell_ends_[cell];
+                for (uint32_t k = begin; k < end; ++k) {
+                    const Photon& ph = (*photons_)[order_[k]];
+                    const Vec3f d = ph.p - q;
+                    if (dot(d, d) <= r2) f(ph);
+                }
+            }
+}
+
+class PhotonKdTree {
+public:
+    PhotonKdTree();
+    ~PhotonKdTree();
+    void build(const std::vector<Photon>& photons, float radius);
+    template <typename F> void for_each_within(const Vec3f& q, float r, F&& f) const;
+
+    struct Index;  // nanoflann's, in photon_grid.cpp
+
+private:
+    // Calls back with photon indices (nanoflann's own order), which this sorts.
+    void within(const Vec3f& q, float r, std::vector<uint32_t>& out) const;
+    const std::vector<Photon>* photons_ = nullptr;
+    std::unique_ptr<Index> index_;
+};
+
+template <typename F> void PhotonKdTree::for_each_within(const Vec3f& q, float r, F&& f) const {
+    thread_local std::vector<uint32_t> found;
+    within(q, r, found);
+    for (const uint32_t i : found) f((*photons_)[i]);
+}
+
+}  // namespace pathlab

@@ -1,0 +1,141 @@
+#include "integrators/photon/sppm.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <atomic>
+#include <cmath>
+
+#include "integrators/common/direct_lighting.hpp"
+#include "integrators/common/path_rules.hpp"
+#include "integrators/integrators.hpp"
+
+namespace pathlab {
+namespace {
+
+// Streams of one pass's random numbers: camera paths use the pixel's own stream, light paths
+// (indexed from 0) theirs.
+uint64_t light_path_stream(size_t path) { return uint64_t(path) + (uint64_t(1) << 41); }
+
+size_t paths_per_chunk(size_t paths) { return std::max<size_t>(64, paths / 256); }
+
+}  // namespace
+
+Sppm::Sppm(const IntegratorOptions& options, SppmFaults faults)
+    : options_(limited_to_length(options)), faults_(faults),
+      max_bounces_(options_.max_depth < 0 ? kMaxBounces : std::min(options_.max_depth, kMaxBounces)), light_paths_(options_) {}
+
+double Sppm::radius(double r1, double alpha, uint64_t i) {
+    // r_i^2 = r_1^2 prod_{k=1}^{i-1} (k + alpha) / (k + 1) = r_1^2 Gamma(i + alpha) / (Gamma(1 + alpha) Gamma(i + 1))
+    const double log_ratio = std::lgamma(double(i) + alpha) - std::lgamma(1 + alpha) - std::lgamma(double(i) + 1);
+    return r1 * std::exp(0.5 * log_ratio);
+}
+
+float Sppm::initial_radius(const Scene& scene) const {
+    return options_.photon_radius > 0 ? options_.photon_radius : 0.005f * scene.scene_sphere().radius;
+}
+
+uint64_t Sppm::trace_photons(const RenderContext& ctx, uint64_t pass, size_t paths) {
+    const size_t per_chunk = paths_per_chunk(paths), chunks = (paths + per_chunk - 1) / per_chunk;
+    chunk_photons_.resize(chunks);
+    std::atomic<uint64_t> rays{0};
+    tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+        const uint64_t rays_before = Scene::rays_traced_by_this_thread();
+        std::vector<PathVertex>& path = paths_.local();  // keeps its capacity from pass to pass
+        std::vector<Photon>& out = chunk_photons_[c];
+        out.clear();
+        for (size_t j = c * per_chunk; j < std::min(paths, (c + 1) * per_chunk); ++j) {
+            Sampler sampler(ctx.seed, light_path_stream(j), pass, ctx.sampler);
+            light_paths_.light_subpath(ctx, sampler, path);
+            for (size_t v = 2; v < path.size(); ++v) {
+                const PathVertex& y = path[v];
+                if (y.kind != VertexKind::Surface || !y.connectible() || int(v) > max_bounces_) continue;
+                out.push_back({y.p, y.sp.frame.to_world(y.sp.wi), y.beta, uint16_t(std::min<size_t>(v, 65535))});
+            }
+        }
+        rays += Scene::rays_traced_by_this_thread() - rays_before;
+    });
+    photons_.clear();
+    for (const auto& c : chunk_photons_) photons_.insert(photons_.end(), c.begin(), c.end());
+    return rays.load();
+}
+
+Rgb Sppm::camera_sample(const RenderContext& ctx, size_t pixel, uint64_t pass, float r, size_t paths) const {
+    const Scene& scene = ctx.scene;
+    Sampler sampler(ctx.seed, pixel, pass, ctx.sampler);
+    const Vec2f jitter = sampler.next2d();
+    const float px = float(pixel % size_t(ctx.width)), py = float(pixel / size_t(ctx.width));
+    Ray ray = ctx.camera.generate(px + jitter.x, py + jitter.y);
+    Rgb L(0.0f), beta(1.0f);
+    const auto counts = [&](int length) { return options_.only_length < 0 || options_.only_length == length; };
+    // t: the index of the camera vertex the ray is about to find (z_1 first); t - 1 bounces before it.
+    for (int t = 1; t - 1 <= max_bounces_; ++t) {
+        Intersection hit;
+        if (!scene.intersect(ray, hit)) {
+            if (counts(t - 1)) L += beta * scene.escaped_radiance(ray.d);
+            break;
+        }
+        // Emission found directly or through Dirac lobes only: no other strategy has it.
+        if (counts(t - 1)) L += beta * emitted_radiance(scene, hit, -normalize(ray.d));
+        const ShadingPoint sp = make_shading_point(scene, hit, normalize(ray.d));
+        if (sp.material->is_black() || t > max_bounces_) break;
+        if (sp.material->is_delta()) {
+            const auto s = sp.material->sample(sp, sp.wi, sampler.next2d());
+            if (!s) break;
+            beta *= s->f * (std::abs(s->wo.z) / s->pdfW);
+            ray = sp.spawn(s->wo);
+            continue;
+        }
+        // The visible point: direct light by a light sample, the rest from the photons.
+        if (counts(t)) L += beta * estimate_light_sample(scene, sp, sampler, /*mis=*/false);
+        const float norm = float(paths) * (faults_.no_pi_in_kernel ? 1.0f : kPi) * r * r;
+        Rgb sum(0.0f);
+        grid_.for_each_within(sp.p, r, [&](const Photon& ph) {
+            const int bounces = t + int(ph.vertex) - 1;
+            if (bounces > max_bounces_ || !counts(bounces)) return;
+            sum += sp.material->eval(sp, sp.wi, sp.frame.to_local(ph.wi)) * ph.power;
+        });
+        L += beta * sum / norm;
+        break;
+    }
+    return L;
+}
+
+PassCounters Sppm::render_passes(const RenderContext& ctx, Film& film, uint64_t first, int count, const PassProgress& progress) {
+    const size_t pixels = ctx.pixel_count();
+    const size_t paths = options_.photons > 0 ? size_t(options_.photons) : pixels;
+    const double r1 = initial_radius(ctx.scene), alpha = options_.photon_alpha;
+    image_.resize(pixels);
+    std::vector<Vec3d>& image = image_;
+    std::atomic<uint64_t> rays{0}, invalid{0};
+    for (int k = 0; k < count; ++k) {
+        const uint64_t pass = first + uint64_t(k);
+        const float r = float(radius(r1, alpha, pass + 1));
+        rays += trace_photons(ctx, pass, paths);
+        grid_.build(photons_, r);
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, pixels, 64), [&](const tbb::blocked_range<size_t>& range) {
+            const uint64_t before = Scene::rays_traced_by_this_thread();
+            uint64_t bad = 0;
+            for (size_t p = range.begin(); p != range.end(); ++p) {
+                const Rgb L = camera_sample(ctx, p, pass, r, paths);
+                if (is_finite(L)) image[p] = Vec3d(L);
+                else image[p] = Vec3d(0.0), ++bad;
+            }
+            rays += Scene::rays_traced_by_this_thread() - before;
+            invalid += bad;
+        });
+        film.add_pass(image);
+        if (progress) progress(double(k + 1) / count);
+    }
+    return {rays.load(), invalid.load()};
+}
+
+const IntegratorInfo& sppm_integrator() {
+    static const IntegratorInfo info{
+        "sppm", {}, "stochastic progressive photon mapping (Knaus-Zwicker iterations): photons + next-event estimation", false, true,
+        path_params(),
+        [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> { return std::make_unique<Sppm>(o); }};
+    return info;
+}
+
+}  // namespace pathlab

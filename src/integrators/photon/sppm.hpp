@@ -1,0 +1,67 @@
+// sppm: stochastic progressive photon mapping (Hachisuka and Jensen 2009) in Knaus and
+// Zwicker's probabilistic formulation (2011): every pass is an independent iteration with its
+// own radius r_i, r_{i+1}^2 = r_i^2 (i + alpha) / (i + 1), so the image, the average of the
+// iterations' images, converges (bias and variance both vanish) for 0 < alpha < 1, and a render
+// split into parts gives the same result as one (the radius depends only on the pass index).
+//
+// An iteration: N light paths (--photons, default one per pixel) traced with the light
+// interface's emission sampling and the adjoint BSDFs, one photon stored wherever a path
+// meets a non-Dirac surface after at least one bounce (y_2, y_3, ...: direct light is next-event
+// estimation's); then per pixel one camera path, followed through Dirac lobes (mirrors, glass,
+// plastic's coating) to its first other surface x (the visible point), which adds the emission
+// found on the way, a light sample (next-event estimation) and the density estimate
+//   L(x, wo) = sum over photons p within r_i of f(x, wo, wi_p) power_p / (N pi r_i^2).
+// Depth: a photon at light vertex j merged at camera vertex t makes a path of t + j - 1 bounces,
+// which must not exceed --max-depth, so sppm converges to the path tracers' image at any depth.
+//
+// The initial radius (--radius, default: 0.5% of the scene's bounding-sphere radius; SmallVCM
+// uses 0.3%) and alpha (--alpha, default 2/3) trade bias against noise early on; the result
+// converges for any. The photons are searched with a hashed grid (photon_grid.hpp; measured
+// against a k-d tree in README). Deterministic: photons are stored in chunk order, and every
+// pixel sums its photons in the grid's fixed order.
+#pragma once
+
+#include <tbb/enumerable_thread_specific.h>
+
+#include <memory>
+#include <vector>
+
+#include "integrators/bidir/bdpt.hpp"
+#include "integrators/integrator.hpp"
+#include "integrators/photon/photon_grid.hpp"
+
+namespace pathlab {
+
+// Deliberate faults, for the tests that must be able to fail.
+struct SppmFaults {
+    bool no_pi_in_kernel = false;  // the density estimate divides by r^2 instead of pi r^2
+};
+
+class Sppm final : public Integrator {
+public:
+    explicit Sppm(const IntegratorOptions& options, SppmFaults faults = {});
+
+    PassCounters render_passes(const RenderContext& ctx, Film& film, uint64_t first, int count,
+                               const PassProgress& progress) override;
+
+    // The radius of iteration i (1-based) for the initial radius r1.
+    static double radius(double r1, double alpha, uint64_t i);
+    float initial_radius(const Scene& scene) const;
+
+private:
+    // The photons of one iteration into photons_, in chunk order; returns the rays traced.
+    uint64_t trace_photons(const RenderContext& ctx, uint64_t pass, size_t paths);
+    Rgb camera_sample(const RenderContext& ctx, size_t pixel, uint64_t pass, float r, size_t paths) const;
+
+    IntegratorOptions options_;
+    SppmFaults faults_;
+    int max_bounces_;
+    Bdpt light_paths_;  // its light subpaths are the photon paths
+    std::vector<std::vector<Photon>> chunk_photons_;
+    std::vector<Photon> photons_;
+    PhotonGrid grid_;
+    tbb::enumerable_thread_specific<std::vector<PathVertex>> paths_;  // each thread's light subpath
+    std::vector<Vec3d> image_;                                        // one iteration's image
+};
+
+}  // namespace pathlab

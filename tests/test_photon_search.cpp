@@ -1,0 +1,87 @@
+// Range search over photons: the hashed grid and nanoflann's k-d tree return exactly the
+// photons within r of a query (|p - q| <= r, the boundary included), the same as brute force,
+// on random and clustered photons, for queries inside and outside their bounds.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "core/rng.hpp"
+#include "integrators/photon/photon_grid.hpp"
+
+namespace pathlab::test {
+namespace {
+
+std::vector<uint32_t> brute_force(const std::vector<Photon>& photons, const Vec3f& q, float r) {
+    std::vector<uint32_t> out;
+    for (size_t i = 0; i < photons.size(); ++i) {
+        const Vec3f d = photons[i].p - q;
+        if (dot(d, d) <= r * r) out.push_back(uint32_t(i));
+    }
+    return out;
+}
+
+template <typename Search> std::vector<uint32_t> found(const Search& s, const std::vector<Photon>& photons, const Vec3f& q, float r) {
+    std::vector<uint32_t> out;
+    s.for_each_within(q, r, [&](const Photon& p) { out.push_back(uint32_t(&p - photons.data())); });
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+std::vector<Photon> random_photons(Pcg32& rng, size_t n) {
+    std::vector<Photon> photons;
+    for (size_t i = 0; i < n; ++i) {
+        Vec3f p(rng.next_float(), rng.next_float(), rng.next_float());
+        if (i % 3 == 0) p = Vec3f(0.3f) + (p - Vec3f(0.5f)) * 0.02f;  // a dense cluster
+        if (i % 97 == 0 && i > 0) p = photons[i - 1].p;               // duplicates
+        photons.push_back({p * 4.0f - Vec3f(1.0f), Vec3f(0, 0, 1), Rgb(1.0f), 2});
+    }
+    return photons;
+}
+
+TEST(PhotonSearch, GridAndKdTreeFindExactlyThePhotonsWithinTheRadius) {
+    Pcg32 rng(12, 34);
+    const std::vector<Photon> photons = random_photons(rng, 6000);
+    size_t grand_total = 0;
+    for (const float build_radius : {0.01f, 0.08f, 0.5f}) {
+        PhotonGrid grid;
+        PhotonKdTree tree;
+        grid.build(photons, build_radius);
+        tree.build(photons, build_radius);
+        size_t total = 0;
+        for (int k = 0; k < 600; ++k) {
+            // Queries in and around the photons' box, some at photons, radii up to the build radius.
+            Vec3f q = Vec3f(rng.next_float(), rng.next_float(), rng.next_float()) * 5.0f - Vec3f(1.5f);
+            if (k % 4 == 0) q = photons[size_t(rng.next_u32() % photons.size())].p;
+            const float r = build_radius * (k % 5 == 0 ? 1.0f : rng.next_float());
+            const std::vector<uint32_t> expected = brute_force(photons, q, r);
+            total += expected.size();
+            ASSERT_EQ(found(grid, photons, q, r), expected) << "grid, r=" << r << ", query " << k;
+            ASSERT_EQ(found(tree, photons, q, r), expected) << "k-d tree, r=" << r << ", query " << k;
+        }
+        EXPECT_GT(total, 150u) << "the queries at photons must find them";
+        grand_total += total;
+    }
+    EXPECT_GT(grand_total, 20000u) << "the larger radii must find many photons";
+}
+
+TEST(PhotonSearch, ThePhotonAtExactlyTheRadiusCountsAndNothingIsFoundInNothing) {
+    const std::vector<Photon> photons = {{Vec3f(0.5f), Vec3f(0, 0, 1), Rgb(1.0f), 2}, {Vec3f(0.5f, 0.5f, 1.5f), Vec3f(0, 0, 1), Rgb(1.0f), 2}};
+    PhotonGrid grid;
+    PhotonKdTree tree;
+    grid.build(photons, 0.25f);
+    tree.build(photons, 0.25f);
+    const Vec3f q(0.75f, 0.5f, 0.5f);  // exactly 0.25 from the first photon
+    EXPECT_EQ(found(grid, photons, q, 0.25f), std::vector<uint32_t>{0});
+    EXPECT_EQ(found(tree, photons, q, 0.25f), std::vector<uint32_t>{0});
+    EXPECT_TRUE(found(grid, photons, q, 0.2499f).empty());
+    EXPECT_TRUE(found(tree, photons, q, 0.2499f).empty());
+
+    const std::vector<Photon> none;
+    grid.build(none, 0.1f);
+    tree.build(none, 0.1f);
+    EXPECT_TRUE(found(grid, none, q, 0.1f).empty());
+    EXPECT_TRUE(found(tree, none, q, 0.1f).empty());
+}
+
+}  // namespace
+}  // namespace pathlab::test

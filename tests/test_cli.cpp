@@ -172,7 +172,10 @@ TEST_F(Cli, BdptOptionsAreCheckedAndTheStrategiesWritten) {
 TEST_F(Cli, SppmOptionsAreChecked) {
     CliResult r = run({"-s", "2", "-a", "pt-mis", "--photons", "1000", "-o", path("x.exr")});
     EXPECT_EQ(r.code, 2);
-    EXPECT_TRUE(contains(r.err, "--photons, --radius and --alpha set sppm's photons; pt-mis has none")) << r.err;
+    EXPECT_TRUE(contains(r.err, "--photons and --radius set the photons of sppm and pm; pt-mis has none")) << r.err;
+    r = run({"-s", "2", "-a", "pm", "--alpha", "0.5", "-o", path("x.exr")});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_TRUE(contains(r.err, "--alpha is sppm's radius reduction, not pm's")) << r.err;
     r = run({"-s", "2", "-a", "sppm", "--alpha", "1.5", "-o", path("x.exr")});
     EXPECT_EQ(r.code, 2);
     EXPECT_TRUE(contains(r.err, "--alpha must be in (0, 1]")) << r.err;

@@ -142,8 +142,11 @@ int run_render_command(const RenderCommandOptions& o) {
                                                  jobs[k].scene_choice().name, jobs[j].scene_choice().name, path));
         for (const std::string& path : jobs[j].outputs) paths.output(path, "the output", /*image=*/true);
         if (!o.stats_path.empty()) paths.output(jobs[j].expand(o.stats_path), "--stats", /*image=*/false);
-        if ((o.photons != 0 || o.photon_radius != 0 || o.photon_alpha != 2.0 / 3.0) && jobs[j].integrator_info().name != "sppm")
-            throw UsageError(fmt::format("--photons, --radius and --alpha set sppm's photons; {} has none", jobs[j].integrator_info().name));
+        const std::string& algorithm = jobs[j].integrator_info().name;
+        if ((o.photons != 0 || o.photon_radius != 0) && algorithm != "sppm" && algorithm != "pm")
+            throw UsageError(fmt::format("--photons and --radius set the photons of sppm and pm; {} has none", algorithm));
+        if (o.photon_alpha != 2.0 / 3.0 && algorithm != "sppm")
+            throw UsageError(fmt::format("--alpha is sppm's radius reduction, not {}'s", algorithm));
         if (o.mis == "power" && jobs[j].integrator_info().name != "bdpt")
             throw UsageError(fmt::format("--mis chooses the heuristic of bdpt; {} has its own", jobs[j].integrator_info().name));
         if (!o.strategies_dir.empty()) {

@@ -18,5 +18,6 @@ const IntegratorInfo& pt_mis_integrator();
 const IntegratorInfo& light_tracer_integrator();
 const IntegratorInfo& bdpt_integrator();
 const IntegratorInfo& sppm_integrator();
+const IntegratorInfo& pm_integrator();
 
 }  // namespace pathlab

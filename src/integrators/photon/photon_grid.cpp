@@ -90,4 +90,10 @@ void PhotonKdTree::within(const Vec3f& q, float r, std::vector<uint32_t>& out) c
     std::sort(out.begin(), out.end());
 }
 
+size_t PhotonKdTree::nearest(const Vec3f& q, size_t k, uint32_t* indices, float* dist2) const {
+    if (!index_ || photons_->empty()) return 0;
+    const float query[3] = {q.x, q.y, q.z};
+    return index_->tree.knnSearch(query, k, indices, dist2);
+}
+
 }  // namespace pathlab

@@ -68,6 +68,11 @@ public:
     void build(const std::vector<Photon>& photons, float radius);
     template <typename F> void for_each_within(const Vec3f& q, float r, F&& f) const;
 
+    // The k photons nearest to q (fewer if there are fewer), nearest first: their indices and
+    // squared distances into indices[0..k) and dist2[0..k); returns how many were found.
+    size_t nearest(const Vec3f& q, size_t k, uint32_t* indices, float* dist2) const;
+    const Photon& photon(uint32_t i) const { return (*photons_)[i]; }
+
     struct Index;  // nanoflann's, in photon_grid.cpp
 
 private:

@@ -86,8 +86,16 @@ Rgb Sppm::camera_sample(const RenderContext& ctx, size_t pixel, uint64_t pass, f
             ray = sp.spawn(s->wo);
             continue;
         }
-        // The visible point: direct light by a light sample, the rest from the photons.
-        if (counts(t)) L += beta * estimate_light_sample(scene, sp, sampler, /*mis=*/false);
+        // The visible point: direct light by a light sample and a BSDF sample combined by the
+        // balance heuristic (as in direct-mis: light sampling alone has infinite variance next
+        // to an area light), the rest from the photons.
+        if (counts(t)) {
+            L += beta * estimate_light_sample(scene, sp, sampler, /*mis=*/true);
+            if (const auto s = sp.material->sample(sp, sp.wi, sampler.next2d())) {
+                EmitterHit found;
+                L += beta * estimate_bsdf_sample_mis(scene, sp, *s, found);
+            }
+        }
         const float norm = float(paths) * (faults_.no_pi_in_kernel ? 1.0f : kPi) * r * r;
         Rgb sum(0.0f);
         grid_.for_each_within(sp.p, r, [&](const Photon& ph) {

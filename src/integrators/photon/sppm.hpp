@@ -9,7 +9,8 @@
 // meets a non-Dirac surface after at least one bounce (y_2, y_3, ...: direct light is next-event
 // estimation's); then per pixel one camera path, followed through Dirac lobes (mirrors, glass,
 // plastic's coating) to its first other surface x (the visible point), which adds the emission
-// found on the way, a light sample (next-event estimation) and the density estimate
+// found on the way, direct light (a light sample and a BSDF sample, by the balance heuristic:
+// light sampling alone has infinite variance next to an area light) and the density estimate
 //   L(x, wo) = sum over photons p within r_i of f(x, wo, wi_p) power_p / (N pi r_i^2).
 // Depth: a photon at light vertex j merged at camera vertex t makes a path of t + j - 1 bounces,
 // which must not exceed --max-depth, so sppm converges to the path tracers' image at any depth.

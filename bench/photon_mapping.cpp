@@ -1,7 +1,9 @@
 // `pathlab_bench pm` (part of `make bench`): the photons of a few scenes (bdpt's light subpaths
 // at their non-Dirac vertices after one bounce, as sppm stores them), traced per second; then
 // the hashed grid against nanoflann's k-d tree: build time, the time of one radius query per
-// pixel's visible point (the first non-Dirac camera hit), and memory. Medians of repeats.
+// pixel's visible point (the first non-Dirac camera hit), and memory. Medians of repeats. Then
+// the equal-time RMSE of pt-mis, bdpt, sppm and pm against a long bdpt reference (its noise
+// subtracted), in interleaved rounds.
 #include "photon_mapping.hpp"
 
 #include <tbb/parallel_for.h>
@@ -122,6 +124,35 @@ void photon_mapping_suite(const PhotonMappingOptions& o) {
                    double(photons.size()) / seconds * 1e-6, gb, kb, gq, kq, gf, (gb + gq) / (kb + kq));
         std::fflush(stdout);
     }
+    fmt::print("\n## Equal time at {0}x{0}, {1} s per render ({2} threads, medians of {3} rounds; reference: bdpt at {4} spp, "
+               "its noise subtracted)\n\n",
+               o.equal_time_size, o.equal_time_seconds, threads, o.equal_time_repeats, o.ref_spp);
+    const std::vector<std::string> algorithms{"pt-mis", "bdpt", "sppm", "pm"};
+    fmt::print("| scene |");
+    for (const auto& a : algorithms) fmt::print(" {} RMSE |", a);
+    fmt::print(" lowest |\n|---|");
+    for (size_t k = 0; k <= algorithms.size(); ++k) fmt::print("---|");
+    fmt::print("\n");
+    for (const std::string& key : o.scenes) {
+        const auto scene = Scene::build(scene_of(key));
+        const Reference ref = make_reference(*scene, "bdpt", o.equal_time_size, o.ref_spp);
+        std::vector<std::vector<double>> errors(algorithms.size());
+        for (int k = 0; k < o.equal_time_repeats; ++k)
+            for (size_t a = 0; a < algorithms.size(); ++a) {
+                const RenderResult r = run(*scene, algorithms[a], o.equal_time_size, 0, o.equal_time_seconds, 300 + uint64_t(k));
+                errors[a].push_back(rmse(r.film.mean(), ref));
+            }
+        std::string row = "| " + key;
+        size_t best = 0;
+        for (size_t a = 0; a < algorithms.size(); ++a) {
+            // 0: below what the reference's own noise lets the measure see
+            row += median(errors[a]) > 0 ? fmt::format(" | {:.4f}", median(errors[a])) : " | < reference noise";
+            if (median(errors[a]) < median(errors[best])) best = a;
+        }
+        fmt::print("{} | {} |\n", row, algorithms[best]);
+        std::fflush(stdout);
+    }
+
     fmt::print("\nMemory: a photon is {} bytes; the grid adds 8 bytes per photon (cell ends and the sorted order), the k-d tree\n"
                "its nodes and index (nanoflann: leaves of up to 10 points).\n",
                sizeof(Photon));

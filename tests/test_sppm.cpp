@@ -12,6 +12,7 @@
 
 #include "integrators/integrators.hpp"
 #include "integrators/photon/sppm.hpp"
+#include "job/render_job.hpp"
 #include "job/renderer.hpp"
 #include "judge/image_statistics.hpp"
 #include "scene/builtin_scenes.hpp"
@@ -175,6 +176,35 @@ TEST(SppmAgreement, DirectLightAloneAgreesWithThePathTracer) {
         const AgreementResult r = test_agreement(a.film.mean(), a.film.standard_error(), b.film.mean(), b.film.standard_error(),
                                                  AgreementOptions{1e-3, 1e-4});
         EXPECT_TRUE(r.agree) << scene << ": " << r.describe();
+    }
+}
+
+// Scene files set sppm's photons (Mitsuba 0.6's spellings too); the command line wins; a bad
+// value names the file and line.
+TEST(SppmSceneFile, ParametersComeFromTheFileUnlessTheCommandLineGivesThem) {
+    const std::string text = R"(<scene version="3.0.0">
+        <integrator type="sppm"><integer name="photonCount" value="3000"/><float name="initial_radius" value="0.04"/>
+            <float name="alpha" value="0.5"/></integrator>
+        <shape type="rectangle"/><emitter type="constant"/></scene>)";
+    const SceneDescription d = load_scene_text(text, "photons.xml", ".");
+    RenderJob from_file(scene_choice_of(d), JobRequest{});
+    EXPECT_EQ(from_file.integrator_info().name, "sppm");
+    EXPECT_EQ(from_file.integrator_options().photons, 3000);
+    EXPECT_FLOAT_EQ(from_file.integrator_options().photon_radius, 0.04f);
+    EXPECT_DOUBLE_EQ(from_file.integrator_options().photon_alpha, 0.5);
+    JobRequest r;
+    r.photons = 500, r.photon_alpha = 0.75;
+    RenderJob overridden(scene_choice_of(d), r);
+    EXPECT_EQ(overridden.integrator_options().photons, 500);
+    EXPECT_DOUBLE_EQ(overridden.integrator_options().photon_alpha, 0.75);
+    EXPECT_FLOAT_EQ(overridden.integrator_options().photon_radius, 0.04f);
+    try {
+        load_scene_text("<scene version=\"3.0.0\">\n<integrator type=\"sppm\"><float name=\"alpha\" value=\"1.5\"/></integrator></scene>",
+                        "bad.xml", ".");
+        ADD_FAILURE() << "alpha = 1.5 was accepted";
+    } catch (const std::exception& e) {
+        EXPECT_NE(std::string(e.what()).find("bad.xml:2"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("alpha must be in (0, 1]"), std::string::npos) << e.what();
     }
 }
 

@@ -82,10 +82,10 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
                    "bdpt: also write one image per strategy (s, t), weighted and unweighted, and montages, into this directory "
                    "(placeholders as for -o)");
     app.add_option("--strategies-depth", o.strategies_depth, "bdpt: ... for paths of up to this many bounces")->capture_default_str();
-    app.add_option("--photons", o.photons, "sppm: light paths per iteration (0: one per pixel)")->capture_default_str();
-    app.add_option("--radius", o.photon_radius, "sppm: the first iteration's photon radius (0: 0.5% of the scene's radius)")
-        ->capture_default_str();
-    app.add_option("--alpha", o.photon_alpha, "sppm: the radius reduction, in (0, 1]")->capture_default_str();
+    app.add_option("--photons", o.photons, "sppm: light paths per iteration (default one per pixel); pm: light paths of its maps (8 per pixel)");
+    app.add_option("--radius", o.photon_radius,
+                   "sppm: the first iteration's photon radius (default two pixel footprints at the scene's centre); pm: a fixed radius instead of the k nearest");
+    app.add_option("--alpha", o.photon_alpha, "sppm: the radius reduction, in (0, 1] (default 2/3)");
     app.add_flag("-q,--quiet", o.quiet, "No progress line and no summary");
 }
 
@@ -143,9 +143,9 @@ int run_render_command(const RenderCommandOptions& o) {
         for (const std::string& path : jobs[j].outputs) paths.output(path, "the output", /*image=*/true);
         if (!o.stats_path.empty()) paths.output(jobs[j].expand(o.stats_path), "--stats", /*image=*/false);
         const std::string& algorithm = jobs[j].integrator_info().name;
-        if ((o.photons != 0 || o.photon_radius != 0) && algorithm != "sppm" && algorithm != "pm")
+        if ((o.photons || o.photon_radius) && algorithm != "sppm" && algorithm != "pm")
             throw UsageError(fmt::format("--photons and --radius set the photons of sppm and pm; {} has none", algorithm));
-        if (o.photon_alpha != 2.0 / 3.0 && algorithm != "sppm")
+        if (o.photon_alpha && algorithm != "sppm")
             throw UsageError(fmt::format("--alpha is sppm's radius reduction, not {}'s", algorithm));
         if (o.mis == "power" && jobs[j].integrator_info().name != "bdpt")
             throw UsageError(fmt::format("--mis chooses the heuristic of bdpt; {} has its own", jobs[j].integrator_info().name));

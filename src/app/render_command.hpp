@@ -3,6 +3,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -31,9 +32,9 @@ struct RenderCommandOptions {
     std::string mis = "balance";
     std::string strategies_dir;
     int strategies_depth = 4;
-    int64_t photons = 0;
-    float photon_radius = 0;
-    double photon_alpha = 2.0 / 3.0;
+    std::optional<int64_t> photons;
+    std::optional<float> photon_radius;
+    std::optional<double> photon_alpha;
 };
 
 void add_render_options(CLI::App& app, RenderCommandOptions& opt);

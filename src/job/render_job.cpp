@@ -22,13 +22,13 @@ RenderJob::RenderJob(SceneChoice scene, const JobRequest& r) : choice_(std::move
     options_.strategies_dir = r.strategies_dir;
     options_.strategies_depth = r.strategies_depth;
     if (r.strategies_depth < 0) throw UsageError("--strategies-depth must be zero or positive");
-    options_.photons = r.photons;
-    options_.photon_radius = r.photon_radius;
-    options_.photon_alpha = r.photon_alpha;
-    if (r.photons < 0) throw UsageError("--photons must be zero (one light path per pixel) or positive");
-    if (!(r.photon_radius >= 0) || !std::isfinite(r.photon_radius))
+    options_.photons = r.photons ? *r.photons : d.photons.value_or(0);
+    options_.photon_radius = r.photon_radius ? *r.photon_radius : d.photon_radius.value_or(0.0f);
+    options_.photon_alpha = r.photon_alpha ? *r.photon_alpha : d.photon_alpha.value_or(2.0 / 3.0);
+    if (options_.photons < 0) throw UsageError("--photons must be zero (the default count) or positive");
+    if (!(options_.photon_radius >= 0) || !std::isfinite(options_.photon_radius))
         throw UsageError("--radius must be zero (from the scene's size) or a positive distance");
-    if (!(r.photon_alpha > 0 && r.photon_alpha <= 1)) throw UsageError("--alpha must be in (0, 1]");
+    if (!(options_.photon_alpha > 0 && options_.photon_alpha <= 1)) throw UsageError("--alpha must be in (0, 1]");
     if (options_.max_depth < -1 || options_.max_depth == 0) throw UsageError("--max-depth must be positive, or -1 for unlimited");
     if (r.time_limit < 0 || !std::isfinite(r.time_limit)) throw UsageError("--time must be a positive number of seconds");
     if (r.spp && *r.spp == 0) throw UsageError("--spp must be a positive number of samples");

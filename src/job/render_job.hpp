@@ -32,9 +32,9 @@ struct JobRequest {
     bool mis_power = false;        // --mis power (bdpt)
     std::string strategies_dir;    // --strategies DIR (bdpt)
     int strategies_depth = 4;      // --strategies-depth N (bdpt)
-    int64_t photons = 0;           // --photons N (sppm)
-    float photon_radius = 0;       // --radius R (sppm)
-    double photon_alpha = 2.0 / 3.0;  // --alpha A (sppm)
+    std::optional<int64_t> photons;       // --photons N (sppm, pm)
+    std::optional<float> photon_radius;   // --radius R (sppm, pm)
+    std::optional<double> photon_alpha;   // --alpha A (sppm)
 };
 
 // The integrator `name` (or an alias); a UsageError listing them all otherwise.

@@ -24,6 +24,9 @@ struct SceneDescription {
     // Render settings a scene file may suggest; command-line options override them.
     std::optional<std::string> algorithm;
     std::optional<int> spp, max_depth, rr_depth;  // depths in pathlab's bounces
+    std::optional<int64_t> photons;               // sppm, pm: light paths (per iteration for sppm)
+    std::optional<float> photon_radius;           // sppm: the first iteration's radius
+    std::optional<double> photon_alpha;           // sppm: the radius reduction
 };
 
 }  // namespace pathlab

@@ -31,6 +31,23 @@ void read_integrator(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b) {
             if (depth < 1) p.fail("rr_depth", fmt::format("rr_depth must be at least 1, got {}", depth));
             b.desc.rr_depth = depth - 1;
         }
+        // Photon mapping (Mitsuba 0.6's sppm spells them photonCount, initialRadius, alpha).
+        if (plugin.find("photon_count") && p.has("photon_count")) {
+            const int n = p.get_int("photon_count");
+            if (n < 0) p.fail("photon_count", fmt::format("photon_count must be zero (the default) or positive, got {}", n));
+            b.desc.photons = n;
+        }
+        if (plugin.find("initial_radius") && p.has("initial_radius")) {
+            const float r = p.get_float("initial_radius");
+            if (!(r >= 0) || !std::isfinite(r))
+                p.fail("initial_radius", fmt::format("initial_radius must be zero (from the scene's size) or positive, got {}", r));
+            b.desc.photon_radius = r;
+        }
+        if (plugin.find("alpha") && p.has("alpha")) {
+            const float a = p.get_float("alpha");
+            if (!(a > 0 && a <= 1)) p.fail("alpha", fmt::format("alpha must be in (0, 1], got {}", a));
+            b.desc.photon_alpha = a;
+        }
         p.check_all_used();
         return 0;
     });

@@ -131,7 +131,14 @@ Rgb PhotonMapper::radiance(const Scene& scene, const Ray& camera_ray, Sampler& s
 
 const IntegratorInfo& pm_integrator() {
     static const IntegratorInfo info{"pm", {}, "photon mapping (Jensen): global and caustic maps, k-nearest estimates, final gathering", false,
-                                     true, path_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
+                                     true,
+                                     [] {
+                                         std::vector<ParamInfo> p = path_params();
+                                         p.push_back({"photon_count", ParamType::Integer, "0",
+                                                      "light paths of the photon maps (0: 8 per pixel; --photons wins)", "photonCount"});
+                                         return p;
+                                     }(),
+                                     [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
                                          return std::make_unique<PhotonMapper>(o);
                                      }};
     return info;

@@ -31,8 +31,15 @@ double Sppm::radius(double r1, double alpha, uint64_t i) {
     return r1 * std::exp(0.5 * log_ratio);
 }
 
-float Sppm::initial_radius(const Scene& scene) const {
-    return options_.photon_radius > 0 ? options_.photon_radius : 0.005f * scene.scene_sphere().radius;
+float Sppm::initial_radius(const RenderContext& ctx) const {
+    if (options_.photon_radius > 0) return options_.photon_radius;
+    // Two pixel footprints at the distance of the scene's centre: the angle between the rays
+    // through two neighbouring pixels at the image centre, times that distance.
+    const float cx = 0.5f * float(ctx.width), cy = 0.5f * float(ctx.height);
+    const Vec3f a = normalize(ctx.camera.generate(cx, cy).d), b = normalize(ctx.camera.generate(cx + 1, cy).d);
+    const float angle = 2 * std::asin(std::min(1.0f, 0.5f * length(a - b)));
+    const float distance = length(ctx.scene.scene_sphere().center - ctx.camera.position());
+    return std::max(2 * angle * distance, 1e-4f * ctx.scene.scene_sphere().radius);
 }
 
 uint64_t Sppm::trace_photons(const RenderContext& ctx, uint64_t pass, size_t paths) {
@@ -112,7 +119,7 @@ Rgb Sppm::camera_sample(const RenderContext& ctx, size_t pixel, uint64_t pass, f
 PassCounters Sppm::render_passes(const RenderContext& ctx, Film& film, uint64_t first, int count, const PassProgress& progress) {
     const size_t pixels = ctx.pixel_count();
     const size_t paths = options_.photons > 0 ? size_t(options_.photons) : pixels;
-    const double r1 = initial_radius(ctx.scene), alpha = options_.photon_alpha;
+    const double r1 = initial_radius(ctx), alpha = options_.photon_alpha;
     image_.resize(pixels);
     std::vector<Vec3d>& image = image_;
     std::atomic<uint64_t> rays{0}, invalid{0};
@@ -141,7 +148,14 @@ PassCounters Sppm::render_passes(const RenderContext& ctx, Film& film, uint64_t 
 const IntegratorInfo& sppm_integrator() {
     static const IntegratorInfo info{
         "sppm", {}, "stochastic progressive photon mapping (Knaus-Zwicker iterations): photons + next-event estimation", false, true,
-        path_params(),
+        [] {
+            std::vector<ParamInfo> p = path_params();
+            p.push_back({"photon_count", ParamType::Integer, "0", "light paths per iteration (0: one per pixel; --photons wins)", "photonCount"});
+            p.push_back({"initial_radius", ParamType::Float, "0", "the first iteration's radius (0: two pixel footprints at the scene's centre; --radius wins)",
+                         "initialRadius"});
+            p.push_back({"alpha", ParamType::Float, "0.666667", "the radius reduction, in (0, 1] (--alpha wins)"});
+            return p;
+        }(),
         [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> { return std::make_unique<Sppm>(o); }};
     return info;
 }

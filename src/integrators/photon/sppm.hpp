@@ -15,9 +15,9 @@
 // Depth: a photon at light vertex j merged at camera vertex t makes a path of t + j - 1 bounces,
 // which must not exceed --max-depth, so sppm converges to the path tracers' image at any depth.
 //
-// The initial radius (--radius, default: 0.5% of the scene's bounding-sphere radius; SmallVCM
-// uses 0.3%) and alpha (--alpha, default 2/3) trade bias against noise early on; the result
-// converges for any. The photons are searched with a hashed grid (photon_grid.hpp; measured
+// The initial radius (--radius, default: two pixel footprints at the distance of the scene's
+// centre, so that the blur starts at the scale of a pixel whatever the resolution) and alpha
+// (--alpha, default 2/3) trade bias against noise early on; the result converges for any. The photons are searched with a hashed grid (photon_grid.hpp; measured
 // against a k-d tree in README). Deterministic: photons are stored in chunk order, and every
 // pixel sums its photons in the grid's fixed order.
 #pragma once
@@ -47,7 +47,7 @@ public:
 
     // The radius of iteration i (1-based) for the initial radius r1.
     static double radius(double r1, double alpha, uint64_t i);
-    float initial_radius(const Scene& scene) const;
+    float initial_radius(const RenderContext& ctx) const;
 
 private:
     // The photons of one iteration into photons_, in chunk order; returns the rays traced.

@@ -23,7 +23,7 @@ test: build
 
 # The performance suite (about 7 minutes on a quiet 2-core machine): throughput, scaling, Embree's bound, scene growth,
 # memory, allocations and pt-mis efficiency; Markdown on stdout, JSON in out/bench/; then light tracing (lt paths/s
-# next to pt-mis, splat accumulation).
+# next to pt-mis, splat accumulation, 1 minute), bdpt against pt-mis (12 minutes) and the photon methods (6 minutes).
 bench: build
 	$(BUILD)/bench/pathlab_bench perf --json out/bench/performance.json
 	$(BUILD)/bench/pathlab_bench lt

@@ -1,9 +1,13 @@
 // Small helpers shared by the tests that render.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
+#include <cstring>
 #include <string>
 
 #include "job/render_job.hpp"
+#include "job/renderer.hpp"
 #include "scene/builtin_scenes.hpp"
 
 namespace pathlab::test {
@@ -32,5 +36,30 @@ inline std::unique_ptr<PixelIntegrator> make_pixel_integrator(const std::string&
 }
 
 inline std::string shared_dir() { return PATHLAB_SHARED_DIR; }
+
+// One render of a scene with a given integrator object (its options and faults as made).
+inline RenderResult render_integrator(const SceneDescription& d, Integrator& integrator, int width, int height, uint64_t spp,
+                                      uint64_t seed) {
+    const auto scene = Scene::build(d);
+    RenderSettings rs;
+    rs.width = width, rs.height = height, rs.spp = spp, rs.seed = seed;
+    return render(*scene, integrator, rs);
+}
+
+inline bool bit_identical(const Image& a, const Image& b) {
+    return a.pixel_count() == b.pixel_count() && std::memcmp(a.data(), b.data(), a.pixel_count() * sizeof(Rgb)) == 0;
+}
+
+// The RMS difference of two Monte Carlo images with both images' own noise subtracted,
+// sqrt(max(0, mean(d^2 - se_a^2 - se_b^2))): what is left is bias (0 when it is below the noise).
+inline double bias_rms(const Image& a, const Image& se_a, const Image& b, const Image& se_b) {
+    double sum = 0;
+    for (size_t i = 0; i < a.pixel_count(); ++i)
+        for (int c = 0; c < 3; ++c) {
+            const double d = double(a[i][c]) - b[i][c];
+            sum += d * d - double(se_a[i][c]) * se_a[i][c] - double(se_b[i][c]) * se_b[i][c];
+        }
+    return std::sqrt(std::max(0.0, sum / double(3 * a.pixel_count())));
+}
 
 }  // namespace pathlab::test

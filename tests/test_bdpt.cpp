@@ -39,13 +39,6 @@ SceneDescription scene_of(const std::string& key) {
     return make_builtin_scene(std::stoi(key));
 }
 
-RenderResult render_with(const SceneDescription& d, Integrator& integrator, int w, int h, uint64_t spp, uint64_t seed) {
-    const auto scene = Scene::build(d);
-    RenderSettings rs;
-    rs.width = w, rs.height = h, rs.spp = spp, rs.seed = seed;
-    return render(*scene, integrator, rs);
-}
-
 AgreementResult agreement(const Film& a, const Film& b) {
     return test_agreement(a.mean(), a.standard_error(), b.mean(), b.standard_error(), kAgreement);
 }
@@ -53,12 +46,12 @@ AgreementResult agreement(const Film& a, const Film& b) {
 // pt-mis's image of the scene, with the same options (depth, or one path length only).
 RenderResult pt_mis_render(const SceneDescription& d, const IntegratorOptions& o, int w, int h, uint64_t spp, uint64_t seed) {
     const std::unique_ptr<Integrator> pt = find_integrator("pt-mis")->make(o);
-    return render_with(d, *pt, w, h, spp, seed);
+    return render_integrator(d, *pt, w, h, spp, seed);
 }
 
 AgreementResult compare_with_pt_mis(const std::string& key, Integrator& bdpt, int w, int h, uint64_t spp) {
     const SceneDescription d = scene_of(key);
-    return agreement(render_with(d, bdpt, w, h, spp, 401).film, pt_mis_render(d, {}, w, h, spp, 402).film);
+    return agreement(render_integrator(d, bdpt, w, h, spp, 401).film, pt_mis_render(d, {}, w, h, spp, 402).film);
 }
 
 class BdptAgreement : public ::testing::TestWithParam<std::string> {};
@@ -100,17 +93,13 @@ TEST(BdptAgreement, DetectsAMissingReversePdfAtASpecularVertex) {
     EXPECT_FALSE(r.agree) << r.describe();
 }
 
-bool bit_identical(const Image& a, const Image& b) {
-    return a.pixel_count() == b.pixel_count() && std::memcmp(a.data(), b.data(), a.pixel_count() * sizeof(Rgb)) == 0;
-}
-
 TEST(BdptDeterminism, OneAndTwoThreadsGiveBitIdenticalImages) {
     for (const char* key : {"5", "specular-sky.xml"}) {
         RenderResult runs[2];
         for (const int threads : {1, 2}) {
             tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
             Bdpt bdpt({});
-            runs[threads - 1] = render_with(scene_of(key), bdpt, 40, 30, 4, 9);
+            runs[threads - 1] = render_integrator(scene_of(key), bdpt, 40, 30, 4, 9);
         }
         EXPECT_TRUE(bit_identical(runs[0].film.mean(), runs[1].film.mean())) << key;
         EXPECT_TRUE(bit_identical(runs[0].film.standard_error(), runs[1].film.standard_error())) << key;
@@ -144,7 +133,7 @@ TEST_P(BdptStrategies, EachLengthsStrategiesAddUpAndConverge) {
     o.strategies_dir = dir;
     o.strategies_depth = kDepth;
     Bdpt bdpt(o);
-    render_with(d, bdpt, kW, kH, kStrategySpp, 5);  // fills the strategies' films and writes them
+    render_integrator(d, bdpt, kW, kH, kStrategySpp, 5);  // fills the strategies' films and writes them
     const StrategyImages& images = *bdpt.strategy_images();
     for (int n = 0; n <= kDepth; ++n) {
         IntegratorOptions length = o;
@@ -152,7 +141,7 @@ TEST_P(BdptStrategies, EachLengthsStrategiesAddUpAndConverge) {
         length.strategies_dir.clear();
         const RenderResult reference = pt_mis_render(d, length, kW, kH, kStrategySpp, 77 + uint64_t(n));
         Bdpt bdpt_n(length);
-        const RenderResult own = render_with(d, bdpt_n, kW, kH, kStrategySpp, 5);
+        const RenderResult own = render_integrator(d, bdpt_n, kW, kH, kStrategySpp, 5);
         const AgreementResult weighted = agreement(own.film, reference.film);
         EXPECT_TRUE(weighted.agree) << "length " << n << ", bdpt: " << weighted.describe();
         Image sum(kW, kH);

@@ -24,10 +24,6 @@ RenderResult render_with(int threads, int tile_size, uint64_t seed = 5, SamplerK
     return render(*scene, *estimator, rs);
 }
 
-bool bit_identical(const Image& a, const Image& b) {
-    return a.pixel_count() == b.pixel_count() && std::memcmp(a.data(), b.data(), a.pixel_count() * sizeof(Rgb)) == 0;
-}
-
 TEST(Determinism, OneAndTwoThreadsGiveBitIdenticalImages) {
     const RenderResult one = render_with(1, 16), two = render_with(2, 16);
     EXPECT_TRUE(bit_identical(one.film.mean(), two.film.mean()));

@@ -31,16 +31,9 @@ SceneDescription scene_of(const std::string& key) {
     return make_builtin_scene(std::stoi(key));
 }
 
-RenderResult render_with(const SceneDescription& d, Integrator& integrator, int w, int h, uint64_t spp, uint64_t seed) {
-    const auto scene = Scene::build(d);
-    RenderSettings rs;
-    rs.width = w, rs.height = h, rs.spp = spp, rs.seed = seed;
-    return render(*scene, integrator, rs);
-}
-
 AgreementResult compare_with_pt_mis(const std::string& key, Integrator& lt, int w, int h, uint64_t spp = kSpp) {
     const SceneDescription d = scene_of(key);
-    const RenderResult a = render_with(d, lt, w, h, spp, 301);
+    const RenderResult a = render_integrator(d, lt, w, h, spp, 301);
     const RenderResult b = render_scene(d, "pt-mis", w, h, int(spp), 302);
     const auto scene = Scene::build(d);
     const std::vector<uint8_t> mask = specular_first_vertex_mask(*scene, w, h, 16, /*dilate=*/false);
@@ -81,10 +74,6 @@ TEST(LightTracerAgreement, DetectsAMissingEmissionPdf) {
     f.drop_emission_pdf = true;
     LightTracer lt({}, f);
     EXPECT_FALSE(compare_with_pt_mis("4", lt, 8, 8, 4096).agree);
-}
-
-bool bit_identical(const Image& a, const Image& b) {
-    return a.pixel_count() == b.pixel_count() && std::memcmp(a.data(), b.data(), a.pixel_count() * sizeof(Rgb)) == 0;
 }
 
 RenderResult lt_render(const std::string& key, int threads, uint64_t spp, uint64_t first = 0) {

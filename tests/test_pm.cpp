@@ -15,14 +15,14 @@
 #include "job/renderer.hpp"
 #include "scene/builtin_scenes.hpp"
 #include "scenefile/scene_file.hpp"
+#include "render_helpers.hpp"
 
 namespace pathlab::test {
 namespace {
 
 constexpr int kSize = 16;
 
-// The RMS difference of pm's image from a pt-mis reference with both images' noise subtracted:
-// the bias (0 when it is below the noise).
+// The bias of pm's image against a pt-mis reference (bias_rms: both images' noise subtracted).
 double bias(const Scene& scene, const Image& ref, const Image& ref_se, int64_t photons, PmFaults faults = {}) {
     IntegratorOptions o;
     o.photons = photons;
@@ -30,14 +30,7 @@ double bias(const Scene& scene, const Image& ref, const Image& ref_se, int64_t p
     RenderSettings rs;
     rs.width = rs.height = kSize, rs.spp = 2048, rs.seed = 8;
     const RenderResult a = render(scene, pm, rs);
-    const Image m = a.film.mean(), se = a.film.standard_error();
-    double sum = 0;
-    for (size_t i = 0; i < m.pixel_count(); ++i)
-        for (int c = 0; c < 3; ++c) {
-            const double d = double(m[i][c]) - ref[i][c];
-            sum += d * d - double(se[i][c]) * se[i][c] - double(ref_se[i][c]) * ref_se[i][c];
-        }
-    return std::sqrt(std::max(0.0, sum / double(3 * m.pixel_count())));
+    return bias_rms(a.film.mean(), a.film.standard_error(), ref, ref_se);
 }
 
 // Scene 2 (diffuse box, ceiling light), 16x16, 2048 samples per pixel: 16x the photons (1000
@@ -76,10 +69,6 @@ TEST(PmMaps, TheCausticMapHoldsOnlyPhotonsThroughDiracLobes) {
     caustic.prepare(RenderContext{*glass, c2, 8, 8, 1, SamplerKind::Independent, 32});
     EXPECT_GT(caustic.caustic_photons(), 100u) << "the glass ball focuses photons";
     EXPECT_LT(caustic.caustic_photons(), caustic.global_photons());
-}
-
-bool bit_identical(const Image& a, const Image& b) {
-    return a.pixel_count() == b.pixel_count() && std::memcmp(a.data(), b.data(), a.pixel_count() * sizeof(Rgb)) == 0;
 }
 
 TEST(PmDeterminism, OneAndTwoThreadsGiveBitIdenticalImages) {

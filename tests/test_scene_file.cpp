@@ -238,10 +238,6 @@ TEST(SceneFileErrors, MicrofacetAndFresnelParameters) {
 
 // ---- the 8 course scenes as files ------------------------------------------------------------
 
-bool bit_identical(const Image& a, const Image& b) {
-    return a.pixel_count() == b.pixel_count() && std::memcmp(a.data(), b.data(), a.pixel_count() * sizeof(Rgb)) == 0;
-}
-
 class CourseSceneFile : public ::testing::TestWithParam<int> {};
 
 TEST_P(CourseSceneFile, RendersBitIdenticallyToItsBuiltInTwin) {
@@ -254,7 +250,7 @@ TEST_P(CourseSceneFile, RendersBitIdenticallyToItsBuiltInTwin) {
     for (const char* algorithm : {"direct-light", "pt-mis"}) {
         const RenderResult a = test::render_scene(file, algorithm, 24, 24, 4, 99);
         const RenderResult b = test::render_scene(builtin, algorithm, 24, 24, 4, 99);
-        EXPECT_TRUE(bit_identical(a.film.mean(), b.film.mean())) << info.name << " with " << algorithm;
+        EXPECT_TRUE(test::bit_identical(a.film.mean(), b.film.mean())) << info.name << " with " << algorithm;
         EXPECT_EQ(a.stats.rays, b.stats.rays);
     }
 }
@@ -263,7 +259,7 @@ INSTANTIATE_TEST_SUITE_P(Scenes, CourseSceneFile, ::testing::Range(0, 8));
 TEST(CourseSceneFile, ADifferentSceneIsNotIdentical) {
     // Test of the test: the twin of scene 2 differs from built-in scene 3.
     const SceneDescription file = load_scene_file(source_path("scenes/2-ceiling-diffuse.xml"));
-    EXPECT_FALSE(bit_identical(test::render_scene(file, "direct-light", 24, 24, 4, 99).film.mean(),
+    EXPECT_FALSE(test::bit_identical(test::render_scene(file, "direct-light", 24, 24, 4, 99).film.mean(),
                                test::render_scene(make_builtin_scene(3), "direct-light", 24, 24, 4, 99).film.mean()));
 }
 

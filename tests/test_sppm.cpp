@@ -17,6 +17,7 @@
 #include "judge/image_statistics.hpp"
 #include "scene/builtin_scenes.hpp"
 #include "scenefile/scene_file.hpp"
+#include "render_helpers.hpp"
 
 namespace pathlab::test {
 namespace {
@@ -97,14 +98,7 @@ protected:
         RenderSettings rs;
         rs.width = 24, rs.height = 18, rs.spp = 512, rs.seed = 8;
         const RenderResult a = render(*scene_, sppm, rs);
-        const Image m = a.film.mean(), se = a.film.standard_error();
-        double sum = 0;
-        for (size_t i = 0; i < m.pixel_count(); ++i)
-            for (int c = 0; c < 3; ++c) {
-                const double d = double(m[i][c]) - (*ref_)[i][c];
-                sum += d * d - double(se[i][c]) * se[i][c] - double((*ref_se_)[i][c]) * (*ref_se_)[i][c];
-            }
-        return std::sqrt(std::max(0.0, sum / double(3 * m.pixel_count())));
+        return bias_rms(a.film.mean(), a.film.standard_error(), *ref_, *ref_se_);
     }
     static Scene* scene_;
     static Image *ref_, *ref_se_;
@@ -123,10 +117,6 @@ TEST_F(SppmBias, ShrinksWithTheRadiusAndWithIterationsAndNeedsPi) {
     EXPECT_LT(progressive, 0.8 * fixed_large) << all;
     EXPECT_GT(no_pi, 2 * progressive) << all;
     EXPECT_GT(fixed_large, 0.0) << "the bias must be seen at all: " << all;
-}
-
-bool bit_identical(const Image& a, const Image& b) {
-    return a.pixel_count() == b.pixel_count() && std::memcmp(a.data(), b.data(), a.pixel_count() * sizeof(Rgb)) == 0;
 }
 
 RenderResult sppm_render(int scene, int threads, uint64_t spp, uint64_t first = 0) {

@@ -2,9 +2,9 @@
 
 #include <tbb/parallel_for.h>
 
-#include "integrators/common/direct_lighting.hpp"
 #include "integrators/common/path_rules.hpp"
 #include "integrators/integrators.hpp"
+#include "integrators/photon/visible_point.hpp"
 
 namespace pathlab {
 namespace {
@@ -80,51 +80,35 @@ Rgb PhotonMapper::estimate(const PhotonKdTree& map, size_t k, const ShadingPoint
 
 Rgb PhotonMapper::radiance(const Scene& scene, const Ray& camera_ray, Sampler& sampler) const {
     const auto counts = [&](int length) { return options_.only_length < 0 || options_.only_length == length; };
-    Ray ray = camera_ray;
-    Rgb L(0.0f), beta(1.0f);
-    // t: the camera vertex the ray is about to find; t - 1 bounces before it.
-    for (int t = 1; t - 1 <= max_bounces_ && t <= kMaxDiracChain; ++t) {
-        Intersection hit;
-        if (!scene.intersect(ray, hit)) {
-            if (counts(t - 1)) L += beta * scene.escaped_radiance(ray.d);
-            return L;
-        }
-        const Vec3f d = normalize(ray.d);
-        if (counts(t - 1)) L += beta * emitted_radiance(scene, hit, -d);
-        const ShadingPoint sp = make_shading_point(scene, hit, d);
-        if (sp.material->is_black() || t > max_bounces_) return L;
-        if (sp.material->is_delta()) {
-            const auto s = sp.material->sample(sp, sp.wi, sampler.next2d());
-            if (!s) return L;
-            beta *= s->f * (std::abs(s->wo.z) / s->pdfW);
-            ray = sp.spawn(s->wo);
-            continue;
-        }
-        // x: direct light (a light sample and the gathering ray's BSDF sample, combined by the
-        // balance heuristic as in direct-mis: light sampling alone has infinite variance next to
-        // an area light), caustics, and one bounce of final gathering into the global map.
-        if (counts(t)) L += beta * estimate_light_sample(scene, sp, sampler, /*mis=*/true);
-        if (options_.only_length < 0) L += beta * estimate(caustic_map_, kCausticK, sp, t);
-        const auto g = sp.material->sample(sp, sp.wi, sampler.next2d());
-        if (!g) return L;
-        EmitterHit found;
-        const Rgb emission = estimate_bsdf_sample_mis(scene, sp, *g, found);
-        if (counts(t)) L += beta * emission;
-        if (!found.hit || t + 1 > max_bounces_ || options_.only_length >= 0) return L;
-        Rgb gbeta = beta * g->f * (std::abs(g->wo.z) / g->pdfW);
-        Intersection ghit = found.isect;
-        Vec3f gdir = sp.frame.to_world(g->wo);
-        for (int u = t + 1; u - 1 <= max_bounces_ && u <= t + kMaxDiracChain; ++u) {
-            const ShadingPoint gp = make_shading_point(scene, ghit, gdir);
-            if (gp.material->is_black()) return L;
-            if (!gp.material->is_delta()) return L + gbeta * estimate(global_map_, kGlobalK, gp, u);
-            const auto s = gp.material->sample(gp, gp.wi, sampler.next2d());
-            if (!s) return L;
-            gbeta *= s->f * (std::abs(s->wo.z) / s->pdfW);
-            gdir = gp.frame.to_world(s->wo);
-            if (!scene.intersect(gp.spawn(s->wo), ghit)) return L;  // the environment is direct light (counted at x)
-        }
-        return L;
+    Rgb L(0.0f);
+    const auto x = trace_to_visible_point(scene, camera_ray, sampler, max_bounces_, kMaxDiracChain, counts, L);
+    if (!x) return L;
+    const ShadingPoint& sp = x->sp;
+    const Rgb& beta = x->beta;
+    const int t = x->t;
+    // x: direct light (a light sample and the gathering ray's BSDF sample, combined by the
+    // balance heuristic as in direct-mis: light sampling alone has infinite variance next to
+    // an area light), caustics, and one bounce of final gathering into the global map.
+    if (counts(t)) L += beta * estimate_light_sample(scene, sp, sampler, /*mis=*/true);
+    if (options_.only_length < 0) L += beta * estimate(caustic_map_, kCausticK, sp, t);
+    const auto g = sp.material->sample(sp, sp.wi, sampler.next2d());
+    if (!g) return L;
+    EmitterHit found;
+    const Rgb emission = estimate_bsdf_sample_mis(scene, sp, *g, found);
+    if (counts(t)) L += beta * emission;
+    if (!found.hit || t + 1 > max_bounces_ || options_.only_length >= 0) return L;
+    Rgb gbeta = beta * g->f * (std::abs(g->wo.z) / g->pdfW);
+    Intersection ghit = found.isect;
+    Vec3f gdir = sp.frame.to_world(g->wo);
+    for (int u = t + 1; u - 1 <= max_bounces_ && u <= t + kMaxDiracChain; ++u) {
+        const ShadingPoint gp = make_shading_point(scene, ghit, gdir);
+        if (gp.material->is_black()) return L;
+        if (!gp.material->is_delta()) return L + gbeta * estimate(global_map_, kGlobalK, gp, u);
+        const auto s = gp.material->sample(gp, gp.wi, sampler.next2d());
+        if (!s) return L;
+        gbeta *= s->f * (std::abs(s->wo.z) / s->pdfW);
+        gdir = gp.frame.to_world(s->wo);
+        if (!scene.intersect(gp.spawn(s->wo), ghit)) return L;  // the environment is direct light (counted at x)
     }
     return L;
 }

@@ -6,9 +6,9 @@
 #include <atomic>
 #include <cmath>
 
-#include "integrators/common/direct_lighting.hpp"
 #include "integrators/common/path_rules.hpp"
 #include "integrators/integrators.hpp"
+#include "integrators/photon/visible_point.hpp"
 
 namespace pathlab {
 namespace {
@@ -73,47 +73,31 @@ Rgb Sppm::camera_sample(const RenderContext& ctx, size_t pixel, uint64_t pass, f
     const Vec2f jitter = sampler.next2d();
     const float px = float(pixel % size_t(ctx.width)), py = float(pixel / size_t(ctx.width));
     Ray ray = ctx.camera.generate(px + jitter.x, py + jitter.y);
-    Rgb L(0.0f), beta(1.0f);
+    Rgb L(0.0f);
     const auto counts = [&](int length) { return options_.only_length < 0 || options_.only_length == length; };
-    // t: the index of the camera vertex the ray is about to find (z_1 first); t - 1 bounces before it.
-    for (int t = 1; t - 1 <= max_bounces_; ++t) {
-        Intersection hit;
-        if (!scene.intersect(ray, hit)) {
-            if (counts(t - 1)) L += beta * scene.escaped_radiance(ray.d);
-            break;
+    const auto x = trace_to_visible_point(scene, ray, sampler, max_bounces_, max_bounces_ + 1, counts, L);
+    if (!x) return L;
+    const ShadingPoint& sp = x->sp;
+    const Rgb& beta = x->beta;
+    const int t = x->t;
+    // The visible point: direct light by a light sample and a BSDF sample combined by the
+    // balance heuristic (as in direct-mis: light sampling alone has infinite variance next
+    // to an area light), the rest from the photons.
+    if (counts(t)) {
+        L += beta * estimate_light_sample(scene, sp, sampler, /*mis=*/true);
+        if (const auto s = sp.material->sample(sp, sp.wi, sampler.next2d())) {
+            EmitterHit found;
+            L += beta * estimate_bsdf_sample_mis(scene, sp, *s, found);
         }
-        // Emission found directly or through Dirac lobes only: no other strategy has it.
-        if (counts(t - 1)) L += beta * emitted_radiance(scene, hit, -normalize(ray.d));
-        const ShadingPoint sp = make_shading_point(scene, hit, normalize(ray.d));
-        if (sp.material->is_black() || t > max_bounces_) break;
-        if (sp.material->is_delta()) {
-            const auto s = sp.material->sample(sp, sp.wi, sampler.next2d());
-            if (!s) break;
-            beta *= s->f * (std::abs(s->wo.z) / s->pdfW);
-            ray = sp.spawn(s->wo);
-            continue;
-        }
-        // The visible point: direct light by a light sample and a BSDF sample combined by the
-        // balance heuristic (as in direct-mis: light sampling alone has infinite variance next
-        // to an area light), the rest from the photons.
-        if (counts(t)) {
-            L += beta * estimate_light_sample(scene, sp, sampler, /*mis=*/true);
-            if (const auto s = sp.material->sample(sp, sp.wi, sampler.next2d())) {
-                EmitterHit found;
-                L += beta * estimate_bsdf_sample_mis(scene, sp, *s, found);
-            }
-        }
-        const float norm = float(paths) * (faults_.no_pi_in_kernel ? 1.0f : kPi) * r * r;
-        Rgb sum(0.0f);
-        grid_.for_each_within(sp.p, r, [&](const Photon& ph) {
-            const int bounces = t + int(ph.vertex) - 1;
-            if (bounces > max_bounces_ || !counts(bounces)) return;
-            sum += sp.material->eval(sp, sp.wi, sp.frame.to_local(ph.wi)) * ph.power;
-        });
-        L += beta * sum / norm;
-        break;
     }
-    return L;
+    const float norm = float(paths) * (faults_.no_pi_in_kernel ? 1.0f : kPi) * r * r;
+    Rgb sum(0.0f);
+    grid_.for_each_within(sp.p, r, [&](const Photon& ph) {
+        const int bounces = t + int(ph.vertex) - 1;
+        if (bounces > max_bounces_ || !counts(bounces)) return;
+        sum += sp.material->eval(sp, sp.wi, sp.frame.to_local(ph.wi)) * ph.power;
+    });
+    return L + beta * sum / norm;
 }
 
 PassCounters Sppm::render_passes(const RenderContext& ctx, Film& film, uint64_t first, int count, const PassProgress& progress) {

@@ -504,14 +504,22 @@ TEST_F(ToolsReport, LoadsInChromiumWithoutConsoleErrors) {
 
 // Ctrl-C during a report: the renders so far are kept and the page is still written (exit 130).
 TEST_F(Tools, InterruptedReportStillWritesThePage) {
-    const std::string cmd = fmt::format(
-        "timeout --preserve-status -s INT 2 {} report --scene 2 --algorithms direct-light,direct-mis --spp 100000000 "
-        "--resolution 32x24 --reference-spp 64 -q -o {} 2> {}",
-        PATHLAB_BINARY, path("r.html"), path("err.txt"));
-    const int status = std::system(cmd.c_str());
+    // On a loaded machine the signal may come before the algorithms start (while the reference
+    // renders, or before pathlab can handle it): such a run says nothing of the behaviour under
+    // test, so it is repeated with a later signal.
+    int status = 0;
+    std::string html;
+    for (const int delay : {2, 5, 12}) {
+        const std::string cmd = fmt::format(
+            "timeout --preserve-status -s INT {} {} report --scene 2 --algorithms direct-light,direct-mis --spp 100000000 "
+            "--resolution 32x24 --reference-spp 64 -q -o {} 2> {}",
+            delay, PATHLAB_BINARY, path("r.html"), path("err.txt"));
+        status = std::system(cmd.c_str());
+        html = fs::exists(path("r.html")) ? read_text(path("r.html")) : "";
+        if (!html.empty() && !contains(html, "Interrupted while rendering the reference")) break;
+    }
     ASSERT_TRUE(WIFEXITED(status)) << read_text(path("err.txt"));
     EXPECT_EQ(WEXITSTATUS(status), 130) << read_text(path("err.txt"));
-    const std::string html = read_text(path("r.html"));
     EXPECT_TRUE(contains(html, "Interrupted: direct-light stopped after")) << html.substr(0, 2000);
     EXPECT_TRUE(contains(html, "Interrupted: direct-mis was not rendered."));
     for (const std::string& s : image_sources(html)) {

@@ -77,15 +77,18 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
                                  "Longest path in bounces (-1: unlimited; default: the scene file's, else -1)");
     app.add_option_function<int>("--rr-depth", [&o](const int& v) { o.rr_depth = v, o.rr_depth_given = true; },
                                  "Bounces before Russian roulette starts (default: the scene file's, else 3)");
-    app.add_option("--mis", o.mis, "bdpt: the MIS heuristic, balance or power")->capture_default_str();
+    app.add_option("--mis", o.mis, "bdpt, vcm, bpm: the MIS heuristic, balance or power")->capture_default_str();
     app.add_option("--strategies", o.strategies_dir,
                    "bdpt: also write one image per strategy (s, t), weighted and unweighted, and montages, into this directory "
                    "(placeholders as for -o)");
     app.add_option("--strategies-depth", o.strategies_depth, "bdpt: ... for paths of up to this many bounces")->capture_default_str();
     app.add_option("--photons", o.photons, "sppm: light paths per iteration (default one per pixel); pm: light paths of its maps (8 per pixel)");
     app.add_option("--radius", o.photon_radius,
-                   "sppm: the first iteration's photon radius (default two pixel footprints at the scene's centre); pm: a fixed radius instead of the k nearest");
-    app.add_option("--alpha", o.photon_alpha, "sppm: the radius reduction, in (0, 1] (default 2/3)");
+                   "sppm, vcm, bpm: the first iteration's photon radius (default two pixel footprints at the scene's centre); pm: a fixed "
+                   "radius instead of the k nearest");
+    app.add_option("--alpha", o.photon_alpha, "sppm, vcm, bpm: the radius reduction, in (0, 1] (default 2/3)");
+    app.add_flag("--no-merging", o.no_merging, "vcm: connections only (then it is bdpt)");
+    app.add_flag("--no-connections", o.no_connections, "vcm: merging only (then it is bpm)");
     app.add_flag("-q,--quiet", o.quiet, "No progress line and no summary");
 }
 
@@ -123,6 +126,9 @@ int run_render_command(const RenderCommandOptions& o) {
     request.photons = o.photons;
     request.photon_radius = o.photon_radius;
     request.photon_alpha = o.photon_alpha;
+    request.vcm_merging = !o.no_merging;
+    request.vcm_connections = !o.no_connections;
+    if (o.no_merging && o.no_connections) throw UsageError("--no-merging and --no-connections together leave vcm no strategy");
 
     std::vector<RenderJob> jobs;
     for (SceneChoice& choice : resolve_scenes(o.scene, defines)) jobs.emplace_back(std::move(choice), request);
@@ -143,12 +149,21 @@ int run_render_command(const RenderCommandOptions& o) {
         for (const std::string& path : jobs[j].outputs) paths.output(path, "the output", /*image=*/true);
         if (!o.stats_path.empty()) paths.output(jobs[j].expand(o.stats_path), "--stats", /*image=*/false);
         const std::string& algorithm = jobs[j].integrator_info().name;
-        if ((o.photons || o.photon_radius) && algorithm != "sppm" && algorithm != "pm")
-            throw UsageError(fmt::format("--photons and --radius set the photons of sppm and pm; {} has none", algorithm));
-        if (o.photon_alpha && algorithm != "sppm")
-            throw UsageError(fmt::format("--alpha is sppm's radius reduction, not {}'s", algorithm));
-        if (o.mis == "power" && jobs[j].integrator_info().name != "bdpt")
-            throw UsageError(fmt::format("--mis chooses the heuristic of bdpt; {} has its own", jobs[j].integrator_info().name));
+        const auto one_of = [&algorithm](std::initializer_list<const char*> names) {
+            for (const char* n : names)
+                if (algorithm == n) return true;
+            return false;
+        };
+        if (o.photons && !one_of({"sppm", "pm"}))
+            throw UsageError(fmt::format("--photons sets the light paths of sppm and pm; {} has no such count", algorithm));
+        if (o.photon_radius && !one_of({"sppm", "pm", "vcm", "bpm"}))
+            throw UsageError(fmt::format("--radius sets the photon radius of sppm, pm, vcm and bpm; {} has none", algorithm));
+        if (o.photon_alpha && !one_of({"sppm", "vcm", "bpm"}))
+            throw UsageError(fmt::format("--alpha is the radius reduction of sppm, vcm and bpm, not {}'s", algorithm));
+        if (o.mis == "power" && !one_of({"bdpt", "vcm", "bpm"}))
+            throw UsageError(fmt::format("--mis chooses the heuristic of bdpt, vcm and bpm; {} has its own", algorithm));
+        if ((o.no_merging || o.no_connections) && algorithm != "vcm")
+            throw UsageError(fmt::format("--no-merging and --no-connections switch off vcm's strategies, not {}'s", algorithm));
         if (!o.strategies_dir.empty()) {
             if (jobs[j].integrator_info().name != "bdpt")
                 throw UsageError(fmt::format("--strategies writes the strategies of bdpt, not of {}", jobs[j].integrator_info().name));

@@ -35,6 +35,8 @@ struct RenderCommandOptions {
     std::optional<int64_t> photons;
     std::optional<float> photon_radius;
     std::optional<double> photon_alpha;
+    bool no_merging = false;      // vcm: connections only (= bdpt)
+    bool no_connections = false;  // vcm: merging only (= bpm)
 };
 
 void add_render_options(CLI::App& app, RenderCommandOptions& opt);

@@ -43,6 +43,9 @@ struct IntegratorOptions {
     int64_t photons = 0;
     float photon_radius = 0;
     double photon_alpha = 2.0 / 3.0;
+    // vcm: its two families of strategies (off: merging = bdpt, connections = bpm).
+    bool vcm_merging = true;
+    bool vcm_connections = true;
 };
 
 // What every pass of one render sees; fixed for the whole render.

@@ -25,6 +25,8 @@ RenderJob::RenderJob(SceneChoice scene, const JobRequest& r) : choice_(std::move
     options_.photons = r.photons ? *r.photons : d.photons.value_or(0);
     options_.photon_radius = r.photon_radius ? *r.photon_radius : d.photon_radius.value_or(0.0f);
     options_.photon_alpha = r.photon_alpha ? *r.photon_alpha : d.photon_alpha.value_or(2.0 / 3.0);
+    options_.vcm_merging = r.vcm_merging;
+    options_.vcm_connections = r.vcm_connections;
     if (options_.photons < 0) throw UsageError("--photons must be zero (the default count) or positive");
     if (!(options_.photon_radius >= 0) || !std::isfinite(options_.photon_radius))
         throw UsageError("--radius must be zero (from the scene's size) or a positive distance");

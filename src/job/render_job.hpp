@@ -34,7 +34,9 @@ struct JobRequest {
     int strategies_depth = 4;      // --strategies-depth N (bdpt)
     std::optional<int64_t> photons;       // --photons N (sppm, pm)
     std::optional<float> photon_radius;   // --radius R (sppm, pm)
-    std::optional<double> photon_alpha;   // --alpha A (sppm)
+    std::optional<double> photon_alpha;   // --alpha A (sppm, vcm, bpm)
+    bool vcm_merging = true;              // not --no-merging (vcm)
+    bool vcm_connections = true;          // not --no-connections (vcm)
 };
 
 // The integrator `name` (or an alias); a UsageError listing them all otherwise.

@@ -23,15 +23,12 @@ float cos_at(const PathVertex& v, const Vec3f& w) {
     return v.kind == VertexKind::Surface ? std::abs(dot(v.sp.frame.n, w)) : (v.has_normal() ? std::abs(dot(v.n, w)) : 1.0f);
 }
 
-// The random numbers of one sample come from separate streams: the camera subpath (the stream
-// a pixel integrator would use), the light subpath, and the connections of each camera vertex
-// t (next-event estimation draws there). So a subpath's vertices, and the light points s = 1
-// samples, are the same whichever strategies are evaluated: a render restricted to one path
-// length (or to a lower depth) is made of the same paths as the full one.
-uint64_t sample_stream(size_t pixel, uint64_t stream) { return uint64_t(pixel) + (stream << 40); }
-
-// Pixels per chunk of a pass: a function of the image size only (see the light tracer).
-size_t chunk_size(size_t pixels) { return std::max<size_t>(16, pixels / 64); }
+// The random numbers of one sample come from separate streams (Bdpt::sample_stream): the
+// camera subpath (the stream a pixel integrator would use), the light subpath, and the
+// connections of each camera vertex t (next-event estimation draws there). So a subpath's
+// vertices, and the light points s = 1 samples, are the same whichever strategies are
+// evaluated: a render restricted to one path length (or to a lower depth) is made of the same
+// paths as the full one.
 
 }  // namespace
 
@@ -154,7 +151,7 @@ void Bdpt::light_subpath(const RenderContext& ctx, Sampler& sampler, std::vector
 }
 
 float Bdpt::mis_weight(const RenderContext& ctx, std::vector<PathVertex>& light, int s, std::vector<PathVertex>& camera, int t,
-                       const PathVertex& sampled, const EdgeDensities& known) const {
+                       const PathVertex& sampled, const EdgeDensities& known, const MergeMis* vm) const {
     if (s + t == 2) return 1.0f;
     const Scene& scene = ctx.scene;
     // The strategy's own vertices: the sampled endpoint (y_0 for s = 1, z_0 for t = 1: the only
@@ -201,7 +198,7 @@ float Bdpt::mis_weight(const RenderContext& ctx, std::vector<PathVertex>& light,
         }
         w = float(1 / (1 + sum));
     } else {
-        w = mis_weight_ratio_walk(ys, s, zs, t, options_.mis_power);
+        w = mis_weight_ratio_walk(ys, s, zs, t, options_.mis_power, vm);
     }
 
     for (Saved& x : saved)
@@ -210,7 +207,7 @@ float Bdpt::mis_weight(const RenderContext& ctx, std::vector<PathVertex>& light,
 }
 
 StrategyResult Bdpt::connect(const RenderContext& ctx, std::vector<PathVertex>& light, int s, std::vector<PathVertex>& camera, int t,
-                             Sampler& sampler) const {
+                             Sampler& sampler, const MergeMis* vm) const {
     const Scene& scene = ctx.scene;
     StrategyResult r;
     PathVertex sampled;
@@ -270,7 +267,7 @@ StrategyResult Bdpt::connect(const RenderContext& ctx, std::vector<PathVertex>& 
         if (is_black(r.L) || scene.occluded(pt.segment_to(qs))) return StrategyResult{};
     }
     if (is_black(r.L)) return r;
-    r.weight = mis_weight(ctx, light, s, camera, t, sampled, known);
+    r.weight = mis_weight(ctx, light, s, camera, t, sampled, known, vm);
     return r;
 }
 

@@ -77,12 +77,21 @@ public:
     // The subpaths of one sample (for the tests and the per-pixel loop).
     void camera_subpath(const RenderContext& ctx, size_t pixel, Sampler& sampler, std::vector<PathVertex>& path) const;
     void light_subpath(const RenderContext& ctx, Sampler& sampler, std::vector<PathVertex>& path) const;
-    // Strategy (s, t) on the subpaths (which it may modify temporarily).
+    // Strategy (s, t) on the subpaths (which it may modify temporarily); `vm`: the merging
+    // strategies that also take part in its MIS weight (vcm).
     StrategyResult connect(const RenderContext& ctx, std::vector<PathVertex>& light, int s, std::vector<PathVertex>& camera, int t,
-                           Sampler& sampler) const;
+                           Sampler& sampler, const MergeMis* vm = nullptr) const;
     // The MIS weight of strategy (s, t); `sampled` replaces y_0 (s = 1) or z_0 (t = 1).
     float mis_weight(const RenderContext& ctx, std::vector<PathVertex>& light, int s, std::vector<PathVertex>& camera, int t,
-                     const PathVertex& sampled, const EdgeDensities& known = {}) const;
+                     const PathVertex& sampled, const EdgeDensities& known = {}, const MergeMis* vm = nullptr) const;
+
+    // The random-number stream of a sample: 0 the camera subpath (the pixel's own), 1 the light
+    // subpath, 1 + t the connections at camera vertex t.
+    static uint64_t sample_stream(size_t pixel, uint64_t stream) { return uint64_t(pixel) + (stream << 40); }
+    // Pixels per chunk of a pass: a function of the image size only.
+    static size_t chunk_size(size_t pixels) { return std::max<size_t>(16, pixels / 64); }
+    bool power_heuristic() const { return options_.mis_power; }
+    int max_bounces() const { return max_bounces_; }
 
     // The per-strategy films (null without --strategies).
     const StrategyImages* strategy_images() const { return strategies_.get(); }

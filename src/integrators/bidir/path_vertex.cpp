@@ -73,25 +73,10 @@ float pdf_light_origin(const Scene& scene, const PathVertex& v, const PathVertex
     return scene.light_pmf(v.light) * pdf_emission(light, v.p, v.emitter_n, w, scene.scene_sphere()).pdfA;
 }
 
-float mis_weight_ratio_walk(const PathVertex* light, int s, const PathVertex* camera, int t, bool power) {
+float mis_weight_ratio_walk(const PathVertex* light, int s, const PathVertex* camera, int t, bool power, const MergeMis* vm) {
     if (s + t == 2) return 1.0f;  // a light seen directly: only s = 0 samples it (s = t = 1 is not used)
-    // A density of 0 marks a Dirac lobe: those strategies are left out, and the ratio passes
-    // through the vertex unchanged.
-    const auto remap0 = [](float f) { return f != 0 ? double(f) : 1.0; };
-    const auto h = [power](double r) { return power ? r * r : r; };
-    double sum = 0, ri = 1;
-    // Strategies with fewer light vertices: the camera subpath's vertices, taken from the light side.
-    for (int i = t - 1; i > 0; --i) {
-        ri *= remap0(camera[i].pdf_rev) / remap0(camera[i].pdf_fwd);
-        if (!camera[i].delta && !camera[i - 1].delta) sum += h(ri);
-    }
-    // Strategies with more light vertices.
-    ri = 1;
-    for (int i = s - 1; i >= 0; --i) {
-        ri *= remap0(light[i].pdf_rev) / remap0(light[i].pdf_fwd);
-        const bool delta_before = i > 0 ? light[i - 1].delta : light[0].delta_light;
-        if (!light[i].delta && !delta_before) sum += h(ri);
-    }
+    const double sum = mis_ratio_sum([light](int i) { return mis_vertex(light[i]); }, s, [camera](int i) { return mis_vertex(camera[i]); },
+                                     t, power, vm);
     return float(1 / (1 + sum));
 }
 

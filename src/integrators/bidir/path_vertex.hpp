@@ -64,10 +64,71 @@ float pdf_light_emission(const Scene& scene, const PathVertex& v, const PathVert
 // position for finite lights, its direction for lights at infinity), looking from `from`.
 float pdf_light_origin(const Scene& scene, const PathVertex& v, const PathVertex& from);
 
+// What the MIS weights read of a vertex (so that a weight can be computed with some of a
+// path's densities replaced, without copying its vertices).
+struct MisVertex {
+    float pdf_fwd, pdf_rev;
+    bool delta, delta_light;
+    bool surface;  // a surface vertex (where vertex merging may happen)
+};
+inline MisVertex mis_vertex(const PathVertex& v) { return {v.pdf_fwd, v.pdf_rev, v.delta, v.delta_light, v.kind == VertexKind::Surface}; }
+
+// Vertex merging (vcm, bpm; Georgiev et al. 2012): the strategies a path can also be sampled by.
+// Merging at vertex x (a non-Dirac surface vertex with at least one light vertex before it and
+// the camera after it) samples x from both sides; its density is that of the connection whose
+// camera endpoint is x, times the light side's area density of x, times eta = the number of
+// light paths merged with (n_VM, against n_VC = 1 for connections) times the acceptance area
+// pi r^2 (the VCM report's formulation). After a Dirac vertex on the light side the density of
+// x is that vertex's delta, which every strategy sampling x from the light side shares: 1.
+struct MergeMis {
+    double eta = 0;
+    bool merging = false;     // merging strategies take part
+    bool connections = true;  // connection strategies with s >= 1 take part (s = 0 always does)
+};
+
+// The sum over the path's strategies other than (s, t) of (p_i / p_(s,t))^beta (beta = 2 for
+// the power heuristic, else 1): Veach's ratio walk over light(0..s) and camera(0..t), callables
+// giving each vertex's MisVertex, with the connecting vertices' densities already those of
+// strategy (s, t). With `vm`, merging strategies too.
+template <typename LightAt, typename CameraAt>
+double mis_ratio_sum(const LightAt& light, int s, const CameraAt& camera, int t, bool power, const MergeMis* vm) {
+    // A density of 0 marks a Dirac lobe: those strategies are left out, and the ratio passes
+    // through the vertex unchanged.
+    const auto remap0 = [](float f) { return f != 0 ? double(f) : 1.0; };
+    const auto h = [power](double r) { return power ? r * r : r; };
+    const bool connections = !vm || vm->connections, merging = vm && vm->merging;
+    double sum = 0, ri = 1;
+    // Strategies with fewer light vertices: the camera subpath's vertices, taken from the light side.
+    for (int i = t - 1; i > 0; --i) {
+        const MisVertex c = camera(i);
+        // Merging at camera vertex i: ri is here the ratio of the connection ending there. A
+        // light-side density of 0 after a Dirac vertex is that vertex's delta, common to every
+        // strategy that samples i from the light side: 1, as in the ratios.
+        if (merging && c.surface && !c.delta && s + (t - 1 - i) >= 1) {
+            const bool after_dirac = i == t - 1 ? light(s - 1).delta : camera(i + 1).delta;
+            sum += h(ri * (after_dirac ? 1.0 : double(c.pdf_rev)) * vm->eta);
+        }
+        ri *= remap0(c.pdf_rev) / remap0(c.pdf_fwd);
+        if (connections && !c.delta && !camera(i - 1).delta) sum += h(ri);
+    }
+    // Strategies with more light vertices.
+    ri = 1;
+    for (int i = s - 1; i >= 0; --i) {
+        const MisVertex l = light(i);
+        ri *= remap0(l.pdf_rev) / remap0(l.pdf_fwd);
+        const bool delta_before = i > 0 ? light(i - 1).delta : l.delta_light;
+        if ((connections || i == 0) && !l.delta && !delta_before) sum += h(ri);
+        // Merging at light vertex i, now the camera endpoint of the connection (i, s + t - i).
+        if (merging && i >= 1 && l.surface && !l.delta) sum += h(ri * (light(i - 1).delta ? 1.0 : double(l.pdf_fwd)) * vm->eta);
+    }
+    return sum;
+}
+
 // The balance (power = false) or power heuristic weight of strategy (s, t) for the path made
 // of light[0..s) and camera[0..t), from their stored densities: Veach's ratio walk. `light`
 // and `camera` hold the subpaths with the connecting vertices' densities already updated for
 // this strategy (see Bdpt::mis_weight); vertices are left unchanged.
-float mis_weight_ratio_walk(const PathVertex* light, int s, const PathVertex* camera, int t, bool power);
+float mis_weight_ratio_walk(const PathVertex* light, int s, const PathVertex* camera, int t, bool power,
+                            const MergeMis* vm = nullptr);
 
 }  // namespace pathlab

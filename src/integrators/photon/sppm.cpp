@@ -8,6 +8,7 @@
 
 #include "integrators/common/path_rules.hpp"
 #include "integrators/integrators.hpp"
+#include "integrators/photon/progressive_radius.hpp"
 #include "integrators/photon/visible_point.hpp"
 
 namespace pathlab {
@@ -25,22 +26,9 @@ Sppm::Sppm(const IntegratorOptions& options, SppmFaults faults)
     : options_(limited_to_length(options)), faults_(faults),
       max_bounces_(options_.max_depth < 0 ? kMaxBounces : std::min(options_.max_depth, kMaxBounces)), light_paths_(options_) {}
 
-double Sppm::radius(double r1, double alpha, uint64_t i) {
-    // r_i^2 = r_1^2 prod_{k=1}^{i-1} (k + alpha) / (k + 1) = r_1^2 Gamma(i + alpha) / (Gamma(1 + alpha) Gamma(i + 1))
-    const double log_ratio = std::lgamma(double(i) + alpha) - std::lgamma(1 + alpha) - std::lgamma(double(i) + 1);
-    return r1 * std::exp(0.5 * log_ratio);
-}
+double Sppm::radius(double r1, double alpha, uint64_t i) { return progressive_radius(r1, alpha, i); }
 
-float Sppm::initial_radius(const RenderContext& ctx) const {
-    if (options_.photon_radius > 0) return options_.photon_radius;
-    // Two pixel footprints at the distance of the scene's centre: the angle between the rays
-    // through two neighbouring pixels at the image centre, times that distance.
-    const float cx = 0.5f * float(ctx.width), cy = 0.5f * float(ctx.height);
-    const Vec3f a = normalize(ctx.camera.generate(cx, cy).d), b = normalize(ctx.camera.generate(cx + 1, cy).d);
-    const float angle = 2 * std::asin(std::min(1.0f, 0.5f * length(a - b)));
-    const float distance = length(ctx.scene.scene_sphere().center - ctx.camera.position());
-    return std::max(2 * angle * distance, 1e-4f * ctx.scene.scene_sphere().radius);
-}
+float Sppm::initial_radius(const RenderContext& ctx) const { return initial_photon_radius(ctx, options_); }
 
 uint64_t Sppm::trace_photons(const RenderContext& ctx, uint64_t pass, size_t paths) {
     const size_t per_chunk = paths_per_chunk(paths), chunks = (paths + per_chunk - 1) / per_chunk;

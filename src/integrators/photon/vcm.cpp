@@ -1,0 +1,220 @@
+#include "integrators/photon/vcm.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <atomic>
+
+#include "integrators/common/path_rules.hpp"
+#include "integrators/integrators.hpp"
+#include "integrators/photon/progressive_radius.hpp"
+
+namespace pathlab {
+
+Vcm::Vcm(const IntegratorOptions& options, VcmFaults faults) : options_(limited_to_length(options)), faults_(faults), bdpt_(options_) {}
+
+size_t Vcm::light_vertex_count() const {
+    size_t n = 0;
+    for (const auto& c : chunk_vertices_) n += c.size();
+    return n;
+}
+
+size_t Vcm::memory_bytes() const {
+    size_t bytes = grid_.memory_bytes() + photons_.capacity() * sizeof(Photon) + photon_vertex_.capacity() * sizeof(void*) +
+                   path_begin_.capacity() * sizeof(uint32_t) + path_length_.capacity() * sizeof(uint16_t);
+    for (const auto& c : chunk_vertices_) bytes += c.capacity() * sizeof(PathVertex);
+    for (const auto& c : chunk_photons_) bytes += c.capacity() * sizeof(Photon);
+    for (const auto& c : chunk_photon_vertex_) bytes += c.capacity() * sizeof(uint32_t);
+    return bytes;
+}
+
+uint64_t Vcm::trace_light_paths(const RenderContext& ctx, uint64_t pass) {
+    const size_t paths = ctx.pixel_count(), per_chunk = Bdpt::chunk_size(paths), chunks = (paths + per_chunk - 1) / per_chunk;
+    chunk_vertices_.resize(chunks);
+    chunk_photons_.resize(chunks);
+    chunk_photon_vertex_.resize(chunks);
+    path_begin_.resize(paths);
+    path_length_.resize(paths);
+    const int max_bounces = bdpt_.max_bounces();
+    std::atomic<uint64_t> rays{0};
+    tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+        const uint64_t rays_before = Scene::rays_traced_by_this_thread();
+        std::vector<PathVertex>& path = subpaths_.local().second;  // keeps its capacity from pass to pass
+        std::vector<PathVertex>& vertices = chunk_vertices_[c];
+        std::vector<Photon>& photons = chunk_photons_[c];
+        std::vector<uint32_t>& photon_vertex = chunk_photon_vertex_[c];
+        vertices.clear(), photons.clear(), photon_vertex.clear();
+        for (size_t j = c * per_chunk; j < std::min(paths, (c + 1) * per_chunk); ++j) {
+            // Light path j is pixel j's, from bdpt's stream: the same path bdpt would connect.
+            Sampler sampler(ctx.seed, Bdpt::sample_stream(j, 1), pass, ctx.sampler);
+            bdpt_.light_subpath(ctx, sampler, path);
+            path_begin_[j] = uint32_t(vertices.size());
+            path_length_[j] = uint16_t(path.size());
+            for (size_t v = 1; v < path.size(); ++v) {
+                const PathVertex& y = path[v];
+                if (y.kind != VertexKind::Surface || !y.connectible() || int(v) > max_bounces) continue;
+                photons.push_back({y.p, y.sp.frame.to_world(y.sp.wi), y.beta, uint16_t(v)});
+                photon_vertex.push_back(uint32_t(vertices.size() + v));
+            }
+            vertices.insert(vertices.end(), path.begin(), path.end());
+        }
+        rays += Scene::rays_traced_by_this_thread() - rays_before;
+    });
+    photons_.clear();
+    photon_vertex_.clear();
+    for (size_t c = 0; c < chunks; ++c) {
+        photons_.insert(photons_.end(), chunk_photons_[c].begin(), chunk_photons_[c].end());
+        for (const uint32_t v : chunk_photon_vertex_[c]) photon_vertex_.push_back(&chunk_vertices_[c][v]);
+    }
+    return rays.load();
+}
+
+float Vcm::merge_weight(const PathVertex* y, int s, const std::vector<PathVertex>& camera, int t, const MergeMis& vm) const {
+    // The path is weighed as the connection (s - 1, t) whose camera endpoint is z = z_{t-1}
+    // (standing for the photon's vertex y_{s-1}): z's light-side density is the photon's, and
+    // the densities through z of its neighbours are z's BSDF's, between the photon's direction
+    // and the camera's. The rest of both subpaths keep their stored densities: the light
+    // subpath did arrive at y_{s-1}, the camera subpath at z.
+    const PathVertex& z = camera[size_t(t - 1)];
+    const PathVertex& photon = y[s - 1];
+    const Vec3f wp = z.sp.frame.to_local(photon.sp.frame.to_world(photon.sp.wi));
+    const float pdf_to_light = z.sp.material->pdf(z.sp.wi, wp);     // z sampling the photon's direction
+    const float pdf_to_camera = z.sp.material->pdf(wp, z.sp.wi);    // ... and the camera's, from the photon's
+    const float light_prev_rev = to_area_density(pdf_to_light, photon, y[s - 2]);
+    const float camera_prev_rev = to_area_density(pdf_to_camera, z, camera[size_t(t - 2)]);
+    const MisVertex zm{z.pdf_fwd, photon.pdf_fwd, false, false, true};
+    const auto light_at = [&](int i) {
+        MisVertex m = mis_vertex(y[i]);
+        if (i == s - 2) m.pdf_rev = light_prev_rev;
+        return m;
+    };
+    const auto camera_at = [&](int i) {
+        if (i == t - 1) return zm;
+        MisVertex m = mis_vertex(camera[size_t(i)]);
+        if (i == t - 2) m.pdf_rev = camera_prev_rev;
+        return m;
+    };
+    const bool power = bdpt_.power_heuristic();
+    // The sum includes this merge itself (merging at camera vertex t - 1), and the connection
+    // (s - 1, t) is the reference, 1, where it exists.
+    const double others = mis_ratio_sum(light_at, s - 1, camera_at, t, power, &vm);
+    const double reference = vm.connections && !y[s - 2].delta ? 1.0 : 0.0;
+    double own = (y[s - 2].delta || faults_.merge_weight_without_light_pdf ? 1.0 : double(photon.pdf_fwd)) * vm.eta;
+    if (power) own *= own;
+    const double total = reference + others;
+    return total > 0 ? float(own / total) : 0.0f;
+}
+
+Rgb Vcm::merge(const std::vector<PathVertex>& camera, int t, float r, const MergeMis& vm) const {
+    const PathVertex& z = camera[size_t(t - 1)];
+    const int max_bounces = bdpt_.max_bounces();
+    Rgb sum(0.0f);
+    grid_.for_each_within(z.p, r, [&](const Photon& ph) {
+        const int s = int(ph.vertex) + 1;
+        const int depth = s + t - 3;
+        if (depth > max_bounces || (options_.only_length >= 0 && depth != options_.only_length)) return;
+        const Rgb f = z.sp.material->eval(z.sp, z.sp.wi, z.sp.frame.to_local(ph.wi));
+        if (is_black(f)) return;
+        const PathVertex* y = photon_vertex_[size_t(&ph - photons_.data())] - ph.vertex;
+        sum += f * ph.power * merge_weight(y, s, camera, t, vm);
+    });
+    return z.beta * sum / float(norm_);
+}
+
+PassCounters Vcm::render_passes(const RenderContext& ctx, Film& film, uint64_t first, int count, const PassProgress& progress) {
+    const size_t pixels = ctx.pixel_count(), per_chunk = Bdpt::chunk_size(pixels);
+    const int chunks = int((pixels + per_chunk - 1) / per_chunk);
+    const double r1 = initial_photon_radius(ctx, options_), alpha = options_.photon_alpha;
+    const int max_bounces = bdpt_.max_bounces();
+    std::atomic<uint64_t> rays{0}, invalid{0};
+    for (int k = 0; k < count; ++k) {
+        const uint64_t pass = first + uint64_t(k);
+        const float r = float(progressive_radius(r1, alpha, pass + 1));
+        MergeMis vm;
+        vm.merging = options_.vcm_merging;
+        vm.connections = options_.vcm_connections;
+        norm_ = double(pixels) * (faults_.no_pi_in_kernel ? 1.0 : kPi) * double(r) * double(r);
+        vm.eta = norm_;
+        rays += trace_light_paths(ctx, pass);
+        if (vm.merging) grid_.build(photons_, r);
+        if (progress) progress((double(k) + 0.25) / count);
+        pass_.begin(pixels, chunks);
+        std::atomic<int> chunks_done{0};
+        tbb::parallel_for(tbb::blocked_range<int>(0, chunks, 1), [&](const tbb::blocked_range<int>& range) {
+            auto& [camera, light] = subpaths_.local();
+            for (int c = range.begin(); c != range.end(); ++c) {
+                const uint64_t rays_before = Scene::rays_traced_by_this_thread();
+                uint64_t chunk_invalid = 0;
+                SplatList& splats = pass_.chunk(c);
+                const auto add = [&](const Rgb& value, bool splat, const Vec2f& raster, size_t pixel) {
+                    if (!is_finite(value)) return void(++chunk_invalid);
+                    if (splat) splats.add(uint32_t(ctx.camera.pixel_of(raster)), value);
+                    else pass_.pixel(pixel) += Vec3d(value);
+                };
+                for (size_t pixel = size_t(c) * per_chunk; pixel < std::min(pixels, size_t(c + 1) * per_chunk); ++pixel) {
+                    Sampler camera_sampler(ctx.seed, pixel, pass, ctx.sampler);
+                    bdpt_.camera_subpath(ctx, pixel, camera_sampler, camera);
+                    // This pixel's light subpath, copied: connections modify it for a moment,
+                    // while other threads read the stored one to merge.
+                    const PathVertex* stored = chunk_vertices_[pixel / per_chunk].data() + path_begin_[pixel];
+                    light.assign(stored, stored + path_length_[pixel]);
+                    for (int t = 1; t <= int(camera.size()); ++t) {
+                        // The connections, as bdpt evaluates them (s = 0 alone without connections).
+                        Sampler sampler(ctx.seed, Bdpt::sample_stream(pixel, 1 + uint64_t(t)), pass, ctx.sampler);
+                        const int s_max = vm.connections ? std::max(1, int(light.size())) : 0;
+                        for (int s = 0; s <= s_max; ++s) {
+                            const int depth = s + t - 2;
+                            if ((s == 1 && t == 1) || depth < 0 || depth > max_bounces) continue;
+                            if (options_.only_length >= 0 && depth != options_.only_length) continue;
+                            const StrategyResult res = bdpt_.connect(ctx, light, s, camera, t, sampler, &vm);
+                            if (!is_black(res.L)) add(res.L * res.weight, res.splat, res.raster, pixel);
+                        }
+                        // Merging at z_{t-1}.
+                        const PathVertex& z = camera[size_t(t - 1)];
+                        if (vm.merging && t >= 2 && z.kind == VertexKind::Surface && z.connectible()) {
+                            const Rgb m = merge(camera, t, r, vm);
+                            if (!is_black(m)) add(m, false, {}, pixel);
+                        }
+                    }
+                }
+                rays += Scene::rays_traced_by_this_thread() - rays_before;
+                invalid += chunk_invalid;
+                if (progress) progress((double(k) + 0.25 + 0.75 * double(++chunks_done) / chunks) / count);
+            }
+        });
+        pass_.finish(film);
+    }
+    return {rays.load(), invalid.load()};
+}
+
+namespace {
+
+std::vector<ParamInfo> vcm_params() {
+    std::vector<ParamInfo> p = path_params();
+    p.push_back({"initial_radius", ParamType::Float, "0", "the first iteration's radius (0: two pixel footprints at the scene's centre; --radius wins)",
+                 "initialRadius"});
+    p.push_back({"alpha", ParamType::Float, "0.666667", "the radius reduction, in (0, 1] (--alpha wins)"});
+    return p;
+}
+
+}  // namespace
+
+const IntegratorInfo& vcm_integrator() {
+    static const IntegratorInfo info{"vcm", {}, "vertex connection and merging: bdpt's connections and photon merging, combined by MIS",
+                                     false, true, vcm_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
+                                         return std::make_unique<Vcm>(o);
+                                     }};
+    return info;
+}
+
+const IntegratorInfo& bpm_integrator() {
+    static const IntegratorInfo info{"bpm", {}, "bidirectional photon mapping: merging at every camera vertex, combined by MIS (vcm without connections)",
+                                     false, true, vcm_params(), [](IntegratorOptions o) -> std::unique_ptr<Integrator> {
+                                         o.vcm_connections = false;
+                                         o.vcm_merging = true;
+                                         return std::make_unique<Vcm>(o);
+                                     }};
+    return info;
+}
+
+}  // namespace pathlab

@@ -1,0 +1,84 @@
+// vcm and bpm: vertex connection and merging (Georgiev, Křivánek, Davidovič and Slusallek 2012,
+// and their technical report "Implementing Vertex Connection and Merging"), and bidirectional
+// photon mapping (Vorba 2011), which is vcm without connections.
+//
+// An iteration i: one light subpath per pixel (N = the pixel count), traced and kept, and a
+// photon at every vertex y_1, y_2, ... on a non-Dirac surface; then per pixel a camera subpath
+// z_0, z_1, ..., which
+//   - connects to its own pixel's light subpath by every strategy (s, t) of bdpt (the same
+//     code, random numbers and densities: bdpt.hpp);
+//   - merges at every non-Dirac surface vertex z_{t-1} with the photons of all N light paths
+//     within the iteration's radius r_i: a photon y_{s-1} there makes the path y_0 .. y_{s-1},
+//     z_{t-2} .. z_0, with the estimate f(z, wo, wi_y) beta_y beta_z / (N pi r_i^2).
+// All these strategies are combined by multiple importance sampling (balance heuristic, or
+// power with --mis power) with bdpt's ratio walk extended by the merging strategies: merging at
+// a vertex x has the density of the connection ending at x, times the light side's area density
+// of x, times eta = N pi r_i^2 (path_vertex.hpp, MergeMis).
+//
+// The radius shrinks as in sppm (Knaus and Zwicker: r_i^2 = r_1^2 prod (k + alpha) / (k + 1),
+// progressive_radius.hpp; --radius, --alpha), so iterations are independent given their index
+// and the image converges. --no-merging leaves bdpt (bit for bit: the same samples and
+// weights), --no-connections bpm (the integrator `bpm`): merging at every camera vertex, plus
+// the emission the camera subpath hits (s = 0), by MIS between them.
+// Depth: merging y_{s-1} at z_{t-1} makes s + t - 3 bounces, limited by --max-depth as in bdpt.
+// Deterministic: light subpaths are traced in fixed chunks and stored in order, the grid's
+// order is fixed, and the camera pass splats (t = 1) through bdpt's per-chunk lists.
+#pragma once
+
+#include <tbb/enumerable_thread_specific.h>
+
+#include <vector>
+
+#include "integrators/bidir/bdpt.hpp"
+#include "integrators/integrator.hpp"
+#include "integrators/photon/photon_grid.hpp"
+#include "render/pass_image.hpp"
+
+namespace pathlab {
+
+// Deliberate faults, for the tests that must be able to fail.
+struct VcmFaults {
+    bool no_pi_in_kernel = false;  // the merge divides by N r^2 instead of N pi r^2 (also in the MIS)
+    bool merge_weight_without_light_pdf = false;  // a merge's own density lacks the light side's density of its vertex
+};
+
+class Vcm final : public Integrator {
+public:
+    explicit Vcm(const IntegratorOptions& options, VcmFaults faults = {});
+
+    PassCounters render_passes(const RenderContext& ctx, Film& film, uint64_t first, int count,
+                               const PassProgress& progress) override;
+
+    // The light subpaths and photons of iteration `pass` (kept until the next); returns the rays traced.
+    uint64_t trace_light_paths(const RenderContext& ctx, uint64_t pass);
+    // The merging estimate at camera vertex z_{t-1} (t >= 2) with the current photons, radius r,
+    // MIS-weighted against every strategy in `vm` (times the camera throughput).
+    Rgb merge(const std::vector<PathVertex>& camera, int t, float r, const MergeMis& vm) const;
+    // The MIS weight of merging photon y_{s-1} (light subpath y[0..s)) at camera vertex z_{t-1}.
+    float merge_weight(const PathVertex* y, int s, const std::vector<PathVertex>& camera, int t, const MergeMis& vm) const;
+
+    const Bdpt& bdpt() const { return bdpt_; }
+    size_t photon_count() const { return photons_.size(); }
+    size_t light_vertex_count() const;
+    // Bytes held for the light vertices and photons of one iteration (the grid included).
+    size_t memory_bytes() const;
+
+private:
+    IntegratorOptions options_;
+    VcmFaults faults_;
+    Bdpt bdpt_;  // the subpaths, the connections and their weights
+    // One iteration's light subpaths, per chunk of light paths, and where each path starts.
+    std::vector<std::vector<PathVertex>> chunk_vertices_;
+    std::vector<std::vector<Photon>> chunk_photons_;
+    std::vector<std::vector<uint32_t>> chunk_photon_vertex_;  // the light vertex of each photon, in its chunk
+    std::vector<uint32_t> path_begin_;                         // light path j: its chunk's vertices from here
+    std::vector<uint16_t> path_length_;                        // ... this many
+    std::vector<Photon> photons_;
+    std::vector<const PathVertex*> photon_vertex_;  // photons_[k] is the light vertex *photon_vertex_[k]
+    PhotonGrid grid_;
+    PassImage pass_;
+    tbb::enumerable_thread_specific<std::pair<std::vector<PathVertex>, std::vector<PathVertex>>> subpaths_;  // camera, light
+    double norm_ = 1;  // N pi r^2 of the current iteration
+};
+
+}  // namespace pathlab

@@ -1,0 +1,158 @@
+// VCM's MIS weights on hand-built paths (mis_harness.hpp): with merging, every strategy that
+// can make a path, the connections (s, t) and merging at each non-Dirac inner vertex x_j, gets
+// the weight of the balance (and power) heuristic computed here from the strategies' densities
+// written out from their definitions, the merge's being the VCM report's: the density of the
+// connection whose camera endpoint is x_j, times the light side's area density of x_j, times
+// eta = light paths x pi r^2. The weights sum to 1, with connections on (vcm) and off (bpm), for
+// several eta; a merge weight that leaves out the light side's density is caught.
+#include "integrators/photon/vcm.hpp"
+#include "mis_harness.hpp"
+
+namespace pathlab::test {
+namespace {
+
+class VcmMisHarness {
+public:
+    VcmMisHarness(const MisHarness& h, bool power, bool connections, VcmFaults faults = {})
+        : h_(h), vcm_(options(power), faults), power_(power) {
+        vm_.merging = true;
+        vm_.connections = connections;
+    }
+    void set_eta(double eta) { vm_.eta = eta; }
+
+    bool valid_connection(const FullPath& f, int s) const { return h_.valid(f, s) && (vm_.connections || s == 0); }
+    bool valid_merge(const FullPath& f, int j) const { return j >= 1 && j <= h_.k(f) - 1 && !h_.specular(f, j); }
+    // The light side's area density of x_j (from x_{j+1}); 1 after a Dirac vertex (its delta,
+    // common to every strategy that samples x_j from the light side).
+    double light_density(const FullPath& f, int j) const {
+        return j + 1 == h_.k(f) ? h_.light_emission(f) : h_.bsdf_density(f, j + 2, j + 1, j);
+    }
+    // Merging at x_j: the connection with camera endpoint x_j (s = k - j) times p_light(x_j) eta.
+    double merge_density(const FullPath& f, int j) const { return h_.strategy_density(f, h_.k(f) - j) * light_density(f, j) * vm_.eta; }
+
+    double direct_weight(const FullPath& f, bool merge, int index) const {
+        const auto h = [this](double x) { return power_ ? x * x : x; };
+        double sum = 0;
+        for (int s = 0; s <= h_.k(f); ++s)
+            if (valid_connection(f, s)) sum += h(h_.strategy_density(f, s));
+        for (int j = 1; j < h_.k(f); ++j)
+            if (valid_merge(f, j)) sum += h(merge_density(f, j));
+        return h(merge ? merge_density(f, index) : h_.strategy_density(f, index)) / sum;
+    }
+
+    float connection_weight(const FullPath& f, int s) const {
+        std::vector<PathVertex> light, camera;
+        h_.subpaths(f, s, light, camera);
+        return vcm_.bdpt().mis_weight(h_.ctx(), light, s, camera, h_.k(f) + 1 - s, h_.sampled_end(f, s), {}, &vm_);
+    }
+    // The photon x_j on the light subpath x_k .. x_j, merged at x_j on the camera subpath x_0 .. x_j.
+    float merge_weight(const FullPath& f, int j) const {
+        const int s = h_.k(f) - j + 1;
+        std::vector<PathVertex> light, camera, unused;
+        h_.subpaths(f, s, light, unused);
+        h_.subpaths(f, s - 1, unused, camera);
+        // As the light walk stores it: 0 after a Dirac vertex.
+        if (h_.specular(f, j + 1)) light.back().pdf_fwd = 0;
+        return vcm_.merge_weight(light.data(), s, camera, j + 1, vm_);
+    }
+
+private:
+    static IntegratorOptions options(bool power) {
+        IntegratorOptions o;
+        o.mis_power = power;
+        return o;
+    }
+    const MisHarness& h_;
+    Vcm vcm_;
+    bool power_;
+    MergeMis vm_;
+};
+
+// Checks every strategy's weight of f against the direct heuristic; returns the sum of the weights.
+double check_weights(const VcmMisHarness& v, const MisHarness& h, const FullPath& f, const std::string& what) {
+    double sum = 0;
+    for (int s = 0; s <= h.k(f); ++s) {
+        if (!v.valid_connection(f, s)) continue;
+        const float w = v.connection_weight(f, s);
+        const double expected = v.direct_weight(f, false, s);
+        EXPECT_FALSE(std::isnan(w)) << what << " s=" << s;
+        EXPECT_NEAR(w, expected, 1e-4 + 1e-4 * expected) << what << ", connection s=" << s;
+        sum += w;
+    }
+    for (int j = 1; j < h.k(f); ++j) {
+        if (!v.valid_merge(f, j)) continue;
+        const float w = v.merge_weight(f, j);
+        const double expected = v.direct_weight(f, true, j);
+        EXPECT_FALSE(std::isnan(w)) << what << " merge at x_" << j;
+        EXPECT_NEAR(w, expected, 1e-4 + 1e-4 * expected) << what << ", merge at x_" << j;
+        sum += w;
+    }
+    return sum;
+}
+
+void expect_weights(const MisHarness& h, const FullPath& f, const std::string& what) {
+    ASSERT_TRUE(f.problem.empty()) << what << ": " << f.problem;
+    for (const bool power : {false, true})
+        for (const bool connections : {true, false}) {
+            VcmMisHarness v(h, power, connections);
+            for (const double eta : {1e-3, 0.1, 10.0}) {
+                v.set_eta(eta);
+                const std::string label = what + (power ? " (power" : " (balance") + (connections ? ", vcm" : ", bpm") +
+                                          ", eta " + std::to_string(eta) + ")";
+                EXPECT_NEAR(check_weights(v, h, f, label), 1.0, 1e-4) << label;
+            }
+        }
+}
+
+TEST(VcmMis, AreaLightPaths) {
+    const MisHarness h(LightKind::Area);
+    const Vec3f on_light(0.1f, 0.45f, 2.5f), on_glossy(1.2f, 1.1f, 0.7f), a(0.2f, 0.4f, 0.0f), b(-0.4f, 2.5f, 1.0f);
+    expect_weights(h, h.build({a, on_light}), "camera-floor-light");
+    expect_weights(h, h.build({a, on_glossy, on_light}), "camera-floor-glossy-light");
+    expect_weights(h, h.build({a, b, on_light}), "camera-floor-wall-light");
+    expect_weights(h, h.build({on_glossy, a, b, on_light}), "camera-glossy-floor-wall-light");
+}
+
+TEST(VcmMis, PathsThroughAMirror) {
+    const MisHarness h(LightKind::Area);
+    const Vec3f on_light(0.1f, 0.45f, 2.5f), on_mirror(-1.2f, 1.0f, 0.8f);
+    expect_weights(h, h.build({floor_point_reflected_to(on_mirror, on_light), on_mirror, kReflect}), "camera-floor-mirror-light");
+    const Vec3f low_mirror(-1.2f, 0.6f, 0.3f);
+    expect_weights(h, h.build({low_mirror, kReflect, on_light}), "camera-mirror-floor-light");
+    expect_weights(h, h.build({low_mirror, kReflect, Vec3f(-0.4f, 2.5f, 1.0f), on_light}), "camera-mirror-floor-wall-light");
+}
+
+// Specular-diffuse-specular: merging is the only strategy (and gets weight 1).
+TEST(VcmMis, SpecularDiffuseSpecularFromAPointLight) {
+    const MisHarness h(LightKind::Point);
+    const Vec3f low_mirror(-1.2f, 0.6f, 0.3f);
+    expect_weights(h, h.build({low_mirror, kReflect}), "camera-mirror-floor-point");
+    expect_weights(h, h.build({low_mirror, kReflect, Vec3f(-0.4f, 2.5f, 1.0f)}), "camera-mirror-floor-wall-point");
+    expect_weights(h, h.build({Vec3f(0.2f, 0.4f, 0.0f), Vec3f(1.2f, 1.1f, 0.7f)}), "camera-floor-glossy-point");
+}
+
+TEST(VcmMis, EnvironmentPaths) {
+    const MisHarness h(LightKind::Environment);
+    const Vec3f a(0.2f, 0.4f, 0.0f);
+    expect_weights(h, h.build({a, Vec3f(1.2f, 1.1f, 0.7f)}, {-1.0f, 0.2f, 0.5f}), "camera-floor-glossy-sky");
+    expect_weights(h, h.build({Vec3f(-1.2f, 0.6f, 0.3f), kReflect}, {0.1f, 0.3f, 1.0f}), "camera-mirror-floor-sky");
+}
+
+// The test of the tests: a merge weight without the light side's density of its vertex no
+// longer sums to 1 with the others.
+TEST(VcmMis, DetectsAMergeDensityWithoutTheLightPdf) {
+    const MisHarness h(LightKind::Area);
+    const FullPath f = h.build({Vec3f(0.2f, 0.4f, 0.0f), Vec3f(-0.4f, 2.5f, 1.0f), Vec3f(0.1f, 0.45f, 2.5f)});
+    ASSERT_TRUE(f.problem.empty()) << f.problem;
+    VcmMisHarness v(h, false, true, VcmFaults{.merge_weight_without_light_pdf = true});
+    v.set_eta(0.1);
+    double sum = 0;
+    for (int s = 0; s <= h.k(f); ++s)
+        if (v.valid_connection(f, s)) sum += v.connection_weight(f, s);
+    for (int j = 1; j < h.k(f); ++j)
+        if (v.valid_merge(f, j)) sum += v.merge_weight(f, j);
+    EXPECT_GT(std::abs(sum - 1.0), 1e-2);
+}
+
+}  // namespace
+}  // namespace pathlab::test

@@ -2,8 +2,10 @@
 // at their non-Dirac vertices after one bounce, as sppm stores them), traced per second; then
 // the hashed grid against nanoflann's k-d tree: build time, the time of one radius query per
 // pixel's visible point (the first non-Dirac camera hit), and memory. Medians of repeats. Then
-// the equal-time RMSE of pt-mis, bdpt, sppm and pm against a long bdpt reference (its noise
-// subtracted), in interleaved rounds.
+// vcm's iterations: light vertices and photons stored, bytes per photon, time per iteration.
+// Then the equal-time RMSE of pt-mis, bdpt, pm, ppm, sppm, bpm and vcm against a long bdpt
+// reference (vcm's on the specular-diffuse-specular scene, where bdpt misses light), its noise
+// subtracted, in interleaved rounds.
 #include "photon_mapping.hpp"
 
 #include <tbb/parallel_for.h>
@@ -17,6 +19,7 @@
 #include "bench_common.hpp"
 #include "integrators/bidir/bdpt.hpp"
 #include "integrators/photon/photon_grid.hpp"
+#include "integrators/photon/vcm.hpp"
 #include "job/scene_choice.hpp"
 #include "scene/builtin_scenes.hpp"
 #include "scenefile/scene_file.hpp"
@@ -124,10 +127,33 @@ void photon_mapping_suite(const PhotonMappingOptions& o) {
                    double(photons.size()) / seconds * 1e-6, gb, kb, gq, kq, gf, (gb + gq) / (kb + kq));
         std::fflush(stdout);
     }
+    fmt::print("\n## vcm's iterations at {0}x{0} ({0}^2 light paths each; {1} threads, medians of {2})\n\n", o.equal_time_size, threads, o.repeats);
+    fmt::print("| scene | light vertices | photons | MB held | bytes per photon | ms per iteration | Mphotons/s |\n|---|---|---|---|---|---|---|\n");
+    for (const std::string& key : o.scenes) {
+        const auto scene = Scene::build(scene_of(key));
+        const PerspectiveCamera camera(scene->camera(), o.equal_time_size, o.equal_time_size);
+        const RenderContext ctx{*scene, camera, o.equal_time_size, o.equal_time_size, 5, SamplerKind::Independent, 32};
+        Vcm vcm({});
+        Film film(o.equal_time_size, o.equal_time_size);
+        std::vector<double> ms;
+        for (int k = 0; k < o.repeats; ++k) {
+            const auto t0 = Clock::now();
+            vcm.render_passes(ctx, film, uint64_t(k), 1, {});
+            ms.push_back(ms_since(t0));
+        }
+        const double photons = double(vcm.photon_count());
+        fmt::print("| {} | {} | {} | {:.2f} | {:.0f} | {:.1f} | {:.2f} |\n", key, vcm.light_vertex_count(), vcm.photon_count(),
+                   double(vcm.memory_bytes()) / (1 << 20), double(vcm.memory_bytes()) / std::max(1.0, photons), median(ms),
+                   photons / median(ms) * 1e-3);
+        std::fflush(stdout);
+    }
+    fmt::print("\n(A light vertex is {} bytes: vcm keeps whole subpaths for its connections; sppm keeps only the photons.)\n",
+               sizeof(PathVertex));
+
     fmt::print("\n## Equal time at {0}x{0}, {1} s per render ({2} threads, medians of {3} rounds; reference: bdpt at {4} spp, "
-               "its noise subtracted)\n\n",
+               "vcm on sds-caustic.xml, its noise subtracted)\n\n",
                o.equal_time_size, o.equal_time_seconds, threads, o.equal_time_repeats, o.ref_spp);
-    const std::vector<std::string> algorithms{"pt-mis", "bdpt", "sppm", "pm"};
+    const std::vector<std::string> algorithms{"pt-mis", "bdpt", "pm", "ppm", "sppm", "bpm", "vcm"};
     fmt::print("| scene |");
     for (const auto& a : algorithms) fmt::print(" {} RMSE |", a);
     fmt::print(" lowest |\n|---|");
@@ -135,7 +161,7 @@ void photon_mapping_suite(const PhotonMappingOptions& o) {
     fmt::print("\n");
     for (const std::string& key : o.scenes) {
         const auto scene = Scene::build(scene_of(key));
-        const Reference ref = make_reference(*scene, "bdpt", o.equal_time_size, o.ref_spp);
+        const Reference ref = make_reference(*scene, key == "sds-caustic.xml" ? "vcm" : "bdpt", o.equal_time_size, o.ref_spp);
         std::vector<std::vector<double>> errors(algorithms.size());
         for (int k = 0; k < o.equal_time_repeats; ++k)
             for (size_t a = 0; a < algorithms.size(); ++a) {
@@ -149,7 +175,9 @@ void photon_mapping_suite(const PhotonMappingOptions& o) {
             row += median(errors[a]) > 0 ? fmt::format(" | {:.4f}", median(errors[a])) : " | < reference noise";
             if (median(errors[a]) < median(errors[best])) best = a;
         }
-        fmt::print("{} | {} |\n", row, algorithms[best]);
+        const double bdpt = median(errors[1]), vcm = median(errors[6]);
+        fmt::print("{} | {} |{}\n", row, algorithms[best],
+                   vcm > 0 ? fmt::format(" (bdpt / vcm MSE {:.2f})", bdpt * bdpt / (vcm * vcm)) : "");
         std::fflush(stdout);
     }
 

@@ -1,6 +1,6 @@
 // The hot path allocates nothing: every estimator's radiance() for thousands of samples, the
 // light tracer's paths once its splat list has the size of a pass, and bdpt's subpaths and
-// connections, and sppm's iterations (but a few), make no heap allocation (counted by
+// connections, and the iterations of sppm, ppm, vcm and bpm (but a few), make no heap allocation (counted by
 // replacing operator new in this test binary).
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
@@ -10,6 +10,7 @@
 #include "integrators/bidir/light_tracer.hpp"
 #include "integrators/photon/pm.hpp"
 #include "integrators/photon/sppm.hpp"
+#include "integrators/photon/vcm.hpp"
 #include "job/renderer.hpp"
 #include "scene/builtin_scenes.hpp"
 
@@ -97,6 +98,20 @@ TEST(Allocation, NoEstimatorAllocatesPerSample) {
                 sppm->render_passes(ctx, film, 2, 1, {});
                 // (a chunk's photon list that outgrows its capacity, at most once per chunk)
                 EXPECT_LT(allocations_by_this_thread() - before, 64u) << info.name << " on scene " << index;
+                continue;
+            }
+            if (auto* vcm = dynamic_cast<Vcm*>(integrator.get())) {
+                // As sppm: after two iterations, one of 4096 light and camera paths (thousands of
+                // photons and merges) allocates at most when one of the 64 chunks'
+                // vertex, photon or photon-index lists outgrows its capacity.
+                tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+                const RenderContext ctx{*scene, camera, 64, 64, 7, SamplerKind::Independent, 32};
+                Film film(64, 64);
+                vcm->render_passes(ctx, film, 0, 2, {});
+                const uint64_t before = allocations_by_this_thread();
+                vcm->render_passes(ctx, film, 2, 1, {});
+                EXPECT_LT(allocations_by_this_thread() - before, 3u * 64u) << info.name << " on scene " << index;
+                EXPECT_GT(vcm->photon_count(), 2048u) << info.name << " on scene " << index;
                 continue;
             }
             if (auto* pm = dynamic_cast<PhotonMapper*>(integrator.get())) {

@@ -172,10 +172,10 @@ TEST_F(Cli, BdptOptionsAreCheckedAndTheStrategiesWritten) {
 TEST_F(Cli, SppmOptionsAreChecked) {
     CliResult r = run({"-s", "2", "-a", "pt-mis", "--photons", "1000", "-o", path("x.exr")});
     EXPECT_EQ(r.code, 2);
-    EXPECT_TRUE(contains(r.err, "--photons sets the light paths of sppm and pm; pt-mis has no such count")) << r.err;
+    EXPECT_TRUE(contains(r.err, "--photons sets the light paths of sppm, ppm and pm; pt-mis has no such count")) << r.err;
     r = run({"-s", "2", "-a", "pm", "--alpha", "0.5", "-o", path("x.exr")});
     EXPECT_EQ(r.code, 2);
-    EXPECT_TRUE(contains(r.err, "--alpha is the radius reduction of sppm, vcm and bpm, not pm's")) << r.err;
+    EXPECT_TRUE(contains(r.err, "--alpha is the radius reduction of sppm, ppm, vcm and bpm, not pm's")) << r.err;
     r = run({"-s", "2", "-a", "sppm", "--alpha", "1.5", "-o", path("x.exr")});
     EXPECT_EQ(r.code, 2);
     EXPECT_TRUE(contains(r.err, "--alpha must be in (0, 1]")) << r.err;

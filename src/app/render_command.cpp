@@ -82,11 +82,11 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
                    "bdpt: also write one image per strategy (s, t), weighted and unweighted, and montages, into this directory "
                    "(placeholders as for -o)");
     app.add_option("--strategies-depth", o.strategies_depth, "bdpt: ... for paths of up to this many bounces")->capture_default_str();
-    app.add_option("--photons", o.photons, "sppm: light paths per iteration (default one per pixel); pm: light paths of its maps (8 per pixel)");
+    app.add_option("--photons", o.photons, "sppm, ppm: light paths per iteration (default one per pixel); pm: light paths of its maps (8 per pixel)");
     app.add_option("--radius", o.photon_radius,
-                   "sppm, vcm, bpm: the first iteration's photon radius (default two pixel footprints at the scene's centre); pm: a fixed "
+                   "sppm, ppm, vcm, bpm: the first iteration's photon radius (default two pixel footprints at the scene's centre); pm: a fixed "
                    "radius instead of the k nearest");
-    app.add_option("--alpha", o.photon_alpha, "sppm, vcm, bpm: the radius reduction, in (0, 1] (default 2/3)");
+    app.add_option("--alpha", o.photon_alpha, "sppm, ppm, vcm, bpm: the radius reduction, in (0, 1] (default 2/3)");
     app.add_flag("--no-merging", o.no_merging, "vcm: connections only (then it is bdpt)");
     app.add_flag("--no-connections", o.no_connections, "vcm: merging only (then it is bpm)");
     app.add_flag("-q,--quiet", o.quiet, "No progress line and no summary");
@@ -154,12 +154,12 @@ int run_render_command(const RenderCommandOptions& o) {
                 if (algorithm == n) return true;
             return false;
         };
-        if (o.photons && !one_of({"sppm", "pm"}))
-            throw UsageError(fmt::format("--photons sets the light paths of sppm and pm; {} has no such count", algorithm));
-        if (o.photon_radius && !one_of({"sppm", "pm", "vcm", "bpm"}))
-            throw UsageError(fmt::format("--radius sets the photon radius of sppm, pm, vcm and bpm; {} has none", algorithm));
-        if (o.photon_alpha && !one_of({"sppm", "vcm", "bpm"}))
-            throw UsageError(fmt::format("--alpha is the radius reduction of sppm, vcm and bpm, not {}'s", algorithm));
+        if (o.photons && !one_of({"sppm", "ppm", "pm"}))
+            throw UsageError(fmt::format("--photons sets the light paths of sppm, ppm and pm; {} has no such count", algorithm));
+        if (o.photon_radius && !one_of({"sppm", "ppm", "pm", "vcm", "bpm"}))
+            throw UsageError(fmt::format("--radius sets the photon radius of sppm, ppm, pm, vcm and bpm; {} has none", algorithm));
+        if (o.photon_alpha && !one_of({"sppm", "ppm", "vcm", "bpm"}))
+            throw UsageError(fmt::format("--alpha is the radius reduction of sppm, ppm, vcm and bpm, not {}'s", algorithm));
         if (o.mis == "power" && !one_of({"bdpt", "vcm", "bpm"}))
             throw UsageError(fmt::format("--mis chooses the heuristic of bdpt, vcm and bpm; {} has its own", algorithm));
         if ((o.no_merging || o.no_connections) && algorithm != "vcm")

@@ -44,7 +44,7 @@ std::string command_line(const ReportOptions& o) {
 CLI::App* add_report_command(CLI::App& app, ReportOptions& o) {
     CLI::App* cmd = app.add_subcommand(
         "report", "Equal-time (or equal-spp) comparison of estimators on one scene as an HTML page: images, errors, convergence plot");
-    cmd->add_option("-s,--scene", o.scene, "Built-in scene (index or name)")->required();
+    cmd->add_option("-s,--scene", o.scene, "Built-in scene (index or name) or a scene file (.xml)")->required();
     cmd->add_option("--algorithms", o.algorithms, "Estimators to compare, comma-separated (see `pathlab algorithms`)")
         ->required()
         ->delimiter(',');
@@ -66,9 +66,9 @@ CLI::App* add_report_command(CLI::App& app, ReportOptions& o) {
 int run_report_command(const ReportOptions& o) {
     // Validate everything before the first render.
     const uint64_t seed = parse_seed_option(o.seed);
-    const std::vector<int> scene_list = parse_builtin_scene_list(o.scene);
-    if (scene_list.size() != 1 || o.scene == "all") throw UsageError("report takes one --scene");
-    const int scene_index = scene_list.front();
+    if (o.scene == "all" || o.scene.find(',') != std::string::npos) throw UsageError("report takes one --scene");
+    std::vector<SceneChoice> scenes = resolve_scenes(o.scene);
+    const SceneChoice choice = std::move(scenes.front());
     std::vector<const IntegratorInfo*> infos;
     for (const std::string& a : o.algorithms) {
         const IntegratorInfo* e = &integrator_or_usage_error(a);
@@ -89,6 +89,7 @@ int run_report_command(const ReportOptions& o) {
                          "or give --reference");
     if (fs::path(o.output).extension() != ".html") throw UsageError(fmt::format("-o {}: the report is an .html file", o.output));
     OutputPaths paths;
+    if (!choice.file.empty()) paths.input(choice.file, "the scene file");
     if (!o.reference.empty()) {
         paths.input(o.reference, "--reference");
         paths.input(stderr_path_for(o.reference), "the reference's standard errors");
@@ -122,8 +123,7 @@ int run_report_command(const ReportOptions& o) {
     std::optional<tbb::global_control> thread_limit;
     if (o.threads != 0) thread_limit.emplace(tbb::global_control::max_allowed_parallelism, thread_count_or_cap(o.threads));
     const bool show_progress = !o.quiet && isatty(STDERR_FILENO);
-    const BuiltinSceneInfo& info = builtin_scenes()[size_t(scene_index)];
-    data.title = fmt::format("scene {} {}", info.index, info.name);
+    data.title = choice.builtin ? fmt::format("scene {} {}", *choice.builtin, choice.name) : fmt::format("{} ({})", choice.name, choice.file);
     data.budget = o.time_limit > 0 ? fmt::format("equal time: {} s per algorithm", o.time_limit)
                                    : fmt::format("equal samples: {} spp per algorithm", o.spp);
     data.command = command_line(o);
@@ -138,7 +138,7 @@ int run_report_command(const ReportOptions& o) {
         ref_request.height = height;
         ref_request.spp = uint64_t(o.reference_spp);
         ref_request.seed = seed + 1000003;  // independent of the compared renders
-        RenderJob ref_job(scene_index, ref_request);
+        RenderJob ref_job(choice, ref_request);
         ref_job.settings.progress = show_progress;
         ref_job.settings.cancel = &InterruptGuard::flag();
         if (!o.quiet) fmt::print(stderr, "reference: {} at {} spp\n", kReferenceAlgorithm, o.reference_spp);
@@ -171,7 +171,7 @@ int run_report_command(const ReportOptions& o) {
         if (o.spp > 0) request.spp = uint64_t(o.spp);
         request.time_limit = o.time_limit;
         request.seed = seed;
-        RenderJob job(scene_index, request);
+        RenderJob job(choice, request);
         ReportRender entry{e->name, {}, {}, {}};
         double next_checkpoint = 0;
         RenderSettings& rs = job.settings;

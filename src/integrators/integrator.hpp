@@ -72,8 +72,9 @@ using PassProgress = std::function<void(double)>;
 class Integrator {
 public:
     virtual ~Integrator() = default;
-    // Called once before the first pass of a render (a cache or photon map built up front).
-    virtual void prepare(const RenderContext&) {}
+    // Called once before the first pass of a render (a cache or photon map built up front),
+    // with the fraction of that work done.
+    virtual void prepare(const RenderContext&, const PassProgress&) {}
     virtual PassCounters render_passes(const RenderContext& ctx, Film& film, uint64_t first, int count,
                                        const PassProgress& progress) = 0;
     // Called once after the last pass (also of an interrupted render): extra outputs.

@@ -73,7 +73,9 @@ RenderStats render_into(const Scene& scene, Integrator& integrator, const Render
     const auto seconds_since_start = [&] {
         return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     };
-    integrator.prepare(ctx);
+    PassProgress on_prepare;
+    if (settings.progress) on_prepare = [&](double fraction) { progress.update(0.0, 0, fmt::format("preparing: {:.0f}%", 100 * fraction)); };
+    integrator.prepare(ctx, on_prepare);
 
     RenderStats st;
     uint64_t done = 0, batch = 1;

@@ -1,5 +1,7 @@
 #include "integrators/photon/pm.hpp"
 
+#include <atomic>
+
 #include <tbb/parallel_for.h>
 
 #include "integrators/common/path_rules.hpp"
@@ -18,12 +20,13 @@ PhotonMapper::PhotonMapper(const IntegratorOptions& options, PmFaults faults)
     : options_(limited_to_length(options)), faults_(faults),
       max_bounces_(options_.max_depth < 0 ? kMaxBounces : std::min(options_.max_depth, kMaxBounces)), light_paths_(options_) {}
 
-void PhotonMapper::prepare(const RenderContext& ctx) {
+void PhotonMapper::prepare(const RenderContext& ctx, const PassProgress& progress) {
     // The maps depend on the scene and the seed only: a continued render keeps them.
     if (prepared_scene_ == &ctx.scene && prepared_seed_ == ctx.seed) return;
     const size_t paths = options_.photons > 0 ? size_t(options_.photons) : 8 * ctx.pixel_count();
     const size_t per_chunk = std::max<size_t>(256, paths / 256), chunks = (paths + per_chunk - 1) / per_chunk;
     std::vector<std::vector<Photon>> global(chunks), caustic(chunks);
+    std::atomic<size_t> chunks_done{0};
     tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
         std::vector<PathVertex> path;
         for (size_t j = c * per_chunk; j < std::min(paths, (c + 1) * per_chunk); ++j) {
@@ -42,6 +45,8 @@ void PhotonMapper::prepare(const RenderContext& ctx) {
                 through_dirac_only &= y.delta;
             }
         }
+        // The k-d trees' building after the tracing: about a tenth of the work.
+        if (progress) progress(0.9 * double(++chunks_done) / double(chunks));
     });
     global_.clear(), caustic_.clear();
     for (size_t c = 0; c < chunks; ++c) {
@@ -51,6 +56,7 @@ void PhotonMapper::prepare(const RenderContext& ctx) {
     global_map_.build(global_, 0);
     caustic_map_.build(caustic_, 0);
     prepared_scene_ = &ctx.scene, prepared_seed_ = ctx.seed;
+    if (progress) progress(1.0);
 }
 
 Rgb PhotonMapper::estimate(const PhotonKdTree& map, size_t k, const ShadingPoint& sp, int t) const {

@@ -37,7 +37,7 @@ class PhotonMapper final : public PixelIntegrator {
 public:
     explicit PhotonMapper(const IntegratorOptions& options, PmFaults faults = {});
 
-    void prepare(const RenderContext& ctx) override;
+    void prepare(const RenderContext& ctx, const PassProgress& progress = {}) override;
     Rgb radiance(const Scene& scene, const Ray& ray, Sampler& sampler) const override;
 
     size_t global_photons() const { return global_.size(); }

@@ -22,8 +22,8 @@ size_t paths_per_chunk(size_t paths) { return std::max<size_t>(64, paths / 256);
 
 }  // namespace
 
-Sppm::Sppm(const IntegratorOptions& options, SppmFaults faults)
-    : options_(limited_to_length(options)), faults_(faults),
+Sppm::Sppm(const IntegratorOptions& options, SppmFaults faults, CameraRays rays)
+    : options_(limited_to_length(options)), faults_(faults), rays_(rays),
       max_bounces_(options_.max_depth < 0 ? kMaxBounces : std::min(options_.max_depth, kMaxBounces)), light_paths_(options_) {}
 
 double Sppm::radius(double r1, double alpha, uint64_t i) { return progressive_radius(r1, alpha, i); }
@@ -58,7 +58,7 @@ uint64_t Sppm::trace_photons(const RenderContext& ctx, uint64_t pass, size_t pat
 Rgb Sppm::camera_sample(const RenderContext& ctx, size_t pixel, uint64_t pass, float r, size_t paths) const {
     const Scene& scene = ctx.scene;
     Sampler sampler(ctx.seed, pixel, pass, ctx.sampler);
-    const Vec2f jitter = sampler.next2d();
+    const Vec2f jitter = rays_ == CameraRays::Jittered ? sampler.next2d() : Vec2f(0.5f, 0.5f);
     const float px = float(pixel % size_t(ctx.width)), py = float(pixel / size_t(ctx.width));
     Ray ray = ctx.camera.generate(px + jitter.x, py + jitter.y);
     Rgb L(0.0f);
@@ -117,18 +117,32 @@ PassCounters Sppm::render_passes(const RenderContext& ctx, Film& film, uint64_t 
     return {rays.load(), invalid.load()};
 }
 
+namespace {
+
+std::vector<ParamInfo> progressive_photon_params() {
+    std::vector<ParamInfo> p = path_params();
+    p.push_back({"photon_count", ParamType::Integer, "0", "light paths per iteration (0: one per pixel; --photons wins)", "photonCount"});
+    p.push_back({"initial_radius", ParamType::Float, "0", "the first iteration's radius (0: two pixel footprints at the scene's centre; --radius wins)",
+                 "initialRadius"});
+    p.push_back({"alpha", ParamType::Float, "0.666667", "the radius reduction, in (0, 1] (--alpha wins)"});
+    return p;
+}
+
+}  // namespace
+
 const IntegratorInfo& sppm_integrator() {
     static const IntegratorInfo info{
         "sppm", {}, "stochastic progressive photon mapping (Knaus-Zwicker iterations): photons + next-event estimation", false, true,
-        [] {
-            std::vector<ParamInfo> p = path_params();
-            p.push_back({"photon_count", ParamType::Integer, "0", "light paths per iteration (0: one per pixel; --photons wins)", "photonCount"});
-            p.push_back({"initial_radius", ParamType::Float, "0", "the first iteration's radius (0: two pixel footprints at the scene's centre; --radius wins)",
-                         "initialRadius"});
-            p.push_back({"alpha", ParamType::Float, "0.666667", "the radius reduction, in (0, 1] (--alpha wins)"});
-            return p;
-        }(),
-        [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> { return std::make_unique<Sppm>(o); }};
+        progressive_photon_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> { return std::make_unique<Sppm>(o); }};
+    return info;
+}
+
+const IntegratorInfo& ppm_integrator() {
+    static const IntegratorInfo info{
+        "ppm", {}, "progressive photon mapping (Hachisuka 2008): fixed hit points through the pixel centres, photon passes, shrinking radius",
+        false, true, progressive_photon_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
+            return std::make_unique<Sppm>(o, SppmFaults{}, CameraRays::PixelCentres);
+        }};
     return info;
 }
 

@@ -38,9 +38,19 @@ struct SppmFaults {
     bool no_pi_in_kernel = false;  // the density estimate divides by r^2 instead of pi r^2
 };
 
+// How the camera rays are chosen: sppm jitters them over the pixel anew in every iteration (so
+// the image integrates the pixel's footprint: antialiasing, and glossy and Dirac choices
+// resampled); ppm (Hachisuka, Ogaki and Jensen 2008) sends them through the pixel centres, the
+// eye pass of the paper, whose hit points then stay where they are (the Dirac choices along the
+// way are drawn anew per iteration, in place of the paper's ray tree; the expectation is the
+// same). ppm converges to the radiance through the pixel centres, without antialiasing. Both
+// reduce the radius as Knaus and Zwicker do (a global radius per iteration rather than the
+// paper's per-hit-point photon statistics), which keeps iterations independent.
+enum class CameraRays { Jittered, PixelCentres };
+
 class Sppm final : public Integrator {
 public:
-    explicit Sppm(const IntegratorOptions& options, SppmFaults faults = {});
+    explicit Sppm(const IntegratorOptions& options, SppmFaults faults = {}, CameraRays rays = CameraRays::Jittered);
 
     PassCounters render_passes(const RenderContext& ctx, Film& film, uint64_t first, int count,
                                const PassProgress& progress) override;
@@ -56,6 +66,7 @@ private:
 
     IntegratorOptions options_;
     SppmFaults faults_;
+    CameraRays rays_;
     int max_bounces_;
     Bdpt light_paths_;  // its light subpaths are the photon paths
     std::vector<std::vector<Photon>> chunk_photons_;

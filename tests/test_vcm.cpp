@@ -127,7 +127,8 @@ TEST(VcmConsistency, DetectsAKernelWithoutPi) {
     EXPECT_FALSE(r.agree) << r.describe();
 }
 
-// The bias where indirect light is sharp: the caustic under the glass ball (scenes/caustic.xml,
+// The error where indirect light is sharp (in the course boxes, at sizes a test can afford, the
+// bias of a radius that never shrinks stays below the noise): the caustic under the glass ball (scenes/caustic.xml,
 // 24x18) against a bdpt reference, as the RMS difference with both images' noise subtracted
 // (bias_rms). Averaged over i iterations the bias is the mean of r_k^2, which falls as
 // i^(alpha - 1): a log-log slope of -1/3 for alpha = 2/3, 0 for a radius that never shrinks.
@@ -162,7 +163,11 @@ protected:
         o.vcm_connections = algorithm == "vcm";
         std::vector<double> mse(counts.size(), 0.0);
         for (int run = 0; run < runs; ++run) {
-            Vcm vcm(o, faults);
+            // sppm with as many light paths per iteration as vcm (one per pixel).
+            std::unique_ptr<Integrator> integrator;
+            if (algorithm == "sppm") integrator = std::make_unique<Sppm>(o, SppmFaults{.no_pi_in_kernel = faults.no_pi_in_kernel});
+            else integrator = std::make_unique<Vcm>(o, faults);
+            Integrator& vcm = *integrator;
             Film film;
             uint64_t done = 0;
             for (size_t k = 0; k < counts.size(); ++k) {
@@ -195,7 +200,8 @@ SceneDescription* VcmBias::scene_ = nullptr;
 Image* VcmBias::ref_ = nullptr;
 Image* VcmBias::ref_se_ = nullptr;
 
-// Over 16 to 1024 iterations (MSE over 6 runs each, radius from 0.25), with alpha = 2/3 the
+// bpm, vcm and sppm (sppm with one light path per pixel, as vcm): over 16 to 1024 iterations
+// (MSE over 6 runs each, radius from 0.25), with alpha = 2/3 the
 // RMS error falls at a log-log slope between the merging's theoretical -1/3 (variance and bias
 // both ~ i^(-1/3) in RMS) and the unbiased strategies' -1/2; with a radius that never shrinks
 // (alpha = 1) it levels off at the bias (last segment flatter than -0.25, 1.3x the shrinking
@@ -203,7 +209,7 @@ Image* VcmBias::ref_se_ = nullptr;
 TEST_F(VcmBias, FallsAtTheSlopeOfTheRadiusSchedule) {
     const std::vector<uint64_t> counts = {16, 64, 256, 1024};
     const auto last_slope = [&](const std::vector<double>& e) { return std::log(e[3] / e[2]) / std::log(double(counts[3]) / double(counts[2])); };
-    for (const std::string algorithm : {"bpm", "vcm"}) {
+    for (const std::string algorithm : {"bpm", "vcm", "sppm"}) {
         const std::vector<double> shrinking = error(algorithm, 2.0 / 3.0, counts, 6), fixed = error(algorithm, 1.0, counts, 6);
         const std::string all = fmt::format("{}: RMS error at {} iterations: alpha 2/3 {:.4f} (slope {:.3f}); fixed radius {:.4f} (slope {:.3f}, last {:.3f})",
                                             algorithm, fmt::join(counts, ", "), fmt::join(shrinking, " "), slope(counts, shrinking),

@@ -7,11 +7,13 @@
 //   pathlab_bench lt       light tracing: paths/s next to pt-mis, and splat accumulation
 //   pathlab_bench bdpt     bdpt against pt-mis: equal-time RMSE, and samples per second
 //   pathlab_bench pm       photons per second; hashed grid against k-d tree (build, query)
+//   pathlab_bench ic       irradiance caching against pt-mis and bdpt at short budgets
 #include <CLI/CLI.hpp>
 
 #include "bidirectional.hpp"
 #include "estimator_efficiency.hpp"
 #include "light_tracing.hpp"
+#include "irradiance_caching.hpp"
 #include "photon_mapping.hpp"
 #include "performance.hpp"
 
@@ -65,7 +67,14 @@ int main(int argc, char** argv) {
     pmc->add_option("--light-paths", pm.light_paths, "Light paths traced per scene")->capture_default_str();
     pmc->add_option("--size", pm.size, "Queries: one per pixel of a size x size image")->capture_default_str();
     pmc->add_option("--repeats", pm.repeats, "Timed repeats (median reported)")->capture_default_str();
+    IrradianceCachingOptions icopt;
+    CLI::App* icc = app.add_subcommand("ic", "Irradiance caching against pt-mis and bdpt at short budgets");
+    icc->add_option("--size", icopt.size, "Image width and height")->capture_default_str();
+    icc->add_option("--budgets", icopt.budgets, "Seconds per render")->delimiter(',')->capture_default_str();
+    icc->add_option("--repeats", icopt.repeats, "Rounds (median reported)")->capture_default_str();
+    icc->add_option("--scenes", icopt.scenes, "Course scene indices")->delimiter(',')->capture_default_str();
     CLI11_PARSE(app, argc, argv);
+    if (*icc) irradiance_caching_suite(icopt);
     if (*pmc) photon_mapping_suite(pm);
     if (*bd) bidirectional_suite(b);
     if (*lt) light_tracing_suite(l);

@@ -168,6 +168,26 @@ TEST_F(Cli, BdptOptionsAreCheckedAndTheStrategiesWritten) {
     EXPECT_TRUE(differ) << "the power heuristic weighs the same paths differently";
 }
 
+// ic's options: only with ic, in range; --ic-records draws the records, the summary and --stats
+// count them.
+TEST_F(Cli, IcOptionsRecordsAndStatistics) {
+    CliResult r = run({"-s", "2", "-a", "pt-mis", "--ic-error", "0.1", "-o", path("x.exr")});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_TRUE(contains(r.err, "are ic's, not pt-mis's")) << r.err;
+    r = run({"-s", "2", "-a", "ic", "--ic-rays", "2", "-o", path("x.exr")});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_TRUE(contains(r.err, "--ic-rays must be 4 to 65536")) << r.err;
+    r = run({"-s", "2", "-a", "ic", "--resolution", "24x24", "--spp", "2", "--ic-rays", "32", "--ic-records", path("records.png"),
+             "--stats", path("ic.json"), "-o", path("ic.exr")});
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(contains(r.err, "records ")) << r.err;
+    EXPECT_TRUE(contains(r.err, "cache_seconds")) << r.err;
+    EXPECT_GT(fs::file_size(path("records.png")), 100u);
+    const auto stats = nlohmann::json::parse(std::ifstream(path("ic.json")));
+    EXPECT_GT(stats["integrator"]["records"].get<double>(), 5.0);
+    EXPECT_GE(stats["integrator"]["records_gathered"].get<double>(), stats["integrator"]["records"].get<double>());
+}
+
 // sppm's options: only with sppm, in range; a render with them runs.
 TEST_F(Cli, SppmOptionsAreChecked) {
     CliResult r = run({"-s", "2", "-a", "pt-mis", "--photons", "1000", "-o", path("x.exr")});

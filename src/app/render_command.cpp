@@ -44,6 +44,7 @@ void write_stats(const std::string& path, RenderJob& job, const RenderResult& r,
         {"interrupted", s.interrupted},
         {"outputs", job.outputs},
     };
+    for (const IntegratorStatistic& x : s.integrator) j["integrator"][x.name] = x.value;
     write_text_file(path, j.dump(2) + "\n");
 }
 
@@ -89,6 +90,10 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
     app.add_option("--alpha", o.photon_alpha, "sppm, ppm, vcm, bpm: the radius reduction, in (0, 1] (default 2/3)");
     app.add_flag("--no-merging", o.no_merging, "vcm: connections only (then it is bdpt)");
     app.add_flag("--no-connections", o.no_connections, "vcm: merging only (then it is bpm)");
+    app.add_option("--ic-rays", o.ic_rays, "ic: rays per irradiance record (stratified)")->capture_default_str();
+    app.add_option("--ic-error", o.ic_error, "ic: the error threshold a (0: no cache, every point gathers for itself)")->capture_default_str();
+    app.add_flag("--ic-no-gradients", o.ic_no_gradients, "ic: interpolate without the irradiance gradients");
+    app.add_option("--ic-records", o.ic_records, "ic: write an image of the cached light with the records as red dots (placeholders as for -o)");
     app.add_flag("-q,--quiet", o.quiet, "No progress line and no summary");
 }
 
@@ -128,6 +133,11 @@ int run_render_command(const RenderCommandOptions& o) {
     request.photon_alpha = o.photon_alpha;
     request.vcm_merging = !o.no_merging;
     request.vcm_connections = !o.no_connections;
+    if (o.ic_rays < 4 || o.ic_rays > 65536) throw UsageError(fmt::format("--ic-rays must be 4 to 65536, got {}", o.ic_rays));
+    if (!(o.ic_error >= 0 && o.ic_error <= 10)) throw UsageError(fmt::format("--ic-error must be 0 to 10, got {}", o.ic_error));
+    request.ic_rays = o.ic_rays;
+    request.ic_error = o.ic_error;
+    request.ic_gradients = !o.ic_no_gradients;
     if (o.no_merging && o.no_connections) throw UsageError("--no-merging and --no-connections together leave vcm no strategy");
 
     std::vector<RenderJob> jobs;
@@ -162,6 +172,14 @@ int run_render_command(const RenderCommandOptions& o) {
             throw UsageError(fmt::format("--alpha is the radius reduction of sppm, ppm, vcm and bpm, not {}'s", algorithm));
         if (o.mis == "power" && !one_of({"bdpt", "vcm", "bpm"}))
             throw UsageError(fmt::format("--mis chooses the heuristic of bdpt, vcm and bpm; {} has its own", algorithm));
+        const bool ic_options = o.ic_rays != 256 || o.ic_error != 0.2f || o.ic_no_gradients || !o.ic_records.empty();
+        if (ic_options && algorithm != "ic")
+            throw UsageError(fmt::format("--ic-rays, --ic-error, --ic-no-gradients and --ic-records are ic's, not {}'s", algorithm));
+        if (!o.ic_records.empty()) {
+            const std::string p = jobs[j].expand(o.ic_records);
+            paths.output(p, "--ic-records", /*image=*/true);
+            jobs[j].integrator_options().ic_records_path = p;
+        }
         if ((o.no_merging || o.no_connections) && algorithm != "vcm")
             throw UsageError(fmt::format("--no-merging and --no-connections switch off vcm's strategies, not {}'s", algorithm));
         if (!o.strategies_dir.empty()) {
@@ -203,10 +221,15 @@ int run_render_command(const RenderCommandOptions& o) {
         }
         const RenderStats& s = result.stats;
         if (!o.quiet)
-            fmt::print(stderr, "{}: {} spp in {:.2f}s ({:.2f} Msamples/s, {:.2f} Mrays/s){} -> {}\n", name, s.spp,
+            fmt::print(stderr, "{}: {} spp in {:.2f}s ({:.2f} Msamples/s, {:.2f} Mrays/s){}{} -> {}\n", name, s.spp,
                        s.seconds, s.seconds > 0 ? double(s.samples) / s.seconds * 1e-6 : 0.0,
                        s.seconds > 0 ? double(s.rays) / s.seconds * 1e-6 : 0.0,
                        s.invalid_samples ? fmt::format(", {} NaN/Inf samples discarded", s.invalid_samples) : "",
+                       s.integrator.empty() ? "" : fmt::format(", {}", fmt::join([&] {
+                           std::vector<std::string> parts;
+                           for (const IntegratorStatistic& x : s.integrator) parts.push_back(fmt::format("{} {:g}", x.name, x.value));
+                           return parts;
+                       }(), ", ")),
                        fmt::join(job.outputs, ", "));
         if (s.interrupted) {
             if (j + 1 < jobs.size()) fmt::print(stderr, "pathlab: interrupted; {} scene(s) not rendered\n", jobs.size() - j - 1);

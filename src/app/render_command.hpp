@@ -37,6 +37,10 @@ struct RenderCommandOptions {
     std::optional<double> photon_alpha;
     bool no_merging = false;      // vcm: connections only (= bdpt)
     bool no_connections = false;  // vcm: merging only (= bpm)
+    int ic_rays = 256;
+    float ic_error = 0.2f;
+    bool ic_no_gradients = false;
+    std::string ic_records;
 };
 
 void add_render_options(CLI::App& app, RenderCommandOptions& opt);

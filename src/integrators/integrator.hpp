@@ -46,6 +46,11 @@ struct IntegratorOptions {
     // vcm: its two families of strategies (off: merging = bdpt, connections = bpm).
     bool vcm_merging = true;
     bool vcm_connections = true;
+    // ic: rays per record, the error threshold a, gradients on, and where to draw the records.
+    int ic_rays = 256;
+    float ic_error = 0.2f;
+    bool ic_gradients = true;
+    std::string ic_records_path;
 };
 
 // What every pass of one render sees; fixed for the whole render.
@@ -69,6 +74,12 @@ struct PassCounters {
 // Called from worker threads with the fraction of the current call's work that is done.
 using PassProgress = std::function<void(double)>;
 
+// A figure an integrator reports after a render (ic: its record count, the cache's build time).
+struct IntegratorStatistic {
+    std::string name;
+    double value;
+};
+
 class Integrator {
 public:
     virtual ~Integrator() = default;
@@ -79,6 +90,8 @@ public:
                                        const PassProgress& progress) = 0;
     // Called once after the last pass (also of an interrupted render): extra outputs.
     virtual void finish(const RenderContext&) {}
+    // Its own figures, for the summary line and --stats.
+    virtual std::vector<IntegratorStatistic> statistics() const { return {}; }
 };
 
 // Today's per-pixel estimators: one Monte Carlo estimate of the radiance arriving along a

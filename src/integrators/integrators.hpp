@@ -19,6 +19,7 @@ const IntegratorInfo& light_tracer_integrator();
 const IntegratorInfo& bdpt_integrator();
 const IntegratorInfo& sppm_integrator();
 const IntegratorInfo& pm_integrator();
+const IntegratorInfo& ic_integrator();
 const IntegratorInfo& ppm_integrator();
 const IntegratorInfo& vcm_integrator();
 const IntegratorInfo& bpm_integrator();

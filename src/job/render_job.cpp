@@ -27,6 +27,9 @@ RenderJob::RenderJob(SceneChoice scene, const JobRequest& r) : choice_(std::move
     options_.photon_alpha = r.photon_alpha ? *r.photon_alpha : d.photon_alpha.value_or(2.0 / 3.0);
     options_.vcm_merging = r.vcm_merging;
     options_.vcm_connections = r.vcm_connections;
+    options_.ic_rays = r.ic_rays;
+    options_.ic_error = r.ic_error;
+    options_.ic_gradients = r.ic_gradients;
     if (options_.photons < 0) throw UsageError("--photons must be zero (the default count) or positive");
     if (!(options_.photon_radius >= 0) || !std::isfinite(options_.photon_radius))
         throw UsageError("--radius must be zero (from the scene's size) or a positive distance");

@@ -37,6 +37,9 @@ struct JobRequest {
     std::optional<double> photon_alpha;   // --alpha A (sppm, vcm, bpm)
     bool vcm_merging = true;              // not --no-merging (vcm)
     bool vcm_connections = true;          // not --no-connections (vcm)
+    int ic_rays = 256;                    // --ic-rays (ic)
+    float ic_error = 0.2f;                // --ic-error (ic)
+    bool ic_gradients = true;             // not --ic-no-gradients (ic)
 };
 
 // The integrator `name` (or an alias); a UsageError listing them all otherwise.

@@ -114,6 +114,7 @@ RenderStats render_into(const Scene& scene, Integrator& integrator, const Render
     }
     progress.finish();
     integrator.finish(ctx);
+    st.integrator = integrator.statistics();
     return st;
 }
 

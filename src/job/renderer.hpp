@@ -23,6 +23,7 @@ struct RenderStats {
     uint64_t rays = 0;             // rays traced (camera, shadow, continuation, light paths)
     uint64_t invalid_samples = 0;  // NaN/Inf samples, discarded (not averaged in)
     bool interrupted = false;      // stopped by the cancel flag
+    std::vector<IntegratorStatistic> integrator;  // the integrator's own figures (ic: records, cache time)
 };
 
 struct RenderSettings {

@@ -8,11 +8,52 @@
 //     (it was already accounted for by the MIS pair at the previous vertex).
 //   pt-mis  (4c): two rays per bounce. The MIS BSDF sample both contributes its weighted
 //     emission and continues the path, so the surface it finds is the next vertex.
+#include "integrators/path/pt_mis.hpp"
+
 #include "integrators/common/direct_lighting.hpp"
 #include "integrators/integrators.hpp"
 #include "integrators/common/path_rules.hpp"
 
 namespace pathlab {
+
+Rgb pt_mis_from_hit(const Scene& scene, Intersection hit, Vec3f dir, int first_bounce, Sampler& sampler, const PathRules& rules,
+                    bool three_rays, int only_length, Rgb L) {
+    const auto counts = [only_length](int length) { return only_length < 0 || only_length == length; };
+    Rgb beta(1.0f);
+    for (int bounces = first_bounce; rules.may_bounce(bounces); ++bounces) {
+        const ShadingPoint sp = make_shading_point(scene, hit, dir);
+        if (sp.material->is_black()) break;
+        // Paths of bounces + 1 bounces ending on a light: the MIS pair.
+        const Rgb direct = estimate_light_sample(scene, sp, sampler, /*mis=*/true);
+        if (counts(bounces + 1)) L += beta * direct;
+        const auto s = sp.material->sample(sp, sp.wi, sampler.next2d());
+        EmitterHit found;
+        if (s) {
+            const Rgb found_emission = estimate_bsdf_sample_mis(scene, sp, *s, found);
+            if (counts(bounces + 1)) L += beta * found_emission;
+        }
+        if (!rules.may_bounce(bounces + 1)) break;
+
+        // Continue the path: with the same BSDF sample (pt-mis) or a fresh one (pt-mis3).
+        // The fresh one is independent of the first: a rejected MIS sample (a direction
+        // below the surface, total internal reflection on a microfacet) must not end it.
+        if (!three_rays && !s) break;
+        BsdfSample next = s ? *s : BsdfSample{};
+        if (three_rays) {
+            const auto c = sp.material->sample(sp, sp.wi, sampler.next2d());
+            if (!c) break;
+            next = *c;
+            found.hit = scene.intersect(sp.spawn(next.wo), found.isect);
+        }
+        if (!found.hit) break;  // escaped: the environment was counted by the MIS pair
+        beta *= next.f * (std::abs(next.wo.z) / next.pdfW);
+        if (!rules.survive_roulette(bounces + 1, beta, sampler)) break;
+        hit = found.isect;
+        dir = sp.frame.to_world(next.wo);
+    }
+    return L;
+}
+
 namespace {
 
 class PtMis final : public PixelIntegrator {
@@ -23,41 +64,8 @@ public:
     Rgb radiance(const Scene& scene, const Ray& camera_ray, Sampler& sampler) const override {
         Intersection hit;
         if (!scene.intersect(camera_ray, hit)) return counts(0) ? scene.escaped_radiance(camera_ray.d) : Rgb(0.0f);
-        Vec3f dir = camera_ray.d;
-        Rgb L = counts(0) ? emitted_radiance(scene, hit, -dir) : Rgb(0.0f);
-        Rgb beta(1.0f);
-        for (int bounces = 0; rules_.may_bounce(bounces); ++bounces) {
-            const ShadingPoint sp = make_shading_point(scene, hit, dir);
-            if (sp.material->is_black()) break;
-            // Paths of bounces + 1 bounces ending on a light: the MIS pair.
-            const Rgb direct = estimate_light_sample(scene, sp, sampler, /*mis=*/true);
-            if (counts(bounces + 1)) L += beta * direct;
-            const auto s = sp.material->sample(sp, sp.wi, sampler.next2d());
-            EmitterHit found;
-            if (s) {
-                const Rgb found_emission = estimate_bsdf_sample_mis(scene, sp, *s, found);
-                if (counts(bounces + 1)) L += beta * found_emission;
-            }
-            if (!rules_.may_bounce(bounces + 1)) break;
-
-            // Continue the path: with the same BSDF sample (pt-mis) or a fresh one (pt-mis3).
-            // The fresh one is independent of the first: a rejected MIS sample (a direction
-            // below the surface, total internal reflection on a microfacet) must not end it.
-            if (!three_rays_ && !s) break;
-            BsdfSample next = s ? *s : BsdfSample{};
-            if (three_rays_) {
-                const auto c = sp.material->sample(sp, sp.wi, sampler.next2d());
-                if (!c) break;
-                next = *c;
-                found.hit = scene.intersect(sp.spawn(next.wo), found.isect);
-            }
-            if (!found.hit) break;  // escaped: the environment was counted by the MIS pair
-            beta *= next.f * (std::abs(next.wo.z) / next.pdfW);
-            if (!rules_.survive_roulette(bounces + 1, beta, sampler)) break;
-            hit = found.isect;
-            dir = sp.frame.to_world(next.wo);
-        }
-        return L;
+        const Rgb emitted = counts(0) ? emitted_radiance(scene, hit, -camera_ray.d) : Rgb(0.0f);
+        return pt_mis_from_hit(scene, hit, camera_ray.d, 0, sampler, rules_, three_rays_, only_length_, emitted);
     }
 
 private:

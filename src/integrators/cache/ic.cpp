@@ -1,0 +1,185 @@
+#include "integrators/cache/ic.hpp"
+
+#include <tbb/parallel_for.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <optional>
+
+#include "core/sampling.hpp"
+#include "image/image_io.hpp"
+#include "integrators/common/direct_lighting.hpp"
+#include "integrators/integrators.hpp"
+#include "integrators/path/pt_mis.hpp"
+
+namespace pathlab {
+namespace {
+
+// The Phong material of sp, if it has a diffuse part the cache can serve.
+const PhongMaterial* cached_diffuse(const ShadingPoint& sp) {
+    const auto* phong = std::get_if<PhongMaterial>(&sp.material->model);
+    return phong && !is_black(phong->diffuse) ? phong : nullptr;
+}
+
+// Random-number streams: the records' gathers, apart from every pixel's own.
+uint64_t record_stream(size_t pixel) { return uint64_t(pixel) + (uint64_t(5) << 41); }
+
+}  // namespace
+
+IrradianceCaching::IrradianceCaching(const IntegratorOptions& options)
+    : options_(options), rules_(options), cache_(options.ic_error, 1.0f, options.ic_gradients) {
+    const int rays = std::max(4, options.ic_rays);
+    M_ = std::max(1, int(std::lround(std::sqrt(double(rays) / kPi))));
+    N_ = std::max(1, int(std::lround(double(rays) / M_)));
+}
+
+float IrradianceCaching::footprint(const Vec3f& p) const { return std::max(1e-6f, length(p - camera_position_) * pixel_angle_); }
+
+void IrradianceCaching::clamp_radius(IrradianceRecord& r) const {
+    const float a = std::max(cache_.error_threshold(), 1e-6f), f = footprint(r.p);
+    float R = std::clamp(r.harmonic, 1.5f * f / a, 20.0f * f / a);
+    // The translational gradient's limit: R <= E / |grad_t E| (in luminance).
+    const Vec3f g = r.grad_t[0] * 0.2126f + r.grad_t[1] * 0.7152f + r.grad_t[2] * 0.0722f;
+    const float E = luminance(r.E), gl = length(g);
+    if (gl > 0 && E > 0) R = std::max(std::min(R, E / gl), 1.5f * f / a);
+    r.R = R;
+}
+
+IrradianceRecord IrradianceCaching::make_record(const Scene& scene, const ShadingPoint& sp, Sampler& sampler) const {
+    IrradianceRecord r = gather_record(sp.p, sp.frame, M_, N_, sampler, [&](const Vec3f& d, float& distance) {
+        Intersection hit;
+        if (!scene.intersect(spawn_ray(sp.p, sp.ng, d), hit)) return Rgb(0.0f);  // the environment: direct light
+        distance = length(hit.p - sp.p);
+        return pt_mis_from_hit(scene, hit, d, 1, sampler, rules_);
+    });
+    clamp_radius(r);
+    return r;
+}
+
+Rgb IrradianceCaching::indirect_irradiance(const Scene& scene, const ShadingPoint& sp, Sampler& sampler) const {
+    Rgb E;
+    if (cache_.interpolate(sp.p, sp.frame.n, E)) return E;
+    // One cosine-distributed gather ray: E = pi L, unbiased.
+    const Vec3f local = square_to_cosine_hemisphere(sampler.next2d());
+    const Vec3f d = sp.frame.to_world(local);
+    Intersection hit;
+    if (!scene.intersect(spawn_ray(sp.p, sp.ng, d), hit)) return Rgb(0.0f);
+    return pt_mis_from_hit(scene, hit, d, 1, sampler, rules_) * kPi;
+}
+
+void IrradianceCaching::prepare(const RenderContext& ctx, const PassProgress& progress) {
+    // The cache depends on the scene, the image and the seed: a continued render keeps it.
+    if (prepared_scene_ == &ctx.scene && prepared_seed_ == ctx.seed && cache_.size() > 0) return;
+    const auto start = std::chrono::steady_clock::now();
+    camera_position_ = ctx.camera.position();
+    const float cx = 0.5f * float(ctx.width), cy = 0.5f * float(ctx.height);
+    const Vec3f a = normalize(ctx.camera.generate(cx, cy).d), b = normalize(ctx.camera.generate(cx + 1, cy).d);
+    pixel_angle_ = 2 * std::asin(std::min(1.0f, 0.5f * length(a - b)));
+    // Grid cubes of about an average record's influence (10 pixel footprints at the scene's centre).
+    const float cell = std::max(10 * pixel_angle_ * length(ctx.scene.scene_sphere().center - camera_position_), 1e-4f);
+    cache_.reset(options_.ic_error, cell, options_.ic_gradients);
+    gathered_ = 0;
+    prepared_scene_ = &ctx.scene, prepared_seed_ = ctx.seed;
+    if (!(options_.ic_error > 0) || !rules_.may_bounce(1)) return;  // every point gathers for itself, or no indirect light
+
+    const int w = ctx.width, h = ctx.height;
+    std::vector<int> strides;
+    for (int s = 8; s >= 1; s /= 2) strides.push_back(s);
+    std::vector<size_t> candidates;
+    std::vector<std::optional<IrradianceRecord>> made;
+    for (size_t level = 0; level < strides.size(); ++level) {
+        const int s = strides[level];
+        candidates.clear();
+        for (int y = 0; y < h; y += s)
+            for (int x = 0; x < w; x += s)
+                if (level == 0 || x % (2 * s) != 0 || y % (2 * s) != 0) candidates.push_back(size_t(y) * size_t(w) + size_t(x));
+        made.assign(candidates.size(), std::nullopt);
+        // The first hits no record covers yet get a record, in parallel (the cache is only read).
+        tbb::parallel_for(size_t(0), candidates.size(), [&](size_t i) {
+            const size_t pixel = candidates[i];
+            const Ray ray = ctx.camera.generate(float(pixel % size_t(w)) + 0.5f, float(pixel / size_t(w)) + 0.5f);
+            Intersection hit;
+            if (!ctx.scene.intersect(ray, hit)) return;
+            const ShadingPoint sp = make_shading_point(ctx.scene, hit, ray.d);
+            if (sp.material->is_black() || !cached_diffuse(sp) || cache_.covered(sp.p, sp.frame.n)) return;
+            Sampler sampler(ctx.seed, record_stream(pixel), 0, ctx.sampler);
+            made[i] = make_record(ctx.scene, sp, sampler);
+            made[i]->pixel = uint32_t(pixel);
+        });
+        // Added in pixel order, unless one added before covers it.
+        for (const auto& r : made) {
+            if (!r) continue;
+            ++gathered_;
+            if (!cache_.covered(r->p, r->n)) cache_.add(*r);
+        }
+        if (progress) progress(double(level + 1) / double(strides.size()));
+    }
+    cache_.clamp_to_neighbours();
+    build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+Rgb IrradianceCaching::radiance(const Scene& scene, const Ray& ray, Sampler& sampler) const {
+    Intersection hit;
+    if (!scene.intersect(ray, hit)) return scene.escaped_radiance(ray.d);
+    Rgb L = emitted_radiance(scene, hit, -ray.d);
+    const ShadingPoint sp = make_shading_point(scene, hit, ray.d);
+    const PhongMaterial* phong = sp.material->is_black() ? nullptr : cached_diffuse(sp);
+    if (!phong) return pt_mis_from_hit(scene, hit, ray.d, 0, sampler, rules_, false, -1, L);
+    if (!rules_.may_bounce(0)) return L;
+    // Direct light: pt-mis's MIS pair.
+    L += estimate_light_sample(scene, sp, sampler, /*mis=*/true);
+    const auto s = sp.material->sample(sp, sp.wi, sampler.next2d());
+    EmitterHit found;
+    if (s) L += estimate_bsdf_sample_mis(scene, sp, *s, found);
+    if (!rules_.may_bounce(1)) return L;
+    // Indirect diffuse light from the cache.
+    L += phong->diffuse * (kInvPi)*indirect_irradiance(scene, sp, sampler);
+    // The Phong lobe's indirect light: the BSDF sample, weighted by the lobe alone.
+    if (!s || s->delta || !found.hit) return L;
+    Rgb beta = max(s->f - phong->diffuse * kInvPi, Rgb(0.0f)) * (std::abs(s->wo.z) / s->pdfW);
+    if (is_black(beta) || !rules_.survive_roulette(1, beta, sampler)) return L;
+    return L + beta * pt_mis_from_hit(scene, found.isect, sp.frame.to_world(s->wo), 1, sampler, rules_);
+}
+
+void IrradianceCaching::finish(const RenderContext& ctx) {
+    if (options_.ic_records_path.empty()) return;
+    // Where the records are: the cache's own view of the indirect diffuse light (rho_d/pi E at
+    // the pixel centres' first hits; black where no record covers them), and a red dot at
+    // every record's position.
+    const int w = ctx.width, h = ctx.height;
+    Image img(w, h);
+    tbb::parallel_for(0, h, [&](int y) {
+        for (int x = 0; x < w; ++x) {
+            const Ray ray = ctx.camera.generate(float(x) + 0.5f, float(y) + 0.5f);
+            Intersection hit;
+            if (!ctx.scene.intersect(ray, hit)) continue;
+            const ShadingPoint sp = make_shading_point(ctx.scene, hit, ray.d);
+            const PhongMaterial* phong = sp.material->is_black() ? nullptr : cached_diffuse(sp);
+            Rgb E;
+            if (phong && cache_.interpolate(sp.p, sp.frame.n, E)) img.at(x, y) = phong->diffuse * kInvPi * E;
+        }
+    });
+    for (const IrradianceRecord& r : cache_.records()) {
+        const int px = int(r.pixel % uint32_t(w)), py = int(r.pixel / uint32_t(w));
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx)
+                if (px + dx >= 0 && px + dx < w && py + dy >= 0 && py + dy < h && std::abs(dx) + std::abs(dy) <= 1)
+                    img.at(px + dx, py + dy) = Rgb(1.0f, 0.05f, 0.05f) * 4.0f;
+    }
+    write_image(img, options_.ic_records_path);
+}
+
+std::vector<IntegratorStatistic> IrradianceCaching::statistics() const {
+    return {{"records", double(cache_.size())}, {"records_gathered", double(gathered_)}, {"cache_seconds", build_seconds_}};
+}
+
+const IntegratorInfo& ic_integrator() {
+    static const IntegratorInfo info{"ic", {}, "irradiance caching with gradients (Ward): cached indirect diffuse light at first hits, pt-mis elsewhere",
+                                     false, true, path_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
+                                         return std::make_unique<IrradianceCaching>(o);
+                                     }};
+    return info;
+}
+
+}  // namespace pathlab

@@ -70,7 +70,9 @@ Rgb IrradianceCaching::indirect_irradiance(const Scene& scene, const ShadingPoin
 
 void IrradianceCaching::prepare(const RenderContext& ctx, const PassProgress& progress) {
     // The cache depends on the scene, the image and the seed: a continued render keeps it.
-    if (prepared_scene_ == &ctx.scene && prepared_seed_ == ctx.seed && cache_.size() > 0) return;
+    if (prepared_scene_ == &ctx.scene && prepared_seed_ == ctx.seed && prepared_width_ == ctx.width && prepared_height_ == ctx.height &&
+        cache_.size() > 0)
+        return;
     const auto start = std::chrono::steady_clock::now();
     camera_position_ = ctx.camera.position();
     const float cx = 0.5f * float(ctx.width), cy = 0.5f * float(ctx.height);
@@ -80,7 +82,7 @@ void IrradianceCaching::prepare(const RenderContext& ctx, const PassProgress& pr
     const float cell = std::max(10 * pixel_angle_ * length(ctx.scene.scene_sphere().center - camera_position_), 1e-4f);
     cache_.reset(options_.ic_error, cell, options_.ic_gradients);
     gathered_ = 0;
-    prepared_scene_ = &ctx.scene, prepared_seed_ = ctx.seed;
+    prepared_scene_ = &ctx.scene, prepared_seed_ = ctx.seed, prepared_width_ = ctx.width, prepared_height_ = ctx.height;
     if (!(options_.ic_error > 0) || !rules_.may_bounce(1)) return;  // every point gathers for itself, or no indirect light
 
     const int w = ctx.width, h = ctx.height;
@@ -145,8 +147,8 @@ Rgb IrradianceCaching::radiance(const Scene& scene, const Ray& ray, Sampler& sam
 void IrradianceCaching::finish(const RenderContext& ctx) {
     if (options_.ic_records_path.empty()) return;
     // Where the records are: the cache's own view of the indirect diffuse light (rho_d/pi E at
-    // the pixel centres' first hits; black where no record covers them), and a red dot at
-    // every record's position.
+    // the pixel centres' first hits, one stop brighter; black where no record covers them), and
+    // a red pixel where each record was placed.
     const int w = ctx.width, h = ctx.height;
     Image img(w, h);
     tbb::parallel_for(0, h, [&](int y) {
@@ -157,16 +159,10 @@ void IrradianceCaching::finish(const RenderContext& ctx) {
             const ShadingPoint sp = make_shading_point(ctx.scene, hit, ray.d);
             const PhongMaterial* phong = sp.material->is_black() ? nullptr : cached_diffuse(sp);
             Rgb E;
-            if (phong && cache_.interpolate(sp.p, sp.frame.n, E)) img.at(x, y) = phong->diffuse * kInvPi * E;
+            if (phong && cache_.interpolate(sp.p, sp.frame.n, E)) img.at(x, y) = phong->diffuse * (2 * kInvPi) * E;
         }
     });
-    for (const IrradianceRecord& r : cache_.records()) {
-        const int px = int(r.pixel % uint32_t(w)), py = int(r.pixel / uint32_t(w));
-        for (int dy = -1; dy <= 1; ++dy)
-            for (int dx = -1; dx <= 1; ++dx)
-                if (px + dx >= 0 && px + dx < w && py + dy >= 0 && py + dy < h && std::abs(dx) + std::abs(dy) <= 1)
-                    img.at(px + dx, py + dy) = Rgb(1.0f, 0.05f, 0.05f) * 4.0f;
-    }
+    for (const IrradianceRecord& r : cache_.records()) img.at(int(r.pixel % uint32_t(w)), int(r.pixel / uint32_t(w))) = Rgb(4.0f, 0.2f, 0.2f);
     write_image(img, options_.ic_records_path);
 }
 

@@ -62,6 +62,7 @@ private:
     uint64_t gathered_ = 0;  // records gathered (some were covered by earlier ones and dropped)
     const Scene* prepared_scene_ = nullptr;
     uint64_t prepared_seed_ = 0;
+    int prepared_width_ = 0, prepared_height_ = 0;
 };
 
 }  // namespace pathlab

@@ -136,7 +136,7 @@ Rgb IrradianceCaching::radiance(const Scene& scene, const Ray& ray, Sampler& sam
     if (s) L += estimate_bsdf_sample_mis(scene, sp, *s, found);
     if (!rules_.may_bounce(1)) return L;
     // Indirect diffuse light from the cache.
-    L += phong->diffuse * (kInvPi)*indirect_irradiance(scene, sp, sampler);
+    L += phong->diffuse * kInvPi * indirect_irradiance(scene, sp, sampler);
     // The Phong lobe's indirect light: the BSDF sample, weighted by the lobe alone.
     if (!s || s->delta || !found.hit) return L;
     Rgb beta = max(s->f - phong->diffuse * kInvPi, Rgb(0.0f)) * (std::abs(s->wo.z) / s->pdfW);

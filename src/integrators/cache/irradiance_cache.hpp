@@ -5,7 +5,8 @@
 //   e_i = |x - p_i| / R_i + sqrt(1 - n . n_i),   w_i = 1/e_i - 1/a   over the records with e_i < a
 // (Ward's weight 1/e_i, less 1/a so that it falls to 0 where the record stops being valid: no
 // seam there), leaving out records in front of x ((x - p_i) . (n + n_i)/2 < -0.01 R_i, Ward's
-// test). Deterministic: a cube's records are visited in the order they were added.
+// test); a record's extrapolation below zero counts as zero. Deterministic: a cube's records are
+// visited in the order they were added.
 #pragma once
 
 #include <unordered_map>

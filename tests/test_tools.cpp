@@ -488,15 +488,20 @@ TEST_F(ToolsReport, WritesValidHtmlWhoseImagesExist) {
 TEST_F(Tools, ReportsOnASceneFileWithThePhotonMethods) {
     const std::string scene = std::string(PATHLAB_SOURCE_DIR) + "/scenes/sds-caustic.xml";
     const CliResult r = run({"report", "--scene", scene, "--algorithms", "bdpt,sppm,vcm", "--spp", "4", "--resolution", "32x24",
-                             "--reference-spp", "16", "-q", "-o", path("out/sds.html")});
+                             "--reference-spp", "16", "--reference-algorithm", "vcm", "-q", "-o", path("out/sds.html")});
     ASSERT_EQ(r.code, 0) << r.err;
     const std::string html = read_text(path("out/sds.html"));
     EXPECT_TRUE(contains(html, "sds-caustic (" + scene + ")"));
+    EXPECT_TRUE(contains(html, "rendered here with vcm at 16 spp"));
     EXPECT_TRUE(contains(html, "<td>vcm</td>"));
     EXPECT_EQ(count(html, "<polyline"), 3);
     const CliResult all = run({"report", "--scene", "all", "--algorithms", "vcm", "--spp", "4", "-o", path("out/all.html")});
     EXPECT_EQ(all.code, 2);
     EXPECT_TRUE(contains(all.err, "report takes one --scene")) << all.err;
+    const CliResult bad = run({"report", "--scene", "2", "--algorithms", "vcm", "--spp", "4", "--reference-algorithm", "nope", "-o",
+                               path("out/bad.html")});
+    EXPECT_EQ(bad.code, 2);
+    EXPECT_TRUE(contains(bad.err, "unknown algorithm 'nope'")) << bad.err;
 }
 
 // Loads the report in headless Chromium: the script must run to its end (it marks <body>)

@@ -24,7 +24,6 @@ namespace pathlab {
 namespace fs = std::filesystem;
 namespace {
 
-constexpr const char* kReferenceAlgorithm = "pt-mis";
 constexpr double kCheckpointGrowth = 1.25;  // checkpoints at geometrically spaced times
 
 bool is_direct_illumination(const IntegratorInfo& e) { return e.name.rfind("direct-", 0) == 0; }
@@ -34,7 +33,8 @@ std::string command_line(const ReportOptions& o) {
     s += o.time_limit > 0 ? fmt::format(" --time {}", o.time_limit) : fmt::format(" --spp {}", o.spp);
     if (!o.resolution.empty()) s += " --resolution " + o.resolution;
     if (!o.reference.empty()) s += " --reference " + o.reference;
-    else s += fmt::format(" --reference-spp {}", o.reference_spp);
+    else s += fmt::format(" --reference-spp {}", o.reference_spp) +
+              (o.reference_algorithm != "pt-mis" ? " --reference-algorithm " + o.reference_algorithm : "");
     if (o.max_depth != -1) s += fmt::format(" --max-depth {}", o.max_depth);
     return s + fmt::format(" --seed {} -o {}", o.seed, o.output);
 }
@@ -55,6 +55,9 @@ CLI::App* add_report_command(CLI::App& app, ReportOptions& o) {
                     "Reference image (.exr/.hdr/.pfm; a .stderr.exr companion is used if present). Default: rendered "
                     "with pt-mis (--max-depth 1 when every algorithm is direct-*), saved beside the report for reuse");
     cmd->add_option("--reference-spp", o.reference_spp, "Samples per pixel of the rendered reference")->capture_default_str();
+    cmd->add_option("--reference-algorithm", o.reference_algorithm,
+                    "The estimator that renders the reference (e.g. vcm where pt-mis misses specular-diffuse-specular light)")
+        ->capture_default_str();
     cmd->add_option("--resolution", o.resolution, "Image size WxH (default: the reference's, else the scene's)");
     cmd->add_option("--seed", o.seed, "Random seed of the compared renders")->capture_default_str();
     cmd->add_option("--max-depth", o.max_depth, "Longest path in bounces (-1: unlimited)")->capture_default_str();
@@ -79,6 +82,7 @@ int run_report_command(const ReportOptions& o) {
     if ((o.time_limit > 0) == (o.spp > 0)) throw UsageError("give exactly one of --time T (equal time) and --spp N (equal samples)");
     if (o.time_limit < 0 || o.spp < 0 || !std::isfinite(o.time_limit)) throw UsageError("--time and --spp must be positive");
     if (o.reference_spp <= 0) throw UsageError("--reference-spp must be positive");
+    const std::string reference_algorithm = integrator_or_usage_error(o.reference_algorithm).name;
     if (o.max_depth < -1 || o.max_depth == 0) throw UsageError("--max-depth must be positive, or -1 for unlimited");
     int width = 0, height = 0;
     parse_resolution_option(o.resolution, width, height);
@@ -132,7 +136,7 @@ int run_report_command(const ReportOptions& o) {
     bool interrupted = false;
     if (data.reference.pixel_count() == 0) {
         JobRequest ref_request;
-        ref_request.algorithm = kReferenceAlgorithm;
+        ref_request.algorithm = reference_algorithm;
         ref_request.max_depth = all_direct ? 1 : o.max_depth;
         ref_request.width = width;
         ref_request.height = height;
@@ -141,7 +145,7 @@ int run_report_command(const ReportOptions& o) {
         RenderJob ref_job(choice, ref_request);
         ref_job.settings.progress = show_progress;
         ref_job.settings.cancel = &InterruptGuard::flag();
-        if (!o.quiet) fmt::print(stderr, "reference: {} at {} spp\n", kReferenceAlgorithm, o.reference_spp);
+        if (!o.quiet) fmt::print(stderr, "reference: {} at {} spp\n", reference_algorithm, o.reference_spp);
         const RenderResult r = ref_job.run();
         data.reference = r.film.mean();
         data.reference_se = r.film.standard_error();
@@ -149,9 +153,9 @@ int run_report_command(const ReportOptions& o) {
         write_image(data.reference, saved);
         write_image(data.reference_se, stderr_path_for(saved));
         data.reference_note = fmt::format("none given, so rendered here with {}{} at {} spp in {:.1f} s (saved as {}; reuse it with --reference)",
-                                          kReferenceAlgorithm, all_direct ? " --max-depth 1 (direct illumination)" : "",
+                                          reference_algorithm, all_direct ? " --max-depth 1 (direct illumination)" : "",
                                           r.stats.spp, r.stats.seconds, saved);
-        data.reference_label = fmt::format("{}{}, {} spp", kReferenceAlgorithm, all_direct ? " (direct)" : "", r.stats.spp);
+        data.reference_label = fmt::format("{}{}, {} spp", reference_algorithm, all_direct ? " (direct)" : "", r.stats.spp);
         if (r.stats.interrupted) {
             interrupted = true;
             data.notes.push_back(fmt::format("Interrupted while rendering the reference (after {} spp): no algorithm was rendered.", r.stats.spp));

@@ -65,6 +65,7 @@ struct ReportOptions {
     std::string output;
     std::string reference;
     int reference_spp = 1024;
+    std::string reference_algorithm = "pt-mis";
     std::string resolution;
     std::string seed = "1234";
     int max_depth = -1;

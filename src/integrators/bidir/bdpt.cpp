@@ -293,28 +293,18 @@ PassCounters Bdpt::render_passes(const RenderContext& ctx, Film& film, uint64_t 
                     Sampler light_sampler(ctx.seed, sample_stream(pixel, 1), pass, ctx.sampler);
                     camera_subpath(ctx, pixel, camera_sampler, camera);
                     light_subpath(ctx, light_sampler, light);
-                    for (int t = 1; t <= int(camera.size()); ++t) {
-                        Sampler sampler(ctx.seed, sample_stream(pixel, 1 + uint64_t(t)), pass, ctx.sampler);
-                        // s = 1 samples its own light point: it exists even when the light
-                        // subpath does not (an emission sample that failed).
-                        for (int s = 0; s <= std::max(1, int(light.size())); ++s) {
-                            const int depth = s + t - 2;
-                            if ((s == 1 && t == 1) || depth < 0 || depth > max_bounces_) continue;
-                            if (options_.only_length >= 0 && depth != options_.only_length) continue;
-                            const StrategyResult r = connect(ctx, light, s, camera, t, sampler);
-                            if (is_black(r.L)) continue;
+                    for_each_connection(
+                        ctx, pixel, pass, light, camera, nullptr,
+                        [&](int s, int t, const StrategyResult& r) {
                             const Rgb value = r.L * r.weight;
-                            if (!is_finite(value)) {
-                                ++chunk_invalid;
-                                continue;
-                            }
+                            if (!is_finite(value)) return void(++chunk_invalid);
                             const uint32_t target = r.splat ? uint32_t(ctx.camera.pixel_of(r.raster)) : uint32_t(pixel);
                             if (r.splat) splats.add(target, value);
                             else pass_.pixel(pixel) += Vec3d(value);
-                            if (depth <= strategies_depth)
+                            if (s + t - 2 <= strategies_depth)
                                 strategies_->chunk(c).push_back({target, uint16_t(StrategyImages::index(s, t)), value, r.L});
-                        }
-                    }
+                        },
+                        [](int) {});
                 }
                 rays += Scene::rays_traced_by_this_thread() - rays_before;
                 invalid += chunk_invalid;

@@ -85,6 +85,29 @@ public:
     float mis_weight(const RenderContext& ctx, std::vector<PathVertex>& light, int s, std::vector<PathVertex>& camera, int t,
                      const PathVertex& sampled, const EdgeDensities& known = {}, const MergeMis* vm = nullptr) const;
 
+    // Every connection strategy of one pixel sample, in bdpt's order and from its random
+    // streams: strategy(s, t, result) for each one with a contribution, and after_vertex(t) once
+    // those ending at camera vertex t are done. `vm`: merging strategies in the weights (vcm);
+    // with vm->connections off only s = 0 is evaluated.
+    template <typename Strategy, typename AfterVertex>
+    void for_each_connection(const RenderContext& ctx, size_t pixel, uint64_t pass, std::vector<PathVertex>& light,
+                             std::vector<PathVertex>& camera, const MergeMis* vm, Strategy&& strategy, AfterVertex&& after_vertex) const {
+        for (int t = 1; t <= int(camera.size()); ++t) {
+            Sampler sampler(ctx.seed, sample_stream(pixel, 1 + uint64_t(t)), pass, ctx.sampler);
+            // s = 1 samples its own light point: it exists even when the light subpath does not
+            // (an emission sample that failed).
+            const int s_max = !vm || vm->connections ? std::max(1, int(light.size())) : 0;
+            for (int s = 0; s <= s_max; ++s) {
+                const int depth = s + t - 2;
+                if ((s == 1 && t == 1) || depth < 0 || depth > max_bounces_) continue;
+                if (options_.only_length >= 0 && depth != options_.only_length) continue;
+                const StrategyResult r = connect(ctx, light, s, camera, t, sampler, vm);
+                if (!is_black(r.L)) strategy(s, t, r);
+            }
+            after_vertex(t);
+        }
+    }
+
     // The random-number stream of a sample: 0 the camera subpath (the pixel's own), 1 the light
     // subpath, 1 + t the connections at camera vertex t.
     static uint64_t sample_stream(size_t pixel, uint64_t stream) { return uint64_t(pixel) + (stream << 40); }

@@ -125,7 +125,6 @@ PassCounters Vcm::render_passes(const RenderContext& ctx, Film& film, uint64_t f
     const size_t pixels = ctx.pixel_count(), per_chunk = Bdpt::chunk_size(pixels);
     const int chunks = int((pixels + per_chunk - 1) / per_chunk);
     const double r1 = initial_photon_radius(ctx, options_), alpha = options_.photon_alpha;
-    const int max_bounces = bdpt_.max_bounces();
     std::atomic<uint64_t> rays{0}, invalid{0};
     for (int k = 0; k < count; ++k) {
         const uint64_t pass = first + uint64_t(k);
@@ -158,24 +157,17 @@ PassCounters Vcm::render_passes(const RenderContext& ctx, Film& film, uint64_t f
                     // while other threads read the stored one to merge.
                     const PathVertex* stored = chunk_vertices_[pixel / per_chunk].data() + path_begin_[pixel];
                     light.assign(stored, stored + path_length_[pixel]);
-                    for (int t = 1; t <= int(camera.size()); ++t) {
-                        // The connections, as bdpt evaluates them (s = 0 alone without connections).
-                        Sampler sampler(ctx.seed, Bdpt::sample_stream(pixel, 1 + uint64_t(t)), pass, ctx.sampler);
-                        const int s_max = vm.connections ? std::max(1, int(light.size())) : 0;
-                        for (int s = 0; s <= s_max; ++s) {
-                            const int depth = s + t - 2;
-                            if ((s == 1 && t == 1) || depth < 0 || depth > max_bounces) continue;
-                            if (options_.only_length >= 0 && depth != options_.only_length) continue;
-                            const StrategyResult res = bdpt_.connect(ctx, light, s, camera, t, sampler, &vm);
-                            if (!is_black(res.L)) add(res.L * res.weight, res.splat, res.raster, pixel);
-                        }
-                        // Merging at z_{t-1}.
-                        const PathVertex& z = camera[size_t(t - 1)];
-                        if (vm.merging && t >= 2 && z.kind == VertexKind::Surface && z.connectible()) {
-                            const Rgb m = merge(camera, t, r, vm);
-                            if (!is_black(m)) add(m, false, {}, pixel);
-                        }
-                    }
+                    // bdpt's connections, then merging at each camera vertex z_{t-1}.
+                    bdpt_.for_each_connection(
+                        ctx, pixel, pass, light, camera, &vm,
+                        [&](int, int, const StrategyResult& res) { add(res.L * res.weight, res.splat, res.raster, pixel); },
+                        [&](int t) {
+                            const PathVertex& z = camera[size_t(t - 1)];
+                            if (vm.merging && t >= 2 && z.kind == VertexKind::Surface && z.connectible()) {
+                                const Rgb m = merge(camera, t, r, vm);
+                                if (!is_black(m)) add(m, false, {}, pixel);
+                            }
+                        });
                 }
                 rays += Scene::rays_traced_by_this_thread() - rays_before;
                 invalid += chunk_invalid;
@@ -191,9 +183,7 @@ namespace {
 
 std::vector<ParamInfo> vcm_params() {
     std::vector<ParamInfo> p = path_params();
-    p.push_back({"initial_radius", ParamType::Float, "0", "the first iteration's radius (0: two pixel footprints at the scene's centre; --radius wins)",
-                 "initialRadius"});
-    p.push_back({"alpha", ParamType::Float, "0.666667", "the radius reduction, in (0, 1] (--alpha wins)"});
+    for (ParamInfo& r : progressive_radius_params()) p.push_back(std::move(r));
     return p;
 }
 

@@ -78,6 +78,13 @@ public:
     }
 
     const Vec3f& position() const { return cam_.position; }
+    // The angle between the rays through the image's centre and one pixel to its right: a
+    // pixel's angular width (the photon methods' and the irradiance cache's radii scale with it).
+    float pixel_angle() const {
+        const float cx = 0.5f * width_, cy = 0.5f * height_;
+        const Vec3f a = normalize(generate(cx, cy).d), b = normalize(generate(cx + 1, cy).d);
+        return 2 * std::asin(std::min(1.0f, 0.5f * length(a - b)));
+    }
     const Vec3f& forward() const { return cam_.forward; }
     int width() const { return int(width_); }
     int height() const { return int(height_); }

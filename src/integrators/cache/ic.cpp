@@ -75,9 +75,7 @@ void IrradianceCaching::prepare(const RenderContext& ctx, const PassProgress& pr
         return;
     const auto start = std::chrono::steady_clock::now();
     camera_position_ = ctx.camera.position();
-    const float cx = 0.5f * float(ctx.width), cy = 0.5f * float(ctx.height);
-    const Vec3f a = normalize(ctx.camera.generate(cx, cy).d), b = normalize(ctx.camera.generate(cx + 1, cy).d);
-    pixel_angle_ = 2 * std::asin(std::min(1.0f, 0.5f * length(a - b)));
+    pixel_angle_ = ctx.camera.pixel_angle();
     // Grid cubes of about an average record's influence (10 pixel footprints at the scene's centre).
     const float cell = std::max(10 * pixel_angle_ * length(ctx.scene.scene_sphere().center - camera_position_), 1e-4f);
     cache_.reset(options_.ic_error, cell, options_.ic_gradients);

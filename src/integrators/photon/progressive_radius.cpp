@@ -13,13 +13,16 @@ double progressive_radius(double r1, double alpha, uint64_t i) {
 
 float initial_photon_radius(const RenderContext& ctx, const IntegratorOptions& options) {
     if (options.photon_radius > 0) return options.photon_radius;
-    // The angle between the rays through two neighbouring pixels at the image centre, times the
-    // distance of the scene's centre.
-    const float cx = 0.5f * float(ctx.width), cy = 0.5f * float(ctx.height);
-    const Vec3f a = normalize(ctx.camera.generate(cx, cy).d), b = normalize(ctx.camera.generate(cx + 1, cy).d);
-    const float angle = 2 * std::asin(std::min(1.0f, 0.5f * length(a - b)));
+    // A pixel's angular width times the distance of the scene's centre.
+    const float angle = ctx.camera.pixel_angle();
     const float distance = length(ctx.scene.scene_sphere().center - ctx.camera.position());
     return std::max(2 * angle * distance, 1e-4f * ctx.scene.scene_sphere().radius);
+}
+
+std::vector<ParamInfo> progressive_radius_params() {
+    return {{"initial_radius", ParamType::Float, "0", "the first iteration's radius (0: two pixel footprints at the scene's centre; --radius wins)",
+             "initialRadius"},
+            {"alpha", ParamType::Float, "0.666667", "the radius reduction, in (0, 1] (--alpha wins)"}};
 }
 
 }  // namespace pathlab

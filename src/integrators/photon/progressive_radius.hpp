@@ -17,4 +17,7 @@ double progressive_radius(double r1, double alpha, uint64_t i);
 // centre, so that the blur starts at the scale of a pixel whatever the resolution.
 float initial_photon_radius(const RenderContext& ctx, const IntegratorOptions& options);
 
+// The scene-file parameters of the radius: initial_radius and alpha (Mitsuba 0.6's initialRadius).
+std::vector<ParamInfo> progressive_radius_params();
+
 }  // namespace pathlab

@@ -122,9 +122,7 @@ namespace {
 std::vector<ParamInfo> progressive_photon_params() {
     std::vector<ParamInfo> p = path_params();
     p.push_back({"photon_count", ParamType::Integer, "0", "light paths per iteration (0: one per pixel; --photons wins)", "photonCount"});
-    p.push_back({"initial_radius", ParamType::Float, "0", "the first iteration's radius (0: two pixel footprints at the scene's centre; --radius wins)",
-                 "initialRadius"});
-    p.push_back({"alpha", ParamType::Float, "0.666667", "the radius reduction, in (0, 1] (--alpha wins)"});
+    for (ParamInfo& r : progressive_radius_params()) p.push_back(std::move(r));
     return p;
 }
 

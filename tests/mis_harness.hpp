@@ -249,6 +249,7 @@ public:
     }
 
     const Bdpt& bdpt(bool power) const { return power ? power_ : balance_; }
+    LightKind kind() const { return kind_; }
     const RenderContext& ctx() const { return ctx_; }
 
 private:
@@ -271,6 +272,42 @@ Vec3f floor_point_reflected_to(const Vec3f& m, const Vec3f& q) {
     const Vec3f image(-2.4f - q.x, q.y, q.z);  // q mirrored in the plane
     const Vec3f d = m - image;
     return m + d * (m.z / -d.z);
+}
+
+struct NamedPath {
+    std::string name;
+    FullPath path;
+};
+
+// The hand-built paths the MIS tests check, for the harness's light: diffuse, glossy and mirror
+// vertices; with the point light, specular-diffuse-specular paths (camera-mirror-floor-point)
+// that only merging can make.
+inline std::vector<NamedPath> hand_built_paths(const MisHarness& h) {
+    const Vec3f a(0.2f, 0.4f, 0.0f), b(-0.4f, 2.5f, 1.0f), on_glossy(1.2f, 1.1f, 0.7f), low_mirror(-1.2f, 0.6f, 0.3f);
+    switch (h.kind()) {
+        case LightKind::Area: {
+            const Vec3f on_light(0.1f, 0.45f, 2.5f), on_mirror(-1.2f, 1.0f, 0.8f);
+            return {{"camera-floor-light", h.build({a, on_light})},
+                    {"camera-floor-glossy-light", h.build({a, on_glossy, on_light})},
+                    {"camera-floor-wall-light", h.build({a, b, on_light})},
+                    {"camera-glossy-floor-wall-light", h.build({on_glossy, a, b, on_light})},
+                    {"camera-light", h.build({on_light})},  // the light seen directly
+                    {"camera-floor-mirror-light", h.build({floor_point_reflected_to(on_mirror, on_light), on_mirror, kReflect})},
+                    // A vertical mirror cannot send light from the floor back down: mirrors seen first.
+                    {"camera-mirror-floor-light", h.build({low_mirror, kReflect, on_light})},
+                    {"camera-mirror-floor-wall-light", h.build({low_mirror, kReflect, b, on_light})}};
+        }
+        case LightKind::Point:
+            return {{"camera-floor-point", h.build({a})},
+                    {"camera-floor-glossy-point", h.build({a, on_glossy})},
+                    {"camera-mirror-floor-point", h.build({low_mirror, kReflect})},
+                    {"camera-mirror-floor-wall-point", h.build({low_mirror, kReflect, b})}};
+        case LightKind::Environment:
+            return {{"camera-floor-sky", h.build({a}, {0.2f, 0.1f, 1.0f})},
+                    {"camera-floor-glossy-sky", h.build({a, on_glossy}, {-1.0f, 0.2f, 0.5f})},
+                    {"camera-mirror-floor-sky", h.build({low_mirror, kReflect}, {0.1f, 0.3f, 1.0f})}};
+    }
+    return {};
 }
 
 }  // namespace

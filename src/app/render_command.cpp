@@ -150,7 +150,16 @@ int run_render_command(const RenderCommandOptions& o) {
     for (const RenderJob& job : jobs)
         if (!job.scene_choice().file.empty()) paths.input(job.scene_choice().file, "the scene file");
     for (size_t j = 0; j < jobs.size(); ++j) {
-        for (const std::string& p : patterns) jobs[j].outputs.push_back(jobs[j].expand(p));
+        // Notes of the scene loader: what it accepted and ignored, or changed.
+        if (!o.quiet)
+            for (const std::string& note : jobs[j].scene_choice().description.notes) fmt::print(stderr, "{}\n", note);
+        // Without -o, the scene file's hdrfilm file_format chooses the HDR output's format.
+        const std::string& format = jobs[j].scene_choice().description.file_format;
+        for (std::string p : patterns) {
+            if (o.outputs.empty() && p.ends_with(".exr") && format != "openexr")
+                p = p.substr(0, p.size() - 4) + (format == "rgbe" ? ".hdr" : ".pfm");
+            jobs[j].outputs.push_back(jobs[j].expand(p));
+        }
         for (size_t k = 0; k < j; ++k)
             for (const std::string& path : jobs[j].outputs)
                 if (std::find(jobs[k].outputs.begin(), jobs[k].outputs.end(), path) != jobs[k].outputs.end())

@@ -69,16 +69,22 @@ private:
     io::FdWriter& w_;
 };
 
-void write_exr(const Image& img, io::FdWriter& out, const std::string& name) {
+void write_exr(const Image& img, io::FdWriter& out, const std::string& name, const std::vector<ExrChannel>& extra = {}) {
     try {
         Imf::Header header(img.width(), img.height());
         for (const char* c : {"R", "G", "B"}) header.channels().insert(c, Imf::Channel(Imf::FLOAT));
+        for (const ExrChannel& c : extra) header.channels().insert(c.name, Imf::Channel(Imf::FLOAT));
         Imf::FrameBuffer fb;
         auto* base = const_cast<char*>(reinterpret_cast<const char*>(img.data()));
         const size_t xs = sizeof(Rgb), ys = sizeof(Rgb) * size_t(img.width());
         fb.insert("R", Imf::Slice(Imf::FLOAT, base + 0 * sizeof(float), xs, ys));
         fb.insert("G", Imf::Slice(Imf::FLOAT, base + 1 * sizeof(float), xs, ys));
         fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
+        for (const ExrChannel& c : extra) {
+            if (c.values.size() != img.pixel_count()) throw ImageIoError(fmt::format("{}: channel {} has the wrong size", name, c.name));
+            fb.insert(c.name, Imf::Slice(Imf::FLOAT, const_cast<char*>(reinterpret_cast<const char*>(c.values.data())), sizeof(float),
+                                         sizeof(float) * size_t(img.width())));
+        }
         ExrOutput stream(out, name);
         Imf::OutputFile file(stream, header);
         struct Quiet {  // destroyed before `file`, on every path
@@ -587,6 +593,11 @@ void write_png8(const Image8& img, const std::string& path) {
 void write_image(const Image& img, const std::string& path, float png_exposure) {
     const ImageFormat format = image_format_for(path);
     io::write_file_atomically(path, [&](io::FdWriter& out) { write_encoded(img, format, out, path, png_exposure); });
+}
+
+void write_exr_with_channels(const Image& img, const std::vector<ExrChannel>& extra, const std::string& path) {
+    if (image_format_for(path) != ImageFormat::Exr) throw ImageIoError(fmt::format("{}: extra channels need an .exr output", path));
+    io::write_file_atomically(path, [&](io::FdWriter& out) { write_exr(img, out, path, extra); });
 }
 
 void write_text_file(const std::string& path, const std::string& text) {

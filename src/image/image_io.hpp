@@ -52,6 +52,13 @@ void check_writable_image_path(const std::string& path);
 // The same for a text output (--stats, --json): not a directory, and a file can be made there.
 void check_writable_path(const std::string& path);
 void write_image(const Image& img, const std::string& path, float png_exposure = 0.0f);
+// An EXR of the image (R, G, B) and extra channels, each width x height floats, row by row
+// (e.g. "m2.R", "dd.Y"); `path` must end in .exr.
+struct ExrChannel {
+    std::string name;
+    std::vector<float> values;
+};
+void write_exr_with_channels(const Image& img, const std::vector<ExrChannel>& extra, const std::string& path);
 void write_png8(const Image8& img, const std::string& path);
 
 // Reads a linear HDR image (.exr, .hdr or .pfm).

@@ -24,6 +24,7 @@
 #include "cameras/camera.hpp"
 #include "core/properties.hpp"
 #include "render/film.hpp"
+#include "render/pixel_filter.hpp"
 #include "samplers/sampler.hpp"
 #include "scene/scene.hpp"
 
@@ -51,6 +52,8 @@ struct IntegratorOptions {
     float ic_error = 0.2f;
     bool ic_gradients = true;
     std::string ic_records_path;
+    // Paths of no bounce (emitters and the environment seen directly) are left out (Mitsuba's hide_emitters).
+    bool hide_emitters = false;
 };
 
 // What every pass of one render sees; fixed for the whole render.
@@ -61,6 +64,8 @@ struct RenderContext {
     uint64_t seed = 0;
     SamplerKind sampler = SamplerKind::Independent;
     int tile_size = 32;  // largest tile edge for pixel integrators (smaller when there are few tiles)
+    // The reconstruction filter (render/pixel_filter.hpp); null or box: each sample in its own pixel.
+    const PixelFilter* filter = nullptr;
 
     size_t pixel_count() const { return size_t(width) * size_t(height); }
 };
@@ -102,7 +107,14 @@ public:
     virtual Rgb radiance(const Scene& scene, const Ray& ray, Sampler& sampler) const = 0;
     PassCounters render_passes(const RenderContext& ctx, Film& film, uint64_t first, int count,
                                const PassProgress& progress) final;
+
+private:
+    PassCounters render_filtered_passes(const RenderContext& ctx, Film& film, uint64_t first, int count, const PassProgress& progress);
+    std::vector<Vec3d> lattice_, filtered_;  // a filtered pass (pixel_filter.hpp)
 };
+
+// The lattice shift of a filtered pass: every pixel's sample of that pass is at pixel + shift.
+Vec2f filter_shift(const RenderContext& ctx, uint64_t pass);
 
 struct IntegratorInfo {
     std::string name;                  // e.g. "direct-light"
@@ -117,6 +129,12 @@ struct IntegratorInfo {
     // Its parameters in scene files (<integrator type=...>), Mitsuba's names and depth convention.
     std::vector<ParamInfo> params;
     std::function<std::unique_ptr<Integrator>(const IntegratorOptions&)> make;
+    // What of a scene file's sensor and film it supports (RenderJob refuses the rest, saying why):
+    // thin lens and orthographic cameras (false: it connects light paths to the pinhole, or
+    // sizes its radii by the pinhole's pixel angle), and reconstruction filters other than box
+    // (false: it adds its samples to the film without them).
+    bool any_camera = true;
+    bool any_filter = true;
 
     PluginInfo plugin() const;
 };

@@ -67,7 +67,8 @@ RenderStats render_into(const Scene& scene, Integrator& integrator, const Render
         throw std::invalid_argument("a render needs a positive sample count or time limit");
 
     const PerspectiveCamera camera(scene.camera(), w, h);
-    const RenderContext ctx{scene, camera, w, h, settings.seed, settings.sampler, settings.tile_size};
+    const PixelFilter filter(scene.description().filter, w, h);
+    const RenderContext ctx{scene, camera, w, h, settings.seed, settings.sampler, settings.tile_size, &filter};
     Progress progress(settings.progress);
     const auto start = std::chrono::steady_clock::now();
     const auto seconds_since_start = [&] {

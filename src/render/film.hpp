@@ -58,10 +58,25 @@ private:
     std::vector<uint64_t> count_;
 };
 
-// The scene-file film (Mitsuba 3's hdrfilm): pathlab's film is a box filter, one pixel wide.
+// The scene-file film (Mitsuba's hdrfilm). Its <rfilter> is the reconstruction filter
+// (core/reconstruction_filter.hpp; box with radius 0.5 is this film as it is: each sample in
+// its own pixel); the others spread samples through render/pixel_filter.hpp.
 inline const PluginInfo& hdrfilm_plugin() {
-    static const PluginInfo info{"film", "hdrfilm", "the image: its size (the outputs' formats come from -o)",
-                                 {{"width", ParamType::Integer, "768", "pixels"}, {"height", ParamType::Integer, "576", "pixels"}}};
+    static const PluginInfo info{
+        "film", "hdrfilm", "the image: its size, window and reconstruction filter (<rfilter>: box, tent, gaussian, mitchell, catmullrom, lanczos)",
+        {{"width", ParamType::Integer, "768", "pixels"},
+         {"height", ParamType::Integer, "576", "pixels"},
+         {"file_format", ParamType::String, "openexr", "openexr, rgbe or pfm: the format of the default output (-o sets others)", "fileFormat"},
+         {"pixel_format", ParamType::String, "rgb", "rgb, or rgba (accepted: pathlab writes RGB, no alpha; noted)", "pixelFormat"},
+         {"component_format", ParamType::String, "float32", "float32, or float16 (accepted: written as float32, more precise; noted)", "componentFormat"},
+         {"crop_offset_x", ParamType::Integer, "0", "the rendered window's left column", "cropOffsetX"},
+         {"crop_offset_y", ParamType::Integer, "0", "the rendered window's top row", "cropOffsetY"},
+         {"crop_width", ParamType::Integer, "", "the window's width (default: to the right edge)", "cropWidth"},
+         {"crop_height", ParamType::Integer, "", "the window's height (default: to the bottom edge)", "cropHeight"},
+         {"sample_border", ParamType::Boolean, "false",
+          "accepted: a filtered pixel at the border is normalised by the filter's weight inside the image (noted when true)", "highQualityEdges"},
+         {"banner", ParamType::Boolean, "false", "accepted and ignored: pathlab never draws a banner into the image"},
+         {"attach_log", ParamType::Boolean, "false", "accepted and ignored (Mitsuba 0.6: the log in the EXR header)", "attachLog"}}};
     return info;
 }
 

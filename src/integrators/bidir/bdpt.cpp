@@ -325,7 +325,7 @@ const IntegratorInfo& bdpt_integrator() {
     static const IntegratorInfo info{"bdpt", {"bpt"}, "bidirectional path tracing: every connection strategy (s, t), combined by MIS",
                                      false, true, path_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
                                          return std::make_unique<Bdpt>(o);
-                                     }};
+                                     }, false, false};
     return info;
 }
 

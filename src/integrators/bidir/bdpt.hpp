@@ -101,6 +101,7 @@ public:
                 const int depth = s + t - 2;
                 if ((s == 1 && t == 1) || depth < 0 || depth > max_bounces_) continue;
                 if (options_.only_length >= 0 && depth != options_.only_length) continue;
+                if (options_.hide_emitters && depth == 0) continue;
                 const StrategyResult r = connect(ctx, light, s, camera, t, sampler, vm);
                 if (!is_black(r.L)) strategy(s, t, r);
             }

@@ -33,7 +33,8 @@ void LightTracer::trace(const RenderContext& ctx, Sampler& sampler, SplatList& o
     const uint32_t flags = light_flags(light);
 
     // Paths of no bounce: the emitter seen by the camera.
-    if (flags & kLightSurface) {
+    if (hide_emitters_) {
+    } else if (flags & kLightSurface) {
         if (const auto k = camera.connect(es->origin)) {
             const float cos_light = dot(es->normal, k->wi);
             if (cos_light > 0 && !scene.occluded(spawn_segment(es->origin, es->normal, camera.position(), Vec3f(0.0f))))
@@ -113,7 +114,7 @@ const IntegratorInfo& light_tracer_integrator() {
     static const IntegratorInfo info{"lt", {"ptracer"}, "light tracing: paths from the lights, every vertex connected to the camera",
                                      false, false, path_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
                                          return std::make_unique<LightTracer>(o);
-                                     }};
+                                     }, false, false};
     return info;
 }
 

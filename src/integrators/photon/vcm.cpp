@@ -193,7 +193,7 @@ const IntegratorInfo& vcm_integrator() {
     static const IntegratorInfo info{"vcm", {}, "vertex connection and merging: bdpt's connections and photon merging, combined by MIS",
                                      false, true, vcm_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
                                          return std::make_unique<Vcm>(o);
-                                     }};
+                                     }, false, false};
     return info;
 }
 
@@ -203,7 +203,7 @@ const IntegratorInfo& bpm_integrator() {
                                          o.vcm_connections = false;
                                          o.vcm_merging = true;
                                          return std::make_unique<Vcm>(o);
-                                     }};
+                                     }, false, false};
     return info;
 }
 

@@ -60,7 +60,7 @@ for t in "${targets[@]}"; do
         scene_xml)
             corpus=build-fuzz/corpus  # where the scene-file corpus has always been
             mkdir -p "$corpus"
-            cp -n scenes/*.xml tests/data/xml_regressions/* "$corpus"/ 2>/dev/null || true
+            cp -n scenes/*.xml tests/data/scenes/*.xml tests/data/scenes/mitsuba/*.xml tests/data/xml_regressions/* "$corpus"/ 2>/dev/null || true
             max_len=4096
             ;;
         obj)

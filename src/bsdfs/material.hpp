@@ -92,23 +92,21 @@ struct Material {
     int32_t back = -1;
 
     Rgb eval(const Vec3f& wi, const Vec3f& wo) const {
-        return std::visit([&](const auto& m) { return m.eval(wi, wo); }, model);
+        return visit_model(model, [&](const auto& m) { return m.eval(wi, wo); });
     }
     float pdf(const Vec3f& wi, const Vec3f& wo) const {
-        return std::visit([&](const auto& m) { return m.pdf(wi, wo); }, model);
+        return visit_model(model, [&](const auto& m) { return m.pdf(wi, wo); });
     }
     // eval() and pdf() together, for models that can share work between them.
     Rgb eval_and_pdf(const Vec3f& wi, const Vec3f& wo, float& pdf) const {
-        return std::visit(
-            [&](const auto& m) {
-                if constexpr (requires { m.eval_and_pdf(wi, wo, pdf); }) {
-                    return m.eval_and_pdf(wi, wo, pdf);
-                } else {
-                    pdf = m.pdf(wi, wo);
-                    return m.eval(wi, wo);
-                }
-            },
-            model);
+        return visit_model(model, [&](const auto& m) {
+            if constexpr (requires { m.eval_and_pdf(wi, wo, pdf); }) {
+                return m.eval_and_pdf(wi, wo, pdf);
+            } else {
+                pdf = m.pdf(wi, wo);
+                return m.eval(wi, wo);
+            }
+        });
     }
     [[gnu::always_inline]] std::optional<BsdfSample> sample(const Vec3f& wi, const Vec2f& u) const {
         return visit_model(model, [&](const auto& m) { return m.sample(wi, u); });

@@ -116,8 +116,9 @@ public:
         const Vec3f d = cam_.forward + cam_.right * (tan_x_ * u) - cam_.up * (tan_y_ * v);
         return Ray{cam_.position, normalize(d), kInf};
     }
-    // Any camera: `lens` is a uniform 2D sample of the aperture (used by thinlens only).
-    Ray generate(float sx, float sy, const Vec2f& lens) const {
+    // Any camera: `lens` is a uniform 2D sample of the aperture (used by thinlens only). Out of
+    // line, so that the pinhole's generate() stays small where it is inlined (pt-mis's loop).
+    [[gnu::noinline]] Ray generate(float sx, float sy, const Vec2f& lens) const {
         if (plain_) return generate(sx, sy);
         const float u = 2 * (cam_.window_x0 + wx_ * (sx / width_) + cam_.principal_x) - 1;
         const float v = 2 * (cam_.window_y0 + wy_ * (sy / height_) + cam_.principal_y) - 1;

@@ -149,7 +149,7 @@ ShapeDesc read_serialized(Properties& p, const ShapeContext& ctx) {
 }
 
 const PluginInfo& cylinder_plugin() {
-    static const PluginInfo info{"shape", "cylinder", "an open tube from p0 to p1 (no caps), outward normals; 128 flat sides with smooth vertex normals (0.04% less area)",
+    static const PluginInfo info{"shape", "cylinder", "an open tube from p0 to p1 (no caps), outward normals; 128 flat sides with smooth vertex normals (0.01% less area)",
                                  {{"p0", ParamType::Point, "0, 0, 0", "centre of one end"},
                                   {"p1", ParamType::Point, "0, 0, 1", "centre of the other end"},
                                   {"radius", ParamType::Float, "1", "radius"},

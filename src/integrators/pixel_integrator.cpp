@@ -24,6 +24,7 @@ PassCounters PixelIntegrator::render_passes(const RenderContext& ctx, Film& film
 
     std::atomic<uint64_t> rays{0}, invalid{0};
     std::atomic<int> tiles_done{0};
+    const bool lens = ctx.camera.needs_lens_sample();
     tbb::parallel_for(tbb::blocked_range<int>(0, tile_count, 1), [&](const tbb::blocked_range<int>& range) {
         for (int tile = range.begin(); tile != range.end(); ++tile) {
             const uint64_t rays_before = Scene::rays_traced_by_this_thread();
@@ -35,9 +36,8 @@ PassCounters PixelIntegrator::render_passes(const RenderContext& ctx, Film& film
                     for (int k = 0; k < count; ++k) {
                         Sampler sampler(ctx.seed, pixel, first + uint64_t(k), ctx.sampler);
                         const Vec2f jitter = sampler.next2d();
-                        const Ray ray = ctx.camera.needs_lens_sample()
-                                            ? ctx.camera.generate(float(x) + jitter.x, float(y) + jitter.y, sampler.next2d())
-                                            : ctx.camera.generate(float(x) + jitter.x, float(y) + jitter.y);
+                        const Ray ray = lens ? ctx.camera.generate(float(x) + jitter.x, float(y) + jitter.y, sampler.next2d())
+                                             : ctx.camera.generate(float(x) + jitter.x, float(y) + jitter.y);
                         const Rgb L = radiance(ctx.scene, ray, sampler);
                         if (is_finite(L)) film.add(pixel, L);
                         else ++tile_invalid;

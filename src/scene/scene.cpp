@@ -189,8 +189,10 @@ void Scene::instance_hit(const RawHit& raw, Intersection& hit) const {
     const InstanceDesc& inst = desc_.instances[size_t(geometry_[raw.inst_id].instance)];
     const MeshDesc& m = desc_.groups[inst.group].meshes[raw.geom_id];
     const Transform& t = inst.to_world;
+    const bool identity = t.m == Transform().m;  // transform_mesh keeps such a mesh's floats as they are
+    const auto place = [&](const Vec3f& v) { return identity ? v : Vec3f(t.point(Vec3d(v))); };
     const auto& tri = m.triangles[raw.prim_id];
-    const Vec3f p0(t.point(Vec3d(m.positions[tri[0]]))), p1(t.point(Vec3d(m.positions[tri[1]]))), p2(t.point(Vec3d(m.positions[tri[2]])));
+    const Vec3f p0 = place(m.positions[tri[0]]), p1 = place(m.positions[tri[1]]), p2 = place(m.positions[tri[2]]);
     const float b1 = raw.u, b2 = raw.v, b0 = 1 - b1 - b2;
     hit.p = p0 * b0 + p1 * b1 + p2 * b2;
     hit.ng = normalize(cross(p1 - p0, p2 - p0));
@@ -198,6 +200,10 @@ void Scene::instance_hit(const RawHit& raw, Intersection& hit) const {
     if (!m.normals.empty()) {
         Vec3f n[3];
         for (int k = 0; k < 3; ++k) {
+            if (identity) {
+                n[k] = m.normals[tri[size_t(k)]];
+                continue;
+            }
             const Vec3d tn = t.normal(Vec3d(m.normals[tri[size_t(k)]]));
             const double len = length(tn);
             n[k] = len > 0 ? Vec3f(tn / len) : Vec3f(0.0f);

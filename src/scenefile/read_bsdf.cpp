@@ -56,8 +56,10 @@ Material read_bsdf_at(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b, 
         std::vector<Material> inner = nested_bsdfs(xml, n, b, depth, type);
         Properties p = xml.properties(n, plugin->info());
         const auto no_transmission = [&](const Material& m, size_t i) {
+            const pugi::xml_node c = xml.plugin_children(n)[i];
+            const std::string what = std::string(c.name()) == "bsdf" ? xml.attr(c, "type") : "dielectric";
             if (m.is_dielectric())
-                xml.fail(xml.plugin_children(n)[i], fmt::format("a dielectric cannot be wrapped in {} (both of its sides already matter)", type));
+                xml.fail(c, fmt::format("a {} cannot be wrapped in {} (both of its sides already matter)", what, type));
         };
         if (type == "twosided") {
             if (inner.size() != 1 && inner.size() != 2)

@@ -181,7 +181,7 @@ void read_sensor(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b) {
     reading([&] {
         Camera c;
         if (type == "orthographic") {
-            c = camera_from(xml, p.get_transform("to_world"), nullptr, 45, FovAxis::X);
+            c = camera_from(xml, p.get_transform("to_world"), block, 45, FovAxis::X);
             c.kind = CameraKind::Orthographic;
             if (const auto t = p.get_transform("to_world")) {
                 c.ortho_half_x = float(length(t->vector({1, 0, 0})));

@@ -75,7 +75,9 @@ public:
     void finish(const RenderContext& ctx) override;
 
     // The subpaths of one sample (for the tests and the per-pixel loop).
-    void camera_subpath(const RenderContext& ctx, size_t pixel, Sampler& sampler, std::vector<PathVertex>& path) const;
+    // `shift`: with a reconstruction filter, the pass's lattice shift replaces the pixel's jitter.
+    void camera_subpath(const RenderContext& ctx, size_t pixel, Sampler& sampler, std::vector<PathVertex>& path,
+                        const Vec2f* shift = nullptr) const;
     void light_subpath(const RenderContext& ctx, Sampler& sampler, std::vector<PathVertex>& path) const;
     // Strategy (s, t) on the subpaths (which it may modify temporarily); `vm`: the merging
     // strategies that also take part in its MIS weight (vcm).

@@ -178,46 +178,6 @@ private:
     static uint32_t lobes_of(const MaskMaterial& m) { return m.inner->lobes() | kLobeSpecular | kLobeTransmission; }
 };
 
-inline Rgb BlendMaterial::eval(const Vec3f& wi, const Vec3f& wo) const {
-    return first->eval(wi, wo) * (1 - weight) + second->eval(wi, wo) * weight;
-}
-inline float BlendMaterial::pdf(const Vec3f& wi, const Vec3f& wo) const {
-    return (1 - weight) * first->pdf(wi, wo) + weight * second->pdf(wi, wo);
-}
-inline std::optional<BsdfSample> BlendMaterial::sample(const Vec3f& wi, Vec2f u) const {
-    const bool pick_second = u.x < weight;
-    const float p = pick_second ? weight : 1 - weight;
-    u.x = pick_second ? u.x / weight : (u.x - weight) / (1 - weight);
-    u.x = std::min(u.x, 0.99999994f);
-    std::optional<BsdfSample> s = (pick_second ? second : first)->sample(wi, u);
-    if (!s) return s;
-    if (s->delta) {
-        s->f *= p;
-        s->pdfW *= p;
-    } else {
-        s->f = eval(wi, s->wo);
-        s->pdfW = pdf(wi, s->wo);
-        if (!(s->pdfW > 0)) return std::nullopt;
-    }
-    return s;
-}
-
-inline Rgb MaskMaterial::eval(const Vec3f& wi, const Vec3f& wo) const { return inner->eval(wi, wo) * opacity; }
-inline float MaskMaterial::pdf(const Vec3f& wi, const Vec3f& wo) const { return opacity * inner->pdf(wi, wo); }
-inline std::optional<BsdfSample> MaskMaterial::sample(const Vec3f& wi, Vec2f u) const {
-    if (u.x >= opacity) {
-        const float c = std::abs(wi.z);
-        if (!(c > 0)) return std::nullopt;
-        return BsdfSample{-wi, Rgb((1 - opacity) / c), 1 - opacity, true, kLobeSpecular | kLobeTransmission};
-    }
-    u.x = std::min(u.x / opacity, 0.99999994f);
-    std::optional<BsdfSample> s = inner->sample(wi, u);
-    if (!s) return s;
-    s->f *= opacity;
-    s->pdfW *= opacity;
-    return s;
-}
-
 // The diffuse reflectance (Mitsuba's aov "albedo"): Lambertian and Phong's rho_d, a coated
 // base's rho, mixtures of them; 0 for purely glossy or specular materials.
 inline Rgb diffuse_albedo(const Material& m) {

@@ -10,6 +10,7 @@ packages=(
   libembree-dev libtbb-dev libopenexr-dev libstb-dev
   libcli11-dev libfmt-dev nlohmann-json3-dev libpugixml-dev libtinyobjloader-dev libnanoflann-dev
   libgtest-dev libbenchmark-dev
+  libopenmpi-dev openmpi-bin libxxhash-dev
   chromium
 )
 

@@ -1,5 +1,7 @@
 #include "job/render_job.hpp"
 
+#include <optional>
+
 #include <fmt/format.h>
 
 #include "image/image_io.hpp"
@@ -70,9 +72,18 @@ std::string RenderJob::expand(const std::string& pattern) const {
     }
 }
 
-void RenderJob::write_outputs(const RenderResult& result, float exposure) const {
+void RenderJob::write_outputs(const RenderResult& result, float exposure,
+                              const std::vector<std::pair<std::string, std::string>>& attributes) const {
     const Image image = result.film.mean();
-    for (const std::string& path : outputs) write_image(image, path, exposure);
+    std::optional<Image> standard_error;
+    for (const std::string& path : outputs) {
+        if (image_format_for(path) != ImageFormat::Exr) {
+            write_image(image, path, exposure);
+            continue;
+        }
+        if (!standard_error) standard_error = result.film.standard_error();
+        write_exr(image, ExrExtras{{{"stderr", *standard_error}}, attributes}, path);
+    }
 }
 
 }  // namespace pathlab

@@ -300,11 +300,14 @@ int run_render_command(const RenderCommandOptions& o, RankGroup* ranks) {
         } catch (const UsageError& e) {
             if (!distributed) throw;
             code = 2, message = e.what();
+        } catch (const std::exception& e) {
+            if (!distributed) throw;
+            code = 1, message = fmt::format("error: {}", e.what());
         }
         std::string messages;
-        if (group.agree(code, message, &messages)) {
+        if (const int agreed = group.agree(code, message, &messages)) {
             if (root) print_messages(messages);
-            return 2;
+            return agreed;
         }
     }
     std::string defines_text;

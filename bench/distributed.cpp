@@ -79,7 +79,8 @@ void distributed_suite(const DistributedOptions& o, const std::string& self) {
     fmt::print("## Two MPI ranks against one process, at equal total threads\n\n");
     const std::string render = fmt::format("--scene {} --resolution {}x{} --spp {} --seed 1 -q -o {}", o.scene, o.size, o.size, o.spp,
                                            (dir / "out.exr").string());
-    fmt::print("`{} --threads 2` against `{} {} --threads 1` ({} runs each, alternating; medians)\n\n", render, mpirun(2), render, o.repeats);
+    fmt::print("`{} {} --threads 2` against `{} {} {} --threads 1` ({} runs each, alternating; medians)\n\n", pathlab, render, mpirun(2), pathlab,
+               render, o.repeats);
     std::vector<double> one_wall, two_wall, one_render, two_render, two_reduce;
     for (int r = 0; r < o.repeats; ++r)
         for (const bool two : {false, true}) {
@@ -157,25 +158,34 @@ void distributed_suite(const DistributedOptions& o, const std::string& self) {
         std::mt19937 rng(3);
         std::uniform_real_distribution<double> u(0, 2);
         for (Vec3d& v : pass) v = Vec3d(float(u(rng)), float(u(rng)), float(u(rng)));
-        std::vector<double> exact_t, plain_t;
-        for (int r = 0; r < o.repeats; ++r) {
-            Film film(size, size);
-            auto start = Clock::now();
-            for (int k = 0; k < passes; ++k)
-                for (size_t i = 0; i < pass.size(); ++i) film.add(i, pass[i]);
-            exact_t.push_back(seconds_since(start));
-            std::vector<Vec3d> sum(pass.size()), sq(pass.size());
-            std::vector<uint64_t> count(pass.size());
-            start = Clock::now();
-            for (int k = 0; k < passes; ++k)
-                for (size_t i = 0; i < pass.size(); ++i) sum[i] += pass[i], sq[i] += pass[i] * pass[i], ++count[i];
-            plain_t.push_back(seconds_since(start));
-            if (sum[7].x < 0 || film.count(7) == 0) std::printf("?");
-        }
+        // Pass-major (add_pass: every pixel once per pass, the film streamed from memory) and
+        // pixel-major (pixel integrators: a pixel's samples of a batch in a row, in cache).
+        std::vector<double> exact_t[2], plain_t[2];
+        for (int r = 0; r < o.repeats; ++r)
+            for (int major = 0; major < 2; ++major) {
+                const auto order = [&](auto&& add) {
+                    if (major == 0)
+                        for (int k = 0; k < passes; ++k)
+                            for (size_t i = 0; i < pass.size(); ++i) add(i);
+                    else
+                        for (size_t i = 0; i < pass.size(); ++i)
+                            for (int k = 0; k < passes; ++k) add(i);
+                };
+                Film film(size, size);
+                auto start = Clock::now();
+                order([&](size_t i) { film.add(i, pass[i]); });
+                exact_t[major].push_back(seconds_since(start));
+                std::vector<Vec3d> sum(pass.size()), sq(pass.size());
+                std::vector<uint64_t> count(pass.size());
+                start = Clock::now();
+                order([&](size_t i) { sum[i] += pass[i], sq[i] += pass[i] * pass[i], ++count[i]; });
+                plain_t[major].push_back(seconds_since(start));
+                if (sum[7].x < 0 || film.count(7) == 0) std::printf("?");
+            }
         const double n = double(passes) * size * size;
-        fmt::print("| accumulation | ns per sample (RGB value and square) |\n|---|---|\n| exact (render/exact_sum.hpp) | {:.1f} |\n"
-                   "| plain double sums (before) | {:.1f} |\n\n",
-                   median(exact_t) / n * 1e9, median(plain_t) / n * 1e9);
+        fmt::print("| accumulation, ns per sample (RGB value and square) | pass-major (add_pass) | pixel-major (pixel integrators) |\n"
+                   "|---|---|---|\n| exact (render/exact_sum.hpp) | {:.1f} | {:.1f} |\n| plain double sums (before) | {:.1f} | {:.1f} |\n\n",
+                   median(exact_t[0]) / n * 1e9, median(exact_t[1]) / n * 1e9, median(plain_t[0]) / n * 1e9, median(plain_t[1]) / n * 1e9);
     }
     fs::remove_all(dir);
 }

@@ -11,6 +11,7 @@ packages=(
   libcli11-dev libfmt-dev nlohmann-json3-dev libpugixml-dev libtinyobjloader-dev libnanoflann-dev
   libassimp-dev zlib1g-dev
   libgtest-dev libbenchmark-dev
+  libopenmpi-dev openmpi-bin libxxhash-dev
   chromium
 )
 

@@ -14,6 +14,21 @@
 //  - integrators that splat onto arbitrary pixels (the light tracer) collect each pass in a
 //    PassImage (render/pass_image.hpp).
 // To add an integrator: one file under src/integrators/<family>/ and one line in registry.cpp.
+//
+// Across processes and checkpoints (docs/distributed.md) the passes of one render are split
+// into parts rendered by different processes, or before and after a restart, each part into its
+// own film, and the films are summed exactly (render/film.hpp). That gives the one-process image
+// bit for bit if, and only if, the integrator keeps to this contract:
+//  1. a pass is a pure function of (scene, seed, image size, options, pass index): anything
+//     that changes from pass to pass (sppm's radius, vcm's) is computed from the pass index,
+//     never carried from the previous pass;
+//  2. prepare() is a pure function of (scene, seed, image size, options), since every process
+//     runs it (pm's photon maps, ic's cache: built identically on every rank, not shared);
+//  3. everything a pass contributes goes into the film given to render_passes (add, or
+//     add_pass of a PassImage); state that accumulates across passes elsewhere (bdpt's
+//     --strategies films) is neither summed across processes nor checkpointed, so the command
+//     line refuses those options there;
+//  4. finish() writes extra outputs only; with several processes it runs on rank 0 alone.
 #pragma once
 
 #include <functional>

@@ -84,18 +84,25 @@ std::string RenderJob::expand(const std::string& pattern) const {
     }
 }
 
-void RenderJob::write_outputs(const RenderResult& result, float exposure) const {
+void RenderJob::write_outputs(const RenderResult& result, float exposure,
+                              const std::vector<std::pair<std::string, std::string>>& attributes) const {
     const Image image = result.film.mean();
     const SceneDescription& d = choice_.description;
-    std::vector<ExrChannel> extra;
     const bool has_exr = std::any_of(outputs.begin(), outputs.end(), [](const std::string& p) { return image_format_for(p) == ImageFormat::Exr; });
-    if (has_exr && d.moment) extra = moment_channels(result.film);
-    if (has_exr && !d.aovs.empty()) {
+    if (!has_exr) {
+        for (const std::string& path : outputs) write_image(image, path, exposure);
+        return;
+    }
+    // An EXR carries the standard errors, the render's identity, and the moment and aov
+    // integrators' channels.
+    ExrExtras extras{{{"stderr", result.film.standard_error()}}, attributes, {}};
+    if (d.moment) extras.channels = moment_channels(result.film);
+    if (!d.aovs.empty()) {
         std::vector<ExrChannel> a = aov_channels(*scene_, d.aovs, result.film.width(), result.film.height(), result.stats.spp, settings.seed);
-        for (ExrChannel& c : a) extra.push_back(std::move(c));
+        for (ExrChannel& c : a) extras.channels.push_back(std::move(c));
     }
     for (const std::string& path : outputs) {
-        if (!extra.empty() && image_format_for(path) == ImageFormat::Exr) write_exr_with_channels(image, extra, path);
+        if (image_format_for(path) == ImageFormat::Exr) write_exr(image, extras, path);
         else write_image(image, path, exposure);
     }
 }

@@ -42,7 +42,8 @@ void validate(const SceneDescription& d) {
             throw SceneError(what + " has an invalid emitted radiance");
     }
     int environments = 0;
-    for (const FreeLight& l : d.lights) environments += std::holds_alternative<EnvironmentLight>(l);
+    for (const FreeLight& l : d.lights)
+        environments += std::holds_alternative<EnvironmentLight>(l) || std::holds_alternative<EnvMapLight>(l);
     if (environments > 1) throw SceneError("a scene can have at most one environment light");
 }
 
@@ -62,7 +63,7 @@ std::unique_ptr<Scene> Scene::build(const SceneDescription& desc) {
 
     for (const FreeLight& l : desc.lights) {
         std::visit([&](const auto& light) { s->lights_.emplace_back(light); }, l);
-        if (std::holds_alternative<EnvironmentLight>(l)) s->environment_ = int(s->lights_.size()) - 1;
+        if (is_environment(s->lights_.back())) s->environment_ = int(s->lights_.size()) - 1;
     }
 
     Vec3f lo(kInf), hi(-kInf);

@@ -322,14 +322,15 @@ TEST(IesBadFiles, EachProblemIsNamedWithTheFileAndTheLine) {
 
 // The hostile files of tests/data/ies_regressions/ (hand-made, and what the fuzzer finds:
 // scripts/fuzz.sh ies): each is refused with an IesError naming it, or parses into a
-// distribution with a finite flux.
+// distribution with a finite, non-negative flux (a cell 1e-6 degrees thin once gave a negative
+// one: the closed form of its integral cancelled).
 TEST(IesBadFiles, RegressionCorpusFailsCleanly) {
     int files = 0;
     for (const auto& entry : std::filesystem::directory_iterator(std::string(PATHLAB_SOURCE_DIR) + "/tests/data/ies_regressions")) {
         ++files;
         try {
             const IesDistribution d(read_ies_file(entry.path().string()));
-            EXPECT_TRUE(std::isfinite(d.flux())) << entry.path();
+            EXPECT_TRUE(std::isfinite(d.flux()) && d.flux() >= 0) << entry.path();
         } catch (const IesError& e) {
             EXPECT_NE(std::string(e.what()).find(entry.path().filename().string()), std::string::npos) << e.what();
         }

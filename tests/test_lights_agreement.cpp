@@ -1,8 +1,9 @@
 // The new lights seen by the bidirectional estimators: bdpt and the light tracer converge to
 // pt-mis's image (per-pixel z-tests, as tests/test_bdpt.cpp and test_light_tracer.cpp judge
 // them) on an outdoor scene lit by an environment map with a sun, and on the course's diffuse
-// box lit by a spot and an IES light instead of its point light. Each comparison raises a false
-// alarm with probability <= 1e-4.
+// box lit by a spot and an IES light instead of its point light; and the direct-illumination
+// estimators agree with each other under the map. Each comparison raises a false alarm with
+// probability <= 1e-4.
 #include <gtest/gtest.h>
 
 #include "integrators/bidir/bdpt.hpp"
@@ -88,6 +89,19 @@ TEST_P(NewLightsAgreement, BdptAndLightTracingConvergeToPtMis) {
     const AgreementResult l = agree(render_integrator(d, lt, c.w, c.h, 2 * c.spp, 503), pt, &mask);
     RecordProperty("lt", l.describe());
     EXPECT_TRUE(l.agree) << c.name << ", lt: " << l.describe();
+}
+
+// The direct-illumination estimators under the map: light sampling, BSDF sampling and their
+// MIS combination converge to one image (the map's lookup, its pdf_li in the MIS weights and its
+// sampling all enter).
+TEST(NewLightsAgreement, DirectEstimatorsAgreeUnderAnEnvmap) {
+    const SceneDescription d = envmap_scene();
+    const RenderResult mis = render_scene(d, "direct-mis", 12, 9, 4096, 601);
+    for (const char* other : {"direct-light", "direct-brdf"}) {
+        const AgreementResult r = agree(render_scene(d, other, 12, 9, 4096, 602), mis);
+        RecordProperty(other, r.describe());
+        EXPECT_TRUE(r.agree) << other << ": " << r.describe();
+    }
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenes, NewLightsAgreement, ::testing::ValuesIn(kCases), [](const auto& info) { return std::string(info.param.name); });

@@ -56,8 +56,9 @@ Rgb EnvMap::lookup(Vec2f uv) const {
     const float s = uv.x * float(width_) - 0.5f, t = uv.y * float(height_) - 0.5f;
     const float fs = std::floor(s), ft = std::floor(t);
     const float wx = s - fs, wy = t - ft;
-    int x0 = int(fs) % width_;
-    if (x0 < 0) x0 += width_;
+    // u in [0, 1): fs in [-1, W - 1]; other u wrap by a modulo.
+    int x0 = int(fs);
+    if (x0 < 0 || x0 >= width_) x0 = ((x0 % width_) + width_) % width_;
     const int x1 = x0 + 1 == width_ ? 0 : x0 + 1;
     const int y0 = std::clamp(int(ft), 0, height_ - 1), y1 = std::clamp(int(ft) + 1, 0, height_ - 1);
     return (texel(x0, y0) * (1 - wx) + texel(x1, y0) * wx) * (1 - wy) + (texel(x0, y1) * (1 - wx) + texel(x1, y1) * wx) * wy;

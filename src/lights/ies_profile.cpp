@@ -286,14 +286,21 @@ IesDistribution::IesDistribution(const IesProfile& p) : vertical_(p.vertical) {
         for (size_t v = 0; v + 1 < nv; ++v) {
             const double g0 = vertical_[v] * kRad, g1 = vertical_[v + 1] * kRad, dg = g1 - g0;
             const double c00 = grid_value(h, v), c10 = grid_value(h + 1, v), c01 = grid_value(h, v + 1), c11 = grid_value(h + 1, v + 1);
-            const double omega = dc * (std::cos(g0) - std::cos(g1));
+            // cos g0 - cos g1, without the cancellation of a thin cell.
+            const double s0 = 2 * std::sin(0.5 * (g0 + g1)) * std::sin(0.5 * dg);
+            const double omega = dc * s0;
             const size_t k = h * (nv - 1) + v;
             cell_solid_angle_[k] = float(omega);
             weights[k] = float(std::max({c00, c10, c01, c11}) * omega);
-            // Averaged over C the interpolant is a + (b - a) t along the cell, t = (g - g0) / dg.
+            // Averaged over C the interpolant is a (1 - t) + b t along the cell, t = (g - g0) / dg:
+            // its integral is a s_lo + b s_hi with s_hi = int t sin g dg = (sin g0 (cos dg - 1 +
+            // dg sin dg) + cos g0 (sin dg - dg cos dg)) / dg and s_lo = s0 - s_hi, both >= 0 (the
+            // series of sin dg - dg cos dg for thin cells, where the closed form cancels).
+            const double p = dg * std::sin(dg) - 2 * std::sin(0.5 * dg) * std::sin(0.5 * dg);
+            const double q = dg < 1e-2 ? dg * dg * dg / 3 - std::pow(dg, 5) / 30 : std::sin(dg) - dg * std::cos(dg);
+            const double s_hi = std::clamp((std::sin(g0) * p + std::cos(g0) * q) / dg, 0.0, s0), s_lo = s0 - s_hi;
             const double a = 0.5 * (c00 + c10), b = 0.5 * (c01 + c11);
-            const double s0 = std::cos(g0) - std::cos(g1), s1 = (std::sin(g1) - std::sin(g0) - dg * std::cos(g1)) / dg;
-            flux += dc * (a * s0 + (b - a) * s1);
+            flux += dc * (a * s_lo + b * s_hi);
         }
     }
     flux_ = flux;

@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "core/file_search.hpp"
 #include "geometry/mesh_files.hpp"
 #include "geometry/shape_meshes.hpp"
 
@@ -177,13 +178,7 @@ ShapeDesc read_cylinder(Properties& p, const ShapeContext&) {
 }  // namespace
 
 std::string ShapeContext::resolve(const std::string& name) const {
-    const std::filesystem::path p(name);
-    if (p.is_absolute()) return name;
-    const std::vector<std::string> dirs = search_dirs.empty() ? std::vector<std::string>{base_dir} : search_dirs;
-    std::error_code ec;
-    for (const std::string& d : dirs)
-        if (std::filesystem::exists(std::filesystem::path(d) / p, ec)) return (std::filesystem::path(d) / p).string();
-    return (std::filesystem::path(dirs.front()) / p).string();
+    return find_in_dirs(name, search_dirs.empty() ? std::vector<std::string>{base_dir} : search_dirs);
 }
 
 const std::vector<ShapePlugin>& shape_plugins() {

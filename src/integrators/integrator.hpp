@@ -135,7 +135,7 @@ struct IntegratorInfo {
     std::string name;                  // e.g. "direct-light"
     std::vector<std::string> aliases;  // the course's assignment numbers ("1"), Mitsuba's names ("ptracer")
     std::string summary;               // one line
-    // True when the integrator cannot see delta (point/directional) lights at all, so its image
+    // True when the integrator cannot see delta (point, spot, ies, directional) lights at all, so its image
     // is black in scenes lit only by them (BRDF-sampled estimators).
     bool blind_to_delta_lights = false;
     // False when pixels whose first camera-side vertex is specular stay black (the light

@@ -57,7 +57,8 @@ void validate(const SceneDescription& d) {
         if (inst.group >= d.groups.size() || !inst.to_world.is_finite() || !inst.to_world.is_affine_invertible())
             throw SceneError("an instance refers to a missing shapegroup or has a degenerate transform");
     int environments = 0;
-    for (const FreeLight& l : d.lights) environments += std::holds_alternative<EnvironmentLight>(l);
+    for (const FreeLight& l : d.lights)
+        environments += std::holds_alternative<EnvironmentLight>(l) || std::holds_alternative<EnvMapLight>(l);
     if (environments > 1) throw SceneError("a scene can have at most one environment light");
 }
 
@@ -77,7 +78,7 @@ std::unique_ptr<Scene> Scene::build(const SceneDescription& desc) {
 
     for (const FreeLight& l : desc.lights) {
         std::visit([&](const auto& light) { s->lights_.emplace_back(light); }, l);
-        if (std::holds_alternative<EnvironmentLight>(l)) s->environment_ = int(s->lights_.size()) - 1;
+        if (is_environment(s->lights_.back())) s->environment_ = int(s->lights_.size()) - 1;
     }
 
     Vec3f lo(kInf), hi(-kInf);

@@ -52,8 +52,9 @@ public:
 
     // Radiance along a ray that escapes the scene in direction w (the environment, if any).
     Rgb escaped_radiance(const Vec3f& w = {}) const {
-        return environment_ >= 0 ? std::get<EnvironmentLight>(lights_[size_t(environment_)]).Le(w) : Rgb(0.0f);
+        return environment_ >= 0 ? environment_radiance(lights_[size_t(environment_)], w) : Rgb(0.0f);
     }
+    // The environment light (constant or envmap), or -1.
     int environment_light() const { return environment_; }
 
     // Chooses a light with probability proportional to its power (uniformly if all are 0).

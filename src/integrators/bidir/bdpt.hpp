@@ -12,8 +12,8 @@
 // sampling, the balance heuristic by default or the power heuristic (`--mis power`), with the
 // weights computed by Veach's ratio walk over the densities stored on the vertices
 // (path_vertex.hpp), as pbrt formulates it. Dirac lobes (mirrors, glass, the coating of
-// plastic), delta lights (point, directional), the constant environment and one-sided emitters
-// each enter the densities as path_vertex.hpp says.
+// plastic), delta lights (point, spot, ies, directional), the environment (constant or a map)
+// and one-sided emitters each enter the densities as path_vertex.hpp says.
 //
 // Depth: a path of s + t vertices has s + t - 2 bounces, counted as the path tracers count
 // them, so `--max-depth` means the same and bdpt converges to pt-mis's image at every depth.

@@ -101,7 +101,7 @@ TEST(Allocation, NoEstimatorAllocatesPerSample) {
                 const uint64_t before = allocations_by_this_thread();
                 integrator->render_passes(ctx, film, 2, 1, {});
                 EXPECT_LT(allocations_by_this_thread() - before, sppm ? 64u : 3u * 64u) << info.name << " on scene " << index;
-                if (vcm) EXPECT_GT(vcm->photon_count(), 2048u) << info.name << " on scene " << index;
+                if (vcm) { EXPECT_GT(vcm->photon_count(), 2048u) << info.name << " on scene " << index; }
                 continue;
             }
             if (auto* pm = dynamic_cast<PhotonMapper*>(integrator.get())) {

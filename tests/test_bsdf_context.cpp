@@ -60,7 +60,7 @@ TEST_P(BsdfContextTest, ImportanceModeIsTheAdjoint) {
         // Radiance mode with a context is the plain model, bit for bit.
         ASSERT_EQ(m.eval(radiance, wi, wo), m.eval(wi, wo));
     }
-    if (!m.is_delta()) EXPECT_GT(nonzero, 1000) << "the test must see non-zero values";
+    if (!m.is_delta()) { EXPECT_GT(nonzero, 1000) << "the test must see non-zero values"; }
 }
 
 TEST_P(BsdfContextTest, SamplesCarryReversePdfsLobesAndImportanceWeights) {

@@ -50,7 +50,7 @@ TEST_P(LightTracerAgreement, ConvergesToThePathTracersImage) {
     const AgreementResult r = file ? compare_with_pt_mis(GetParam(), lt, 16, 12, 16384) : compare_with_pt_mis(GetParam(), lt, 8, 8);
     ::testing::Test::RecordProperty("agreement", r.describe());
     EXPECT_TRUE(r.agree) << GetParam() << ": " << r.describe();
-    if (file) EXPECT_GT(r.excluded, 10) << "the scene must show specular surfaces";
+    if (file) { EXPECT_GT(r.excluded, 10) << "the scene must show specular surfaces"; }
 }
 INSTANTIATE_TEST_SUITE_P(Scenes, LightTracerAgreement,
                          ::testing::Values("0", "1", "2", "3", "4", "5", "6", "7", "specular-box.xml", "specular-sky.xml"),
@@ -140,8 +140,8 @@ TEST(LightTracerCheck, SpecularFirstVertexMaskMarksMirrorsGlassAndPlasticOnly) {
         const bool specular = scene->intersect(camera.generate(float(i % 48) + 0.5f, float(i / 48) + 0.5f), hit) &&
                               (scene->material(hit.material).lobes() & kLobeSpecular);
         specular_centres += specular;
-        if (specular) EXPECT_TRUE(exact[i]) << "pixel " << i;  // its centre sees a specular surface
-        if (exact[i]) EXPECT_TRUE(dilated[i]);
+        if (specular) { EXPECT_TRUE(exact[i]) << "pixel " << i; }  // its centre sees a specular surface
+        if (exact[i]) { EXPECT_TRUE(dilated[i]); }
     }
     EXPECT_GT(specular_centres, 100u);
     EXPECT_LT(count_marked(dilated), exact.size() / 3);

@@ -475,7 +475,7 @@ TEST(SceneFileMeshes, PlyAndSerializedRenderAsTheSameObj) {
     };
     const std::string glossy = R"(<bsdf type="roughconductor"><float name="alpha" value="0.3"/></bsdf>)";
     const Image obj = render(R"(<shape type="obj"><string name="filename" value="m.obj"/>)" + glossy + "</shape>");
-    for (const std::string& s : {R"(<shape type="ply"><string name="filename" value="m_ascii.ply"/>)",
+    for (const char* s : {R"(<shape type="ply"><string name="filename" value="m_ascii.ply"/>)",
                                  R"(<shape type="ply"><string name="filename" value="m_binary.ply"/>)",
                                  R"(<shape type="serialized"><string name="filename" value="m.serialized"/>)"})
         EXPECT_TRUE(test::bit_identical(obj, render(s + glossy + "</shape>"))) << s;

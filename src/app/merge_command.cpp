@@ -210,7 +210,7 @@ int run_merge_command(const MergeOptions& o) {
     attributes.emplace_back("pathlab:invalidSamples", fmt::format("{}", invalid));
     attributes.emplace_back("pathlab:mergedFrom", fmt::format("{}", inputs.size()));
     attributes.emplace_back("pathlab:version", PATHLAB_VERSION);
-    write_exr(mean, ExrExtras{{{"stderr", standard_error}}, attributes}, o.output);
+    write_exr(mean, ExrExtras{{{"stderr", standard_error}}, attributes, {}}, o.output);
     if (!o.quiet)
         fmt::print(stderr, "merged {} renders ({}): {} spp{} -> {}\n", inputs.size(), all_films ? "exact, from checkpoints" : "from float images",
                    spp, invalid ? fmt::format(", {} NaN/Inf samples had been discarded (weights assume every pixel has spp samples)", invalid) : "",

@@ -91,7 +91,7 @@ RenderStats render_into(const Scene& scene, Integrator& integrator, const Render
     RenderStats st;
     st.resumed_spp = settings.done.count();
     PassSet done = settings.done;
-    uint64_t batch = 1, my_spp = 0, my_rays = 0;
+    uint64_t batch = 1, my_spp = 0;
     double my_seconds = 0, last_checkpoint = 0;
     const uint64_t pixels = uint64_t(w) * uint64_t(h);
     while (true) {

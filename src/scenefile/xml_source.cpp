@@ -23,10 +23,16 @@ std::string rgb_text(const Vec3d& c) { return fmt::format("{}, {}, {}", float(c.
 // sRGB's transfer function, decoded (Mitsuba 0.6's <srgb>).
 double srgb_to_linear(double v) { return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4); }
 
+std::shared_ptr<LoadContext> make_context(SceneDefines defines) {
+    auto context = std::make_shared<LoadContext>();
+    context->defines = std::move(defines);
+    return context;
+}
+
 }  // namespace
 
 XmlSource::XmlSource(const std::string& text, std::string file, SceneDefines defines)
-    : XmlSource(text, std::move(file), std::make_shared<LoadContext>(LoadContext{std::move(defines)})) {}
+    : XmlSource(text, std::move(file), make_context(std::move(defines))) {}
 
 XmlSource::XmlSource(const std::string& text, std::string file, std::shared_ptr<LoadContext> context)
     : text_(text), file_(std::move(file)), context_(std::move(context)) {

@@ -9,6 +9,7 @@ packages=(
   build-essential cmake pkg-config
   libembree-dev libtbb-dev libopenexr-dev libstb-dev
   libcli11-dev libfmt-dev nlohmann-json3-dev libpugixml-dev libtinyobjloader-dev libnanoflann-dev
+  libopenvdb-dev
   libgtest-dev libbenchmark-dev
   chromium
 )

@@ -11,6 +11,7 @@ Material read_bsdf(XmlSource& xml, const pugi::xml_node& n) {
     xml.check_attributes(n, {"type", "id", "name"});
     const std::string type = xml.attr(n, "type");
     const BsdfPlugin* plugin = find_bsdf_plugin(type);
+    if (type == null_bsdf_plugin().type) xml.fail(n, "a null BSDF is a shape's own BSDF (nested in it, or declared with an id); nothing wraps it");
     if (!plugin) xml.fail(n, fmt::format("unsupported bsdf type '{}'; supported: {}", type, bsdf_type_names()));
     if (!plugin->read) {  // twosided
         std::vector<pugi::xml_node> inner = xml.plugin_children(n);
@@ -37,9 +38,18 @@ Material read_bsdf(XmlSource& xml, const pugi::xml_node& n) {
 
 void read_named_bsdf(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b) {
     const auto id = xml.optional_attr(n, "id");
+    if (xml.optional_attr(n, "type") == null_bsdf_plugin().type) {  // no material: a medium boundary
+        xml.check_attributes(n, {"type", "id"});
+        if (!xml.plugin_children(n).empty()) xml.fail(xml.plugin_children(n).front(), "a null BSDF has no nested plugins");
+        Properties p = xml.properties(n, null_bsdf_plugin());
+        reading([&] { return p.check_all_used(), 0; });
+        if (id && (b.named_bsdfs.count(*id) || b.null_bsdfs.count(*id))) xml.fail(n, fmt::format("the id '{}' is already used", *id));
+        if (id) b.null_bsdfs.insert(*id);
+        return;
+    }
     const uint32_t index = b.add_material(read_bsdf(xml, n));
     if (id) {
-        if (b.named_bsdfs.count(*id)) xml.fail(n, fmt::format("the id '{}' is already used", *id));
+        if (b.named_bsdfs.count(*id) || b.null_bsdfs.count(*id)) xml.fail(n, fmt::format("the id '{}' is already used", *id));
         b.named_bsdfs[*id] = index;
     }
 }

@@ -5,6 +5,7 @@
 
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 
 #include "geometry/shape_plugins.hpp"
@@ -17,6 +18,8 @@ namespace pathlab {
 struct SceneBuilder {
     SceneDescription desc;
     std::map<std::string, uint32_t> named_bsdfs;  // id -> index into desc.materials
+    std::set<std::string> null_bsdfs;             // ids of <bsdf type="null">
+    std::map<std::string, int32_t> named_media;   // id -> index into desc.media
     std::optional<uint32_t> default_material;
     bool have_sensor = false, have_integrator = false;
     ShapeContext shapes;
@@ -35,5 +38,11 @@ Material read_bsdf(XmlSource& xml, const pugi::xml_node& n);                    
 void read_named_bsdf(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b);
 void read_shape(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b);       // read_shape.cpp
 void read_free_emitter(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b);  // read_emitter.cpp
+// read_medium.cpp: a <medium> (its index in desc.media), one declared at the top level, the
+// medium a <ref id> names, and the null BSDF's declaration.
+int32_t read_medium(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b);
+void read_named_medium(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b);
+int32_t medium_reference(XmlSource& xml, const pugi::xml_node& ref, const SceneBuilder& b);
+const PluginInfo& null_bsdf_plugin();
 
 }  // namespace pathlab

@@ -41,8 +41,9 @@ SceneDescription load_scene_text(const std::string& text, const std::string& fil
         else if (tag == "bsdf") read_named_bsdf(xml, n, b);
         else if (tag == "shape") read_shape(xml, n, b);
         else if (tag == "emitter") read_free_emitter(xml, n, b);
+        else if (tag == "medium") read_named_medium(xml, n, b);
         else xml.fail(n, fmt::format("unsupported element <{}> in <scene>; supported: <default>, <integrator>, <sensor>, "
-                                     "<bsdf>, <shape>, <emitter>", tag));
+                                     "<bsdf>, <shape>, <emitter>, <medium>", tag));
     }
     if (b.desc.meshes.empty() && b.desc.spheres.empty()) xml.fail_file("the scene has no shapes");
     return std::move(b.desc);

@@ -9,12 +9,16 @@
 //   pathlab_bench pm       photons per second; hashed grid against k-d tree (build, query)
 //   pathlab_bench ic       irradiance caching against pt-mis and bdpt at short budgets
 //   pathlab_bench volumes  volpath: samples/s, equal-time RMSE with and without MIS, optical thickness
+//   pathlab_bench distributed  2 MPI ranks against 1 process, film reduction, checkpoints
+//   pathlab_bench lights   an environment map's cost per sample against the constant environment; spot and IES
 #include <CLI/CLI.hpp>
 
 #include "bidirectional.hpp"
+#include "distributed.hpp"
 #include "estimator_efficiency.hpp"
 #include "light_tracing.hpp"
 #include "irradiance_caching.hpp"
+#include "lights.hpp"
 #include "photon_mapping.hpp"
 #include "performance.hpp"
 #include "volumes.hpp"
@@ -84,7 +88,33 @@ int main(int argc, char** argv) {
     vol->add_option("--scenes", vo.scenes, "Scene files of scenes/ with media")->delimiter(',')->capture_default_str();
     vol->add_option("--plain-scenes", vo.plain_scenes, "Scene files of scenes/ without media")->delimiter(',')->capture_default_str();
     vol->add_option("--fixed-spp", vo.fixed_spp, "Samples per pixel of the renders without media")->capture_default_str();
+    LightsOptions lo;
+    CLI::App* lic = app.add_subcommand("lights", "An environment map's cost per sample against the constant environment; spot and IES");
+    lic->add_option("--size", lo.size, "Image width and height")->capture_default_str();
+    lic->add_option("--seconds", lo.seconds, "Seconds per timed render")->capture_default_str();
+    lic->add_option("--repeats", lo.repeats, "Interleaved rounds (median reported)")->capture_default_str();
+    lic->add_option("--scenes", lo.scenes, "Course scene indices with an environment")->delimiter(',')->capture_default_str();
+    lic->add_option("--map-width", lo.map_width, "Width of the constant environment map")->capture_default_str();
+    DistributedOptions dopt;
+    CLI::App* dist = app.add_subcommand("distributed", "2 MPI ranks against 1 process, film reduction, checkpoint write and size");
+    dist->add_option("--size", dopt.size, "Image width and height of the speedup renders")->capture_default_str();
+    dist->add_option("--spp", dopt.spp, "Their samples per pixel")->capture_default_str();
+    dist->add_option("--scene", dopt.scene, "Their scene")->capture_default_str();
+    dist->add_option("--repeats", dopt.repeats, "Timed runs per figure (median reported)")->capture_default_str();
+    dist->add_option("--film-sizes", dopt.film_sizes, "Film sizes reduced and checkpointed")->delimiter(',')->capture_default_str();
+    CLI::App* worker = app.add_subcommand("distributed-reduce-worker", "(run by `distributed` under mpirun)");
+    worker->group("");
+    worker->add_option("--film-sizes", dopt.film_sizes)->delimiter(',');
+    worker->add_option("--repeats", dopt.repeats);
+    // Under mpirun this program is one rank of the reduction benchmark.
+    std::vector<std::string> args(argv, argv + argc);
     CLI11_PARSE(app, argc, argv);
+    if (*worker) {
+        distributed_reduce_worker(dopt.film_sizes, dopt.repeats, argc, argv);
+        return 0;
+    }
+    if (*dist) distributed_suite(dopt, args[0]);
+    if (*lic) lights_suite(lo);
     if (*vol) volumes_suite(vo);
     if (*icc) irradiance_caching_suite(icopt);
     if (*pmc) photon_mapping_suite(pm);

@@ -6,6 +6,8 @@
 #include <tbb/global_control.h>
 
 #include <cmath>
+#include <fstream>
+#include <iterator>
 
 #include "../tools/smoke_grid.hpp"
 #include "geometry/shape_meshes.hpp"
@@ -29,11 +31,41 @@ TEST(Volpath, WithoutMediaItIsPtMisBitForBit) {
     for (int s = 0; s < 8; ++s) scenes.push_back(make_builtin_scene(s));
     for (const char* f : {"scenes/materials/smooth.xml", "scenes/materials/roughdielectric.xml", "scenes/caustic.xml"})
         scenes.push_back(load_scene_file(source_path(f)));
+    // The merged lights (envmap, spot, IES), and a thin-lens camera with a Gaussian filter and a
+    // twosided pair of BSDFs (front, back) in the course box.
+    for (const char* f : {"scenes/envmap-sky.xml", "scenes/spot.xml", "scenes/ies.xml"}) scenes.push_back(load_scene_file(source_path(f)));
+    {
+        std::string text;
+        {
+            std::ifstream in(source_path("scenes/2-ceiling-diffuse.xml"));
+            text.assign(std::istreambuf_iterator<char>(in), {});
+        }
+        const auto replace = [&](const std::string& from, const std::string& to) {
+            const size_t at = text.find(from);
+            ASSERT_NE(at, std::string::npos) << from;
+            text.replace(at, from.size(), to);
+        };
+        replace("<scene version=\"3.0.0\">", "<scene version=\"3.0.0\"><path value=\"" + source_path("scenes") + "\"/>");
+        replace("<sensor type=\"perspective\">",
+                "<sensor type=\"thinlens\"><float name=\"aperture_radius\" value=\"0.1\"/><float name=\"focus_distance\" value=\"3\"/>");
+        replace("<film type=\"hdrfilm\">", "<film type=\"hdrfilm\"><rfilter type=\"gaussian\"/>");
+        replace("<bsdf type=\"twosided\" id=\"floor\"><bsdf type=\"diffuse\"><rgb name=\"reflectance\" value=\"0.803921998, 0.803921998, 0.803921998\"/></bsdf></bsdf>",
+                "<bsdf type=\"twosided\" id=\"floor\"><bsdf type=\"diffuse\"/><bsdf type=\"roughconductor\"/></bsdf>");
+        const std::string file = testing::TempDir() + "volpath-thinlens.xml";
+        std::ofstream(file) << text;
+        scenes.push_back(load_scene_file(file));
+    }
+    const auto own_loop = make_volpath(IntegratorOptions{}, {true, false});
     for (const SceneDescription& d : scenes) {
         const RenderResult a = render_scene(d, "pt-mis", 16, 12, 4, 7), b = render_scene(d, "volpath", 16, 12, 4, 7);
         EXPECT_TRUE(bit_identical(a.film.mean(), b.film.mean())) << d.name;
         EXPECT_TRUE(bit_identical(a.film.standard_error(), b.film.standard_error())) << d.name;
         EXPECT_EQ(a.stats.rays, b.stats.rays) << d.name;
+        // volpath's own loop (not pt-mis's, which it hands a scene without media to).
+        const RenderResult c = render_integrator(d, *own_loop, 16, 12, 4, 7);
+        EXPECT_TRUE(bit_identical(a.film.mean(), c.film.mean())) << d.name << ": volpath's own loop";
+        EXPECT_TRUE(bit_identical(a.film.standard_error(), c.film.standard_error())) << d.name << ": volpath's own loop";
+        EXPECT_EQ(a.stats.rays, c.stats.rays) << d.name << ": volpath's own loop";
     }
 }
 

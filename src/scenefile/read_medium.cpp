@@ -119,16 +119,13 @@ int32_t read_medium(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b) {
 
 void read_named_medium(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b) {
     const auto id = xml.optional_attr(n, "id");
-    if (id && b.named_media.count(*id)) xml.fail(n, fmt::format("the id '{}' is already used by another medium", *id));
+    if (id && b.named.count(*id)) b.name(xml, n, *id, "medium", int32_t(-1));  // names the earlier declaration
     const int32_t index = read_medium(xml, n, b);
-    if (id) b.named_media[*id] = index;
+    if (id) b.name(xml, n, *id, "medium", index);
 }
 
 int32_t medium_reference(XmlSource& xml, const pugi::xml_node& ref, const SceneBuilder& b) {
-    const std::string id = xml.attr(ref, "id");
-    const auto it = b.named_media.find(id);
-    if (it == b.named_media.end()) xml.fail(ref, fmt::format("no <medium> with id '{}' is declared before this reference", id));
-    return it->second;
+    return std::any_cast<int32_t>(b.resolve(xml, ref, "medium").value);
 }
 
 }  // namespace pathlab

@@ -21,6 +21,7 @@
 #include "integrators/common/direct_lighting.hpp"
 #include "integrators/common/path_rules.hpp"
 #include "integrators/integrators.hpp"
+#include "integrators/path/pt_mis.hpp"
 
 namespace pathlab {
 namespace {
@@ -192,7 +193,7 @@ EmitterHit emission_found(const Scene& scene, const Walk& w, const Vec3f& from) 
         const int env = scene.environment_light();
         if (env >= 0) {
             e.Le = scene.escaped_radiance(w.dir);
-            e.pdf_light = scene.light_pmf(env) * std::get<EnvironmentLight>(scene.lights()[size_t(env)]).pdf_li(w.dir);
+            e.pdf_light = scene.light_pmf(env) * environment_pdf_li(scene.lights()[size_t(env)], w.dir);
         }
     } else if (w.kind == Walk::kSurface) {
         e.Le = emitted_radiance(scene, w.isect, -w.dir / length(w.dir));
@@ -206,17 +207,25 @@ EmitterHit emission_found(const Scene& scene, const Walk& w, const Vec3f& from) 
 
 class Volpath final : public PixelIntegrator {
 public:
-    Volpath(const IntegratorOptions& o, VolpathSettings s) : rules_(o), mis_(s.mis) {}
+    Volpath(const IntegratorOptions& o, VolpathSettings s)
+        : rules_(o), mis_(s.mis), pt_mis_without_media_(s.pt_mis_without_media), hide_(o.hide_emitters) {}
 
     Rgb radiance(const Scene& scene, const Ray& camera_ray, Sampler& sampler) const override {
+        if (!scene.has_media() && pt_mis_without_media_) {  // pt-mis's own loop: the same image, pt-mis's speed
+            Intersection hit;
+            if (!scene.intersect(camera_ray, hit)) return hide_ ? Rgb(0.0f) : scene.escaped_radiance(camera_ray.d);
+            const Rgb emitted = hide_ ? Rgb(0.0f) : emitted_radiance(scene, hit, -camera_ray.d);
+            return pt_mis_from_hit(scene, hit, camera_ray.d, 0, sampler, rules_, false, -1, emitted);
+        }
         MediumState st{sampler};
         Rgb seg(1.0f);
         Walk w = walk(scene, camera_ray, scene.camera_medium(), st, seg);
         Rgb beta = seg;
         // What the camera sees directly (pt-mis: L starts as the emission at the first hit).
         Rgb L(0.0f);
-        if (w.kind == Walk::kEscaped) return beta * scene.escaped_radiance(w.dir) / mean(st.r);
-        if (w.kind == Walk::kSurface) L = beta * emitted_radiance(scene, w.isect, -w.dir) / mean(st.r);
+        // (hide_emitters: not the emitters and the sky seen directly, also through media.)
+        if (w.kind == Walk::kEscaped) return hide_ ? Rgb(0.0f) : beta * scene.escaped_radiance(w.dir) / mean(st.r);
+        if (w.kind == Walk::kSurface && !hide_) L = beta * emitted_radiance(scene, w.isect, -w.dir) / mean(st.r);
         for (int bounces = 0; w.kind != Walk::kLost && rules_.may_bounce(bounces); ++bounces) {
             Vertex v;
             v.medium = w.medium;
@@ -282,7 +291,7 @@ private:
     }
 
     PathRules rules_;
-    bool mis_;
+    bool mis_, pt_mis_without_media_, hide_;
 };
 
 }  // namespace

@@ -14,6 +14,10 @@ struct VolpathSettings {
     // next-event estimation alone finds the lights (emission that a phase or BSDF sample
     // finds counts only after a Dirac lobe): the benchmark's comparison.
     bool mis = true;
+    // In a scene without media, pt-mis's loop (pt_mis.hpp) renders: the same image bit for bit
+    // (volpath's own loop draws pt-mis's numbers and does its arithmetic, tested with this off),
+    // without the 9 to 15% its walk bookkeeping costs (docs/volumes.md, "Cost").
+    bool pt_mis_without_media = true;
 };
 
 std::unique_ptr<Integrator> make_volpath(const IntegratorOptions& options, VolpathSettings settings = {});

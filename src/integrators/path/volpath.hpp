@@ -16,7 +16,7 @@ struct VolpathSettings {
     bool mis = true;
     // In a scene without media, pt-mis's loop (pt_mis.hpp) renders: the same image bit for bit
     // (volpath's own loop draws pt-mis's numbers and does its arithmetic, tested with this off),
-    // without the 9 to 15% its walk bookkeeping costs (docs/volumes.md, "Cost").
+    // without the walk's bookkeeping (measured at up to 15%, docs/volumes.md, "Cost").
     bool pt_mis_without_media = true;
 };
 

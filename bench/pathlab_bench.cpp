@@ -8,6 +8,7 @@
 //   pathlab_bench bdpt     bdpt against pt-mis: equal-time RMSE, and samples per second
 //   pathlab_bench pm       photons per second; hashed grid against k-d tree (build, query)
 //   pathlab_bench ic       irradiance caching against pt-mis and bdpt at short budgets
+//   pathlab_bench volumes  volpath: samples/s, equal-time RMSE with and without MIS, optical thickness
 //   pathlab_bench distributed  2 MPI ranks against 1 process, film reduction, checkpoints
 //   pathlab_bench lights   an environment map's cost per sample against the constant environment; spot and IES
 #include <CLI/CLI.hpp>
@@ -20,6 +21,7 @@
 #include "lights.hpp"
 #include "photon_mapping.hpp"
 #include "performance.hpp"
+#include "volumes.hpp"
 
 int main(int argc, char** argv) {
     using namespace pathlab::bench;
@@ -77,6 +79,15 @@ int main(int argc, char** argv) {
     icc->add_option("--budgets", icopt.budgets, "Seconds per render")->delimiter(',')->capture_default_str();
     icc->add_option("--repeats", icopt.repeats, "Rounds (median reported)")->capture_default_str();
     icc->add_option("--scenes", icopt.scenes, "Course scene indices")->delimiter(',')->capture_default_str();
+    VolumesOptions vo;
+    CLI::App* vol = app.add_subcommand("volumes", "volpath: samples/s, equal-time RMSE with and without MIS, optical thickness");
+    vol->add_option("--size", vo.size, "Image width and height")->capture_default_str();
+    vol->add_option("--seconds", vo.seconds, "Seconds per timed render")->capture_default_str();
+    vol->add_option("--repeats", vo.repeats, "Rounds (median reported)")->capture_default_str();
+    vol->add_option("--ref-spp", vo.ref_spp, "Samples per pixel of each reference")->capture_default_str();
+    vol->add_option("--scenes", vo.scenes, "Scene files of scenes/ with media")->delimiter(',')->capture_default_str();
+    vol->add_option("--plain-scenes", vo.plain_scenes, "Scene files of scenes/ without media")->delimiter(',')->capture_default_str();
+    vol->add_option("--fixed-spp", vo.fixed_spp, "Samples per pixel of the renders without media")->capture_default_str();
     LightsOptions lo;
     CLI::App* lic = app.add_subcommand("lights", "An environment map's cost per sample against the constant environment; spot and IES");
     lic->add_option("--size", lo.size, "Image width and height")->capture_default_str();
@@ -104,6 +115,7 @@ int main(int argc, char** argv) {
     }
     if (*dist) distributed_suite(dopt, args[0]);
     if (*lic) lights_suite(lo);
+    if (*vol) volumes_suite(vo);
     if (*icc) irradiance_caching_suite(icopt);
     if (*pmc) photon_mapping_suite(pm);
     if (*bd) bidirectional_suite(b);

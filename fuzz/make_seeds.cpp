@@ -1,6 +1,7 @@
 // Writes the seed corpora of the reader fuzz targets, from files pathlab (and the libraries it
 // links) can make itself: small images in every format and variant the readers know, and OBJ
-// meshes. Usage: fuzz_make_seeds DIR  (creates DIR/exr, DIR/hdr, DIR/pfm, DIR/png, DIR/obj).
+// meshes, voxel grids. Usage: fuzz_make_seeds DIR  (creates DIR/exr, DIR/hdr, DIR/pfm, DIR/png,
+// DIR/obj, DIR/vol).
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
@@ -17,6 +18,7 @@
 #include <vector>
 
 #include "image/image_io.hpp"
+#include "media/grid_files.hpp"
 
 namespace fs = std::filesystem;
 using pathlab::Image;
@@ -73,7 +75,7 @@ int main(int argc, char** argv) {
         return 2;
     }
     const fs::path dir = argv[1];
-    for (const char* sub : {"exr", "hdr", "pfm", "png", "obj"}) fs::create_directories(dir / sub);
+    for (const char* sub : {"exr", "hdr", "pfm", "png", "obj", "vol"}) fs::create_directories(dir / sub);
 
     // pathlab's own writers, at sizes around the readers' special cases (HDR run-length
     // encoding needs widths of 8 or more).
@@ -132,5 +134,14 @@ int main(int argc, char** argv) {
                 "g front\ns 1\nf 1/1/1 2/2/1 3/3/1 4/4/1\n");
     write_bytes(dir / "obj" / "negative.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf -4 -3 -2\nf -1 -3 -2\nusemtl red\nf 1//1 2 3\n");
     write_bytes(dir / "obj" / "polygon.obj", "v 0 0 0\nv 2 0 0\nv 3 1 0\nv 2 2 0\nv 0 2 0\nv -1 1 0\nf 1 2 3 4 5 6\nl 1 2\np 3\n");
+
+    // .vol grids of 1 and 3 channels, written by pathlab's writer.
+    for (int channels : {1, 3}) {
+        pathlab::VoxelGrid g;
+        g.res = {4, 3, 2};
+        g.channels = channels;
+        for (size_t i = 0; i < g.voxel_count() * size_t(channels); ++i) g.data.push_back(float(i % 7) * 0.25f);
+        pathlab::write_vol_file((dir / "vol" / ("grid" + std::to_string(channels) + ".vol")).string(), g);
+    }
     return 0;
 }

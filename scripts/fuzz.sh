@@ -1,26 +1,27 @@
 #!/usr/bin/env bash
 # Fuzzes pathlab's readers of untrusted files with libFuzzer (clang, AddressSanitizer, UBSan).
-#   scripts/fuzz.sh TARGET [SECONDS]   TARGET: scene_xml, exr, hdr, pfm, png, obj, ies, or all
+#   scripts/fuzz.sh TARGET [SECONDS]   TARGET: scene_xml, exr, hdr, pfm, png, obj, vol, ies, or all
 #                                      (all: each target in turn for SECONDS); default 660 s
 #   scripts/fuzz.sh [SECONDS]          the scene-file loader, as before (scene_xml)
 # Seeds: the shipped scenes, meshes and IES files, images and meshes written by fuzz_make_seeds
 # (pathlab's own writers and the libraries it links), and the regression corpora under tests/data/.
 # Crashing or hanging inputs are written to build-fuzz/crashes/TARGET-*; once fixed, copy them
 # to tests/data/xml_regressions/, tests/data/image_regressions/, tests/data/obj_regressions/ or
-# tests/data/ies_regressions/, where `make test` keeps loading them. Each run's log is build-fuzz/fuzz-TARGET.log and its
+# tests/data/vol_regressions/ or tests/data/ies_regressions/,
+# where `make test` keeps loading them. Each run's log is build-fuzz/fuzz-TARGET.log and its
 # figures (executions, exec/s, coverage) are summarised at the end.
 # On a shared machine run it as `nice -n 19 scripts/fuzz.sh ...`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-all_targets=(scene_xml exr hdr pfm png obj ies)
+all_targets=(scene_xml exr hdr pfm png obj vol ies)
 if [[ $# -eq 0 || $1 =~ ^[0-9]+$ ]]; then
     targets=(scene_xml)
     seconds=${1:-660}
 else
     case $1 in
         all) targets=("${all_targets[@]}") ;;
-        scene_xml | exr | hdr | pfm | png | obj | ies) targets=("$1") ;;
+        scene_xml | exr | hdr | pfm | png | obj | vol | ies) targets=("$1") ;;
         *) echo "fuzz.sh: unknown target '$1' (valid: ${all_targets[*]}, all)" >&2; exit 2 ;;
     esac
     seconds=${2:-660}
@@ -72,6 +73,13 @@ for t in "${targets[@]}"; do
             make_seeds
             cp -n scenes/meshes/*.obj build-fuzz/seeds/obj/* "$corpus"/ 2>/dev/null || true
             cp -n tests/data/obj_regressions/* "$corpus"/ 2>/dev/null || true
+            ;;
+        vol)
+            corpus=build-fuzz/corpus-vol
+            mkdir -p "$corpus"
+            make_seeds
+            cp -n build-fuzz/seeds/vol/* "$corpus"/ 2>/dev/null || true
+            cp -n tests/data/vol_regressions/* "$corpus"/ 2>/dev/null || true
             ;;
         ies)
             corpus=build-fuzz/corpus-ies

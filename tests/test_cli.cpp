@@ -284,9 +284,9 @@ TEST_F(Cli, SceneFileErrorsGiveFileLineColumnAndExitCode2) {
     r = run({"--scene", write_scene(path("ok.xml")), "-D", "novalue", "-o", path("x.exr")});
     EXPECT_EQ(r.code, 2);
     EXPECT_TRUE(contains(r.err, "expected name=value")) << r.err;
-    r = run({"--scene", write_scene(path("odd.xml"), "volpath"), "-o", path("x.exr")});
+    r = run({"--scene", write_scene(path("odd.xml"), "stokes"), "-o", path("x.exr")});
     EXPECT_EQ(r.code, 2);
-    EXPECT_TRUE(contains(r.err, "unsupported integrator type 'volpath'")) << r.err;
+    EXPECT_TRUE(contains(r.err, "unsupported integrator type 'stokes'")) << r.err;
 }
 
 }  // namespace

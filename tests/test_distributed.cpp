@@ -424,17 +424,20 @@ TEST_F(Distributed, PlainBinaryRunsWithoutMpirunAndForcedSingletonMpiToo) {
 }
 
 TEST_F(Distributed, TwoRanksOfOneThreadEqualOneProcessOfTwoThreadsForEveryIntegrator) {
-    // One scene file per integrator (the course's scene 3 with its <integrator>), all rendered by
-    // one command: one mpirun start instead of one per integrator.
-    const std::vector<std::string> algorithms = {"pt-mis", "lt", "bdpt", "sppm", "ppm", "pm", "vcm", "bpm", "ic"};
+    // One scene file per integrator (the course's scene 3 with its <integrator>; volpath: scene 2
+    // in fog, whose file names volpath), all rendered by one command: one mpirun start instead of
+    // one per integrator.
+    const std::vector<std::string> algorithms = {"pt-mis", "lt", "bdpt", "sppm", "ppm", "pm", "vcm", "bpm", "ic", "volpath"};
     fs::create_directory_symlink(fs::path(PATHLAB_SOURCE_DIR) / "scenes/meshes", dir_ / "meshes");
     const std::string scene = file_bytes(std::string(PATHLAB_SOURCE_DIR) + "/scenes/3-ceiling-glossy.xml");
     const std::string open = "<scene version=\"3.0.0\">";
     ASSERT_NE(scene.find(open), std::string::npos);
     std::string list;
+    const std::string fog = file_bytes(std::string(PATHLAB_SOURCE_DIR) + "/scenes/fog-ceiling.xml");
+    ASSERT_NE(fog.find("<integrator type=\"volpath\"/>"), std::string::npos);
     for (const std::string& a : algorithms) {
-        std::string text = scene;
-        text.insert(text.find(open) + open.size(), "<integrator type=\"" + a + "\"/>");
+        std::string text = a == "volpath" ? fog : scene;
+        if (a != "volpath") text.insert(text.find(open) + open.size(), "<integrator type=\"" + a + "\"/>");
         std::ofstream(path(a + ".xml")) << text;
         list += (list.empty() ? "" : ",") + path(a + ".xml");
     }

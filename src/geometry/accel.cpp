@@ -84,13 +84,13 @@ void sphere_occluded(const RTCOccludedFunctionNArguments* args) {
     if (intersect_sphere(s, o, d, ray->tnear, ray->tfar) >= 0) ray->tfar = -kInf;
 }
 
-RTCRay to_embree(const Ray& r) {
+RTCRay to_embree(const Ray& r, uint32_t mask) {
     RTCRay e{};
     e.org_x = r.o.x, e.org_y = r.o.y, e.org_z = r.o.z;
     e.dir_x = r.d.x, e.dir_y = r.d.y, e.dir_z = r.d.z;
     e.tnear = 0.0f;
     e.tfar = r.tmax;
-    e.mask = 0xffffffffu;
+    e.mask = mask;
     e.flags = 0;
     return e;
 }
@@ -164,6 +164,7 @@ uint32_t Accel::add_mesh(const MeshDesc& mesh) {
     auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
                                                                3 * sizeof(uint32_t), mesh.triangles.size()));
     std::memcpy(idx, mesh.triangles.data(), mesh.triangles.size() * 3 * sizeof(uint32_t));
+    rtcSetGeometryMask(geom, mesh.media.index_matched ? kMaskMediumBoundaries : kMaskSurfaces);
     rtcCommitGeometry(geom);
     const uint32_t id = rtcAttachGeometry(scene_, geom);
     rtcReleaseGeometry(geom);
@@ -179,6 +180,7 @@ uint32_t Accel::add_sphere(const SphereDesc& sphere) {
     rtcSetGeometryBoundsFunction(geom, sphere_bounds, nullptr);
     rtcSetGeometryIntersectFunction(geom, sphere_intersect);
     rtcSetGeometryOccludedFunction(geom, sphere_occluded);
+    rtcSetGeometryMask(geom, sphere.media.index_matched ? kMaskMediumBoundaries : kMaskSurfaces);
     rtcCommitGeometry(geom);
     const uint32_t id = rtcAttachGeometry(scene_, geom);
     rtcReleaseGeometry(geom);
@@ -190,11 +192,11 @@ void Accel::commit() {
     throw_on_device_error(device_, "build the scene");
 }
 
-bool Accel::intersect(const Ray& ray, RawHit& hit) const {
+bool Accel::intersect(const Ray& ray, RawHit& hit, uint32_t mask) const {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     RTCRayHit rh;
-    rh.ray = to_embree(ray);
+    rh.ray = to_embree(ray, mask);
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(scene_, &context, &rh);
@@ -203,10 +205,10 @@ bool Accel::intersect(const Ray& ray, RawHit& hit) const {
     return true;
 }
 
-bool Accel::occluded(const Ray& ray) const {
+bool Accel::occluded(const Ray& ray, uint32_t mask) const {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
-    RTCRay r = to_embree(ray);
+    RTCRay r = to_embree(ray, mask);
     rtcOccluded1(scene_, &context, &r);
     return r.tfar < 0;
 }

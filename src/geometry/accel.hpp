@@ -15,6 +15,14 @@ struct RTCSceneTy;
 
 namespace pathlab {
 
+// Which shapes a ray sees (Embree's ray and geometry masks): surfaces, and the index-matched
+// boundaries of media, which only the volumetric path tracer looks for.
+enum RayMask : uint32_t {
+    kMaskSurfaces = 1,
+    kMaskMediumBoundaries = 2,
+    kMaskAll = kMaskSurfaces | kMaskMediumBoundaries,
+};
+
 struct RawHit {
     float t;
     float u, v;  // barycentrics of vertices 1 and 2 (triangles)
@@ -30,7 +38,8 @@ public:
     Accel(const Accel&) = delete;
     Accel& operator=(const Accel&) = delete;
 
-    // Each returns the Embree geometry id.
+    // Each returns the Embree geometry id. An index-matched medium boundary gets the mask
+    // kMaskMediumBoundaries, every other shape kMaskSurfaces.
     uint32_t add_mesh(const MeshDesc& mesh);
     uint32_t add_sphere(const SphereDesc& sphere);
     // A group of meshes for instances (its own Embree scene, committed here); returns its index.
@@ -39,8 +48,8 @@ public:
     uint32_t add_instance(uint32_t group, const Transform& to_world);
     void commit();
 
-    bool intersect(const Ray& ray, RawHit& hit) const;
-    bool occluded(const Ray& ray) const;
+    bool intersect(const Ray& ray, RawHit& hit, uint32_t mask = kMaskSurfaces) const;
+    bool occluded(const Ray& ray, uint32_t mask = kMaskSurfaces) const;
 
     // The Embree scene itself, for benchmarks that measure Embree's raw throughput on it.
     RTCSceneTy* embree_scene() const { return scene_; }

@@ -12,6 +12,20 @@
 
 namespace pathlab {
 
+// The participating media on the two sides of a shape's surface (indices into the scene's
+// media, -1 for none), as Mitsuba's interior/exterior: interior is the side the geometric normal
+// points away from. A shape without media leaves the medium of a ray that crosses it as it
+// was. An index-matched boundary (Mitsuba's null BSDF) does not scatter at all: only volpath
+// sees it (as a change of medium); every other estimator's rays pass through it.
+struct MediumInterface {
+    int32_t interior = -1, exterior = -1;
+    bool index_matched = false;
+
+    bool changes_medium() const { return interior >= 0 || exterior >= 0; }
+    // The medium on the side of direction w (geometric normal ng).
+    int32_t medium_towards(const Vec3f& w, const Vec3f& ng) const { return dot(w, ng) > 0 ? exterior : interior; }
+};
+
 struct MeshDesc {
     std::string name;
     std::vector<Vec3f> positions;
@@ -20,6 +34,7 @@ struct MeshDesc {
     std::vector<std::array<uint32_t, 3>> triangles;
     uint32_t material = 0;
     Rgb emission{0.0f};  // radiance of a one-sided area emitter on the winding-normal side
+    MediumInterface media{};
 };
 
 struct SphereDesc {
@@ -28,6 +43,7 @@ struct SphereDesc {
     uint32_t material = 0;
     bool flip_normals = false;  // normals point inwards
     Rgb emission{0.0f};         // radiance of a one-sided area emitter on the normal side
+    MediumInterface media{};
 };
 
 // A shapegroup: meshes that instances place, each instance by its own transform (Embree

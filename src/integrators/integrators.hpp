@@ -23,5 +23,6 @@ const IntegratorInfo& ic_integrator();
 const IntegratorInfo& ppm_integrator();
 const IntegratorInfo& vcm_integrator();
 const IntegratorInfo& bpm_integrator();
+const IntegratorInfo& volpath_integrator();
 
 }  // namespace pathlab

@@ -49,6 +49,12 @@ public:
                 fixed_to_float(nested_uniform_scramble(sobol_dimension1(i), seed1))};
     }
 
+    // Another stream of the same sample, keyed by `stream` (same kind, its own dimensions):
+    // what an integrator draws there does not shift this stream's dimensions. volpath draws
+    // its free-flight distances there, so that a path through no medium uses exactly the
+    // numbers pt-mis uses. (Keyed by the sample index's low 32 bits.)
+    Sampler fork(uint64_t stream) const { return Sampler(pixel_hash_, stream, reverse_bits(reversed_index_), kind_); }
+
 private:
     uint64_t dimension_hash() { return mix64(pixel_hash_ + 0x9e3779b97f4a7c15ull * ++dimension_); }
     // nested_uniform_scramble(index, seed), with the index's bit reversal done once.

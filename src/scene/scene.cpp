@@ -41,6 +41,23 @@ void validate(const SceneDescription& d) {
         if (!is_finite(s.emission) || min_component(s.emission) < 0)
             throw SceneError(what + " has an invalid emitted radiance");
     }
+    const auto check_media = [&](const MediumInterface& mi, const std::string& what) {
+        for (int32_t m : {mi.interior, mi.exterior})
+            if (m < -1 || m >= int32_t(d.media.size()))
+                throw SceneError(fmt::format("{} refers to medium {}, but the scene has {} media", what, m, d.media.size()));
+    };
+    for (size_t i = 0; i < d.meshes.size(); ++i) {
+        check_media(d.meshes[i].media, fmt::format("mesh '{}'", d.meshes[i].name.empty() ? std::to_string(i) : d.meshes[i].name));
+        if (d.meshes[i].media.index_matched && !is_black(d.meshes[i].emission))
+            throw SceneError(fmt::format("mesh '{}' is an index-matched medium boundary and cannot emit", d.meshes[i].name));
+    }
+    for (size_t i = 0; i < d.spheres.size(); ++i) {
+        check_media(d.spheres[i].media, fmt::format("sphere {}", i));
+        if (d.spheres[i].media.index_matched && !is_black(d.spheres[i].emission))
+            throw SceneError(fmt::format("sphere {} is an index-matched medium boundary and cannot emit", i));
+    }
+    if (d.camera_medium < -1 || d.camera_medium >= int32_t(d.media.size()))
+        throw SceneError(fmt::format("the camera's medium {} is not one of the scene's {} media", d.camera_medium, d.media.size()));
     for (size_t g = 0; g < d.groups.size(); ++g)
         for (const MeshDesc& m : d.groups[g].meshes) {
             const std::string what = fmt::format("mesh '{}' of shapegroup '{}'", m.name, d.groups[g].name);
@@ -94,6 +111,7 @@ std::unique_ptr<Scene> Scene::build(const SceneDescription& desc) {
         }
         s->face_normals_.push_back(std::move(normals));
         GeometryRecord rec{false, uint32_t(i), -1, &s->desc_.meshes[i], s->face_normals_.back().data()};
+        if (m.media.changes_medium() || m.media.index_matched) rec.media = &s->desc_.meshes[i].media;
         if (!is_black(m.emission)) {
             rec.first_light = int32_t(s->lights_.size());
             for (const auto& t : m.triangles)
@@ -107,6 +125,7 @@ std::unique_ptr<Scene> Scene::build(const SceneDescription& desc) {
         const uint32_t id = s->accel_.add_sphere(sp);
         if (id >= s->geometry_.size()) s->geometry_.resize(id + 1);
         GeometryRecord rec{true, uint32_t(i), -1};
+        if (sp.media.changes_medium() || sp.media.index_matched) rec.media = &s->desc_.spheres[i].media;
         if (!is_black(sp.emission)) {
             rec.first_light = int32_t(s->lights_.size());
             s->lights_.emplace_back(SphereLight{sp.center, sp.radius, sp.flip_normals, sp.emission});
@@ -129,6 +148,8 @@ std::unique_ptr<Scene> Scene::build(const SceneDescription& desc) {
             }
     }
     s->accel_.commit();
+    s->has_media_ = desc.camera_medium >= 0;
+    for (const GeometryRecord& rec : s->geometry_) s->has_media_ = s->has_media_ || rec.media;
     if (lo.x <= hi.x) {
         s->center_ = (lo + hi) * 0.5f;
         s->radius_ = std::max(1e-3f, 0.5f * length(hi - lo));
@@ -146,15 +167,13 @@ bool Scene::has_hittable_emitters() const {
     return std::any_of(lights_.begin(), lights_.end(), [](const Light& l) { return !is_delta_light(l); });
 }
 
-bool Scene::intersect(const Ray& ray, Intersection& hit) const {
-    ++t_rays_traced;
-    RawHit raw;
-    if (!accel_.intersect(ray, raw)) return false;
+// The hit record of a raw hit (inlined into both intersect functions).
+[[gnu::always_inline]] inline void Scene::fill(const Ray& ray, const RawHit& raw, Intersection& hit) const {
     hit.t = raw.t;
     hit.uv = Vec2f(0.0f, 0.0f);
     if (raw.inst_id != RawHit::kNoInstance) [[unlikely]] {
         instance_hit(raw, hit);
-        return true;
+        return;
     }
     const GeometryRecord& rec = geometry_[raw.geom_id];
     if (rec.is_sphere) {
@@ -183,6 +202,22 @@ bool Scene::intersect(const Ray& ray, Intersection& hit) const {
         hit.material = m.material;
         hit.light = rec.first_light >= 0 ? rec.first_light + int32_t(raw.prim_id) : -1;
     }
+}
+
+bool Scene::intersect(const Ray& ray, Intersection& hit) const {
+    ++t_rays_traced;
+    RawHit raw;
+    if (!accel_.intersect(ray, raw)) return false;
+    fill(ray, raw, hit);
+    return true;
+}
+
+bool Scene::intersect(const Ray& ray, Intersection& hit, uint32_t mask, const MediumInterface*& media) const {
+    ++t_rays_traced;
+    RawHit raw;
+    if (!accel_.intersect(ray, raw, mask)) return false;
+    fill(ray, raw, hit);
+    media = raw.inst_id == RawHit::kNoInstance ? geometry_[raw.geom_id].media : nullptr;  // instances bound no media
     return true;
 }
 

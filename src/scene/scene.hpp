@@ -37,6 +37,10 @@ public:
 
     bool intersect(const Ray& ray, Intersection& hit) const;
     bool occluded(const Ray& ray) const;
+    // volpath's: the shapes `mask` lets through (accel.hpp: surfaces, index-matched medium
+    // boundaries), and `media`, the media on the two sides of the shape hit (null when it
+    // changes no medium). The functions above see surfaces only.
+    bool intersect(const Ray& ray, Intersection& hit, uint32_t mask, const MediumInterface*& media) const;
 
     const std::string& name() const { return name_; }
     const Camera& camera() const { return camera_; }
@@ -45,6 +49,11 @@ public:
     const SceneDescription& description() const { return desc_; }
 
     const Material& material(uint32_t index) const { return materials_[index]; }
+    // Participating media: only volpath renders them; the other estimators see a scene without.
+    const Medium& medium(int32_t index) const { return desc_.media[size_t(index)]; }
+    int32_t camera_medium() const { return desc_.camera_medium; }
+    // True when some shape changes the medium or the camera sits in one.
+    bool has_media() const { return has_media_; }
     const std::vector<Light>& lights() const { return lights_; }
     bool has_delta_lights() const;
     // True when a sampled direction can find emission (an area light or the environment).
@@ -72,12 +81,14 @@ public:
 
 private:
     Scene() = default;
+    void fill(const Ray& ray, const RawHit& raw, Intersection& hit) const;
     struct GeometryRecord {
         bool is_sphere = false;
         uint32_t index = 0;        // into desc_.meshes or desc_.spheres
         int32_t first_light = -1;  // area light of triangle k is first_light + k
         const MeshDesc* mesh = nullptr;       // triangles: the mesh, and its unit face normals
         const Vec3f* face_normals = nullptr;  // (computed once, not per hit)
+        const MediumInterface* media = nullptr;  // a shape's media, if it changes the medium
         int32_t instance = -1;                // an instance: its index in desc_.instances
     };
 
@@ -97,6 +108,7 @@ private:
     std::vector<Light> lights_;
     LightDistribution light_distribution_;
     int environment_ = -1;
+    bool has_media_ = false;
     Vec3f center_{0.0f};
     float radius_ = 1;
 };

@@ -11,6 +11,7 @@
 #include "core/reconstruction_filter.hpp"
 #include "geometry/shape.hpp"
 #include "lights/registry.hpp"
+#include "media/medium.hpp"
 
 namespace pathlab {
 
@@ -24,6 +25,10 @@ struct SceneDescription {
     std::vector<ShapeGroupDesc> groups;  // placed by instances
     std::vector<InstanceDesc> instances;
     std::vector<FreeLight> lights;
+    // Participating media (shapes refer to them by index, MediumInterface) and the one the
+    // camera sits in (-1: none).
+    std::vector<Medium> media;
+    int32_t camera_medium = -1;
     // Render settings a scene file may suggest; command-line options override them.
     std::optional<std::string> algorithm;
     std::optional<int> spp, max_depth, rr_depth;  // depths in pathlab's bounces

@@ -8,6 +8,7 @@
 #include "integrators/integrator.hpp"
 #include "lights/area.hpp"
 #include "lights/registry.hpp"
+#include "media/medium.hpp"
 #include "render/film.hpp"
 #include "samplers/sampler.hpp"
 #include "scenefile/readers.hpp"
@@ -38,7 +39,11 @@ std::vector<PluginInfo> all_plugins() {
     for (const ShapePlugin& s : shape_plugins()) out.push_back(s.info());
     for (const PluginInfo& s : group_shape_plugins()) out.push_back(s);
     for (const BsdfPlugin& b : bsdf_plugins()) out.push_back(b.info());
+    out.push_back(null_bsdf_plugin());
     for (const EmitterPlugin& e : emitter_plugins()) out.push_back(e.info());
+    for (const PluginInfo& (*media)() : {homogeneous_plugin, heterogeneous_plugin, isotropic_phase_plugin, hg_phase_plugin,
+                                         gridvolume_plugin, constvolume_plugin})
+        out.push_back(media());
     return out;
 }
 

@@ -36,6 +36,8 @@ Material read_bsdf_at(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b, 
     if (depth > kMaxNesting) xml.fail(n, fmt::format("BSDFs nested more than {} deep", kMaxNesting));
     if (std::string(n.name()) == "ref") {
         const NamedObject& o = b.resolve(xml, n, "bsdf");
+        if (o.value.type() == typeid(NullBsdf))
+            xml.fail(n, "a null BSDF is a shape's own BSDF (nested in it, or declared with an id); nothing wraps it");
         return b.desc.materials[std::any_cast<uint32_t>(o.value)];
     }
     xml.check_attributes(n, {"type", "id", "name"});
@@ -44,8 +46,8 @@ Material read_bsdf_at(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b, 
         xml.fail(n, fmt::format("unsupported bsdf type '{}': pathlab has no principled (Disney) model, so base_color, metallic, "
                                 "specular, roughness, spec_tint, anisotropic, sheen, clearcoat and spec_trans cannot be honoured; "
                                 "use roughplastic (a dielectric coat over a base colour) or roughconductor (metallic = 1)", type));
-    if (type == "null") xml.fail(n, "unsupported bsdf type 'null': it marks a medium's boundary, and pathlab has no participating media yet");
     const BsdfPlugin* plugin = find_bsdf_plugin(type);
+    if (type == null_bsdf_plugin().type) xml.fail(n, "a null BSDF is a shape's own BSDF (nested in it, or declared with an id); nothing wraps it");
     if (!plugin) xml.fail(n, fmt::format("unsupported bsdf type '{}'; supported: {}", type, bsdf_type_names()));
     if (!plugin->read) {  // a wrapper
         for (const pugi::xml_node& c : n.children())
@@ -125,6 +127,14 @@ Material read_bsdf(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b) { r
 
 void read_named_bsdf(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b) {
     const auto id = xml.optional_attr(n, "id");
+    if (xml.optional_attr(n, "type") == null_bsdf_plugin().type) {  // no material: a medium boundary
+        xml.check_attributes(n, {"type", "id"});
+        if (!xml.plugin_children(n).empty()) xml.fail(xml.plugin_children(n).front(), "a null BSDF has no nested plugins");
+        Properties p = xml.properties(n, null_bsdf_plugin());
+        reading([&] { return p.check_all_used(), 0; });
+        if (id) b.name(xml, n, *id, "bsdf", NullBsdf{});
+        return;
+    }
     if (id && b.named.count(*id)) b.name(xml, n, *id, "bsdf", uint32_t(0));  // names the earlier declaration
     const uint32_t index = b.add_material(read_bsdf(xml, n, b));
     if (id) b.name(xml, n, *id, "bsdf", index);

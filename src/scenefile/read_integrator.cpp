@@ -30,9 +30,6 @@ const char* const kAovKinds[] = {"depth", "position", "sh_normal", "geo_normal",
 void read_plain_integrator(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b) {
     xml.check_attributes(n, {"type", "id", "name"});
     const std::string type = xml.attr(n, "type");
-    if (type == "volpath" || type == "volpathmis" || type == "volpath_simple")
-        xml.fail(n, fmt::format("unsupported integrator type '{}': it renders participating media, which pathlab does not have yet; "
-                                "for surfaces alone use 'path'", type));
     const IntegratorInfo* info = find_integrator(type);
     if (!info)
         xml.fail(n, fmt::format("unsupported integrator type '{}'; supported: {}, and the wrappers moment and aov", type, integrator_names()));

@@ -1,5 +1,6 @@
 // <sensor type="perspective|thinlens|orthographic"> with its nested <film type="hdrfilm"> (and
-// its <rfilter>) and <sampler>.
+// its <rfilter>) and <sampler>, and the medium it sits in (a nested <medium>, or
+// <ref name="medium" id="..."/>).
 #include <cmath>
 
 #include <fmt/format.h>
@@ -223,9 +224,11 @@ void read_sensor(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b) {
         const std::string tag = c.name();
         if (tag == "film") read_film(xml, c, b);
         else if (tag == "sampler") read_sampler(xml, c, b);
-        else if (tag == "medium" || (tag == "ref" && std::string(c.attribute("name").value()) == "medium"))
-            xml.fail(c, "a sensor's medium needs participating media, which pathlab does not have yet");
-        else xml.fail(c, fmt::format("unsupported element <{}> in <sensor>; supported: <film>, <sampler>", tag));
+        else if (tag == "medium" || tag == "ref") {  // the medium the camera sits in
+            if (b.desc.camera_medium >= 0) xml.fail(c, "a sensor can be in only one medium");
+            if (tag == "ref") xml.check_attributes(c, {"id", "name"});
+            b.desc.camera_medium = tag == "medium" ? read_medium(xml, c, b) : medium_reference(xml, c, b);
+        } else xml.fail(c, fmt::format("unsupported element <{}> in <sensor>; supported: <film>, <sampler>, <medium>, <ref> (to a medium)", tag));
     }
 }
 

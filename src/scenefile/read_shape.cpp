@@ -1,6 +1,9 @@
 // <shape type>: a plugin of geometry/shape_plugins.hpp, with one <bsdf> or <ref id> (default:
-// one-sided diffuse 0.5) and optionally an <emitter type="area">; or a shapegroup (meshes
-// placed by instances, through Embree instancing) and its instances.
+// one-sided diffuse 0.5), optionally an <emitter type="area">, and the media on its two sides
+// (<medium name="interior|exterior"> or <ref name="interior|exterior" id>); or a shapegroup
+// (meshes placed by instances, through Embree instancing) and its instances. A null BSDF, or
+// media without any BSDF (as Mitsuba 0.6 read it; Mitsuba 3 would give such a shape its default
+// diffuse BSDF), makes the shape an index-matched boundary between its media.
 #include <fmt/format.h>
 
 #include "lights/area.hpp"
@@ -83,28 +86,57 @@ void read_shape_into(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b, s
     }
 
     std::optional<uint32_t> material;
+    bool null_bsdf = false;
+    MediumInterface media;
     Rgb emission(0.0f);
     bool emitter = false;
+    // A medium on one side: name="interior" or "exterior".
+    const auto medium_side = [&](const pugi::xml_node& c) -> int32_t& {
+        const std::string side = xml.attr(c, "name");
+        if (side != "interior" && side != "exterior")
+            xml.fail(c, fmt::format("a shape's medium is named interior or exterior, not '{}'", side));
+        int32_t& slot = side == "interior" ? media.interior : media.exterior;
+        if (slot >= 0) xml.fail(c, fmt::format("the shape already has an {} medium", side));
+        return slot;
+    };
     for (const pugi::xml_node& c : xml.plugin_children(n)) {
         const std::string tag = c.name();
         const std::string ref_name = tag == "ref" ? std::string(c.attribute("name").value()) : "";
-        if (ref_name == "interior" || ref_name == "exterior" || tag == "medium")
-            xml.fail(c, "a shape's interior/exterior medium needs participating media, which pathlab does not have yet");
-        if (tag == "ref") {
+        if (tag == "medium") {
+            int32_t& slot = medium_side(c);
+            slot = read_medium(xml, c, b);
+        } else if (ref_name == "interior" || ref_name == "exterior") {
+            int32_t& slot = medium_side(c);
+            slot = medium_reference(xml, c, b);
+        } else if (tag == "ref") {
             // A <ref> names its kind by what it refers to (a bsdf, an emitter, ...).
             xml.check_attributes(c, {"id", "name"});
             const std::string id = xml.attr(c, "id");
             const auto it = b.named.find(id);
             if (it == b.named.end()) xml.fail(c, fmt::format("no <bsdf> with id '{}' is declared before this reference", id));
+            if (it->second.kind == "medium")
+                xml.fail(c, fmt::format("'{}' is a medium: refer to it with name=\"interior\" or name=\"exterior\"", id));
             if (it->second.kind != "bsdf")
                 xml.fail(c, fmt::format("'{}' is a <{}>; a shape refers to a <bsdf> (its emitter is nested: <emitter type=\"area\">)", id,
                                         it->second.kind));
-            if (material) xml.fail(c, "a shape can have only one BSDF");
-            material = std::any_cast<uint32_t>(it->second.value);
+            if (material || null_bsdf) xml.fail(c, "a shape can have only one BSDF");
+            if (it->second.value.type() == typeid(NullBsdf))
+                null_bsdf = true;
+            else
+                material = std::any_cast<uint32_t>(it->second.value);
         } else if (tag == "bsdf") {
-            if (material) xml.fail(c, "a shape can have only one BSDF");
-            material = b.add_material(read_bsdf(xml, c, b));
-            if (const auto id = xml.optional_attr(c, "id")) b.name(xml, c, *id, "bsdf", *material);
+            if (material || null_bsdf) xml.fail(c, "a shape can have only one BSDF");
+            if (xml.optional_attr(c, "type") == null_bsdf_plugin().type) {
+                xml.check_attributes(c, {"type", "name", "id"});
+                if (!xml.plugin_children(c).empty()) xml.fail(xml.plugin_children(c).front(), "a null BSDF has no nested plugins");
+                Properties np = xml.properties(c, null_bsdf_plugin());
+                reading([&] { return np.check_all_used(), 0; });
+                null_bsdf = true;
+                if (const auto id = xml.optional_attr(c, "id")) b.name(xml, c, *id, "bsdf", NullBsdf{});
+            } else {
+                material = b.add_material(read_bsdf(xml, c, b));
+                if (const auto id = xml.optional_attr(c, "id")) b.name(xml, c, *id, "bsdf", *material);
+            }
         } else if (tag == "emitter") {
             xml.check_attributes(c, {"type", "id", "name"});
             const std::string etype = xml.attr(c, "type");
@@ -119,9 +151,11 @@ void read_shape_into(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b, s
             });
             emitter = true;
         } else {
-            xml.fail(c, fmt::format("unsupported element <{}> in <shape>; supported: <bsdf>, <ref>, <emitter>", tag));
+            xml.fail(c, fmt::format("unsupported element <{}> in <shape>; supported: <bsdf>, <ref>, <emitter>, <medium>", tag));
         }
     }
+    media.index_matched = null_bsdf || (!material && !emitter && media.changes_medium());
+    if (media.index_matched && emitter) xml.fail(n, "a shape with a null BSDF cannot emit light in pathlab (give it a BSDF)");
     if (!material) {
         if (!b.default_material) {
             Material m = make_phong(Rgb(0.5f));
@@ -141,12 +175,14 @@ void read_shape_into(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b, s
     });
     if (group) {
         if (emitter) xml.fail(n, "a shape in a shapegroup cannot emit light (pathlab samples emitters one by one)");
+        if (media.changes_medium() || media.index_matched) xml.fail(n, "a shape in a shapegroup cannot bound media (place it on its own)");
         if (std::holds_alternative<SphereDesc>(shape))
             xml.fail(n, "an exact sphere cannot be in a shapegroup; place spheres one by one, or use a sphere mesh (obj, ply)");
     }
     if (auto* sphere = std::get_if<SphereDesc>(&shape)) {
         sphere->material = *material;
         sphere->emission = emission;
+        sphere->media = media;
         b.desc.spheres.push_back(*sphere);
         return;
     }
@@ -155,6 +191,7 @@ void read_shape_into(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b, s
     if (const auto id = xml.optional_attr(n, "id")) m.name = *id;
     m.material = *material;
     m.emission = emission;
+    m.media = media;
     (group ? *group : b.desc.meshes).push_back(std::move(m));
 }
 

@@ -6,6 +6,7 @@
 #include <any>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 
 #include "geometry/shape_plugins.hpp"
@@ -22,6 +23,11 @@ struct NamedObject {
     SourceLocation where;
     std::any value;
 };
+
+// The value of a <bsdf type="null" id="..."> in SceneBuilder::named (kind "bsdf"): no material,
+// only the mark that makes a shape an index-matched boundary between its media. Named media are
+// kind "medium" with their int32_t index into desc.media.
+struct NullBsdf {};
 
 // What the readers build up while a file is read.
 struct SceneBuilder {
@@ -55,5 +61,11 @@ void read_named_bsdf(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b);
 void read_shape(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b);       // read_shape.cpp
 std::vector<PluginInfo> group_shape_plugins();  // shapegroup, instance
 void read_free_emitter(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b);  // read_emitter.cpp
+// read_medium.cpp: a <medium> (its index in desc.media), one declared at the top level, the
+// medium a <ref id> names, and the null BSDF's declaration.
+int32_t read_medium(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b);
+void read_named_medium(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b);
+int32_t medium_reference(XmlSource& xml, const pugi::xml_node& ref, const SceneBuilder& b);
+const PluginInfo& null_bsdf_plugin();
 
 }  // namespace pathlab

@@ -112,10 +112,10 @@ void Loader::read_children(XmlSource& xml, const pugi::xml_node& scene) {
         else if (tag == "texture")
             xml.fail(n, "<texture> needs textures, which pathlab does not have yet; use constant values (<rgb>, <float>)");
         else if (tag == "medium")
-            xml.fail(n, "<medium> needs participating media, which pathlab does not have yet");
+            read_named_medium(xml, n, b);
         else
             xml.fail(n, fmt::format("unsupported element <{}> in <scene>; supported: <default>, <path>, <include>, <alias>, "
-                                    "<integrator>, <sensor>, <bsdf>, <shape>, <emitter>", tag));
+                                    "<integrator>, <sensor>, <bsdf>, <shape>, <emitter>, <medium>", tag));
     }
 }
 

@@ -17,14 +17,22 @@ struct SceneChoice {
     std::optional<int> builtin;  // the course index of a built-in scene
     std::string file;            // the scene file, if any
     SceneDescription description;
+    SceneParameters parameters;  // a scene file's $name parameters, with the values they took
+    std::string hash;            // a scene file's identity (scene_file_hash); empty for a built-in scene
 };
+
+// A scene file's identity for reference manifests: FNV-1a (64 bits, hex) of the file's bytes
+// followed by each parameter's "name=value" line, so that the same file with another -D value
+// is another scene.
+std::string scene_file_hash(const std::string& path, const SceneParameters& parameters);
 
 // True for a key that names a scene file (ends in .xml).
 bool looks_like_scene_file(const std::string& key);
 
 // "3", "ceiling-glossy", "ws_c_sdsgwdwg", "scenes/x.xml", "all" or a comma-separated list of
 // them. Unknown names and malformed scene files (file:line:column) are UsageErrors; scene files
-// are refused with a UsageError unless `allow_files`.
+// are refused with a UsageError unless `allow_files`. A define that no scene of the list uses
+// (no $name) is a UsageError listing the parameters the scenes have.
 std::vector<SceneChoice> resolve_scenes(const std::string& spec, const SceneDefines& defines = {}, bool allow_files = true);
 SceneChoice builtin_scene_choice(int index);
 // A scene made by the caller (tests, benchmarks): named after desc.name.

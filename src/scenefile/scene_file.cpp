@@ -21,7 +21,7 @@ SceneFileError::SceneFileError(std::string file_, int line_, int column_, const 
       message(message_) {}
 
 SceneDescription load_scene_text(const std::string& text, const std::string& file_name, const std::string& base_dir,
-                                 const SceneDefines& defines, bool allow_files) {
+                                 const SceneDefines& defines, bool allow_files, SceneParameters* used) {
     XmlSource xml(text, file_name, defines);
     const pugi::xml_node scene = xml.root();
     if (std::string(scene.name()) != "scene") xml.fail(scene, fmt::format("the root element must be <scene>, not <{}>", scene.name()));
@@ -45,10 +45,11 @@ SceneDescription load_scene_text(const std::string& text, const std::string& fil
                                      "<bsdf>, <shape>, <emitter>", tag));
     }
     if (b.desc.meshes.empty() && b.desc.spheres.empty()) xml.fail_file("the scene has no shapes");
+    if (used) *used = xml.used_parameters();
     return std::move(b.desc);
 }
 
-SceneDescription load_scene_file(const std::string& path, const SceneDefines& defines) {
+SceneDescription load_scene_file(const std::string& path, const SceneDefines& defines, SceneParameters* used) {
     std::error_code ec;
     if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
         throw SceneFileError(path, 0, 0, "not a regular file");
@@ -57,7 +58,7 @@ SceneDescription load_scene_file(const std::string& path, const SceneDefines& de
     std::ostringstream text;
     text << in.rdbuf();
     const std::filesystem::path p(path);
-    return load_scene_text(text.str(), path, p.has_parent_path() ? p.parent_path().string() : ".", defines);
+    return load_scene_text(text.str(), path, p.has_parent_path() ? p.parent_path().string() : ".", defines, true, used);
 }
 
 }  // namespace pathlab

@@ -35,13 +35,16 @@ struct SceneFileError : std::runtime_error {
 // Values for $name substitution: command-line -D name=value pairs; a <default> in the file
 // applies only to names not given here.
 using SceneDefines = std::map<std::string, std::string>;
+// The $name parameters a scene file uses, each with the value it took (-D, else <default>).
+using SceneParameters = std::map<std::string, std::string>;
 
-// Loads a scene file; relative mesh paths are resolved against the file's directory.
-SceneDescription load_scene_file(const std::string& path, const SceneDefines& defines = {});
+// Loads a scene file; relative mesh paths are resolved against the file's directory. `used`,
+// if given, receives the $name parameters the file uses.
+SceneDescription load_scene_file(const std::string& path, const SceneDefines& defines = {}, SceneParameters* used = nullptr);
 
 // Loads a scene from text (`file_name` is used in messages). With allow_files = false, shapes
 // that read files (obj) are an error: the fuzzer uses this.
 SceneDescription load_scene_text(const std::string& text, const std::string& file_name, const std::string& base_dir,
-                                 const SceneDefines& defines = {}, bool allow_files = true);
+                                 const SceneDefines& defines = {}, bool allow_files = true, SceneParameters* used = nullptr);
 
 }  // namespace pathlab

@@ -75,6 +75,7 @@ std::string XmlSource::substitute(const pugi::xml_node& n, const std::string& va
             fail(n, fmt::format("undefined parameter ${} (define it with <default name=\"{}\" value=\"...\"/> or -D {}=...)", name,
                                 name, name));
         out += it->second;
+        used_[name] = it->second;
         i = j;
     }
     return out;

@@ -35,6 +35,8 @@ public:
     std::optional<std::string> optional_attr(const pugi::xml_node& n, const char* name) const;
     // <default name value>: a value for $name (command-line -D values win).
     void define(const pugi::xml_node& n);
+    // The $name parameters substituted so far, with their values.
+    const SceneParameters& used_parameters() const { return used_; }
 
     // ---- values ----------------------------------------------------------------------------
     float parse_float(const pugi::xml_node& n, const std::string& s) const;
@@ -57,6 +59,7 @@ private:
     const std::string& text_;
     std::string file_;
     SceneDefines defines_;
+    mutable SceneParameters used_;
     std::vector<size_t> line_starts_;
     pugi::xml_document doc_;
 };

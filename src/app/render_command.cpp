@@ -51,13 +51,11 @@ void write_stats(const std::string& path, RenderJob& job, const RenderResult& r,
 }  // namespace
 
 void add_render_options(CLI::App& app, RenderCommandOptions& o) {
-    app.add_option("-s,--scene", o.scene,
-                   "Scene: course index 0-7, name (see `pathlab scenes`), a scene file (.xml), a comma-separated list, or 'all'")
-        ->capture_default_str();
+    add_scene_arguments(app, o.scenes);
     app.add_option_function<std::string>(
         "-a,--algorithm", [&o](const std::string& v) { o.algorithm = v, o.algorithm_given = true; },
-        "Estimator name or course alias (see `pathlab algorithms`); default: the scene file's integrator, else pt-mis");
-    app.add_option("-D,--define", o.defines, "name=value for $name in scene files (repeatable; overrides <default>)");
+        "Estimator name or course alias (see `pathlab algorithms`), or a comma-separated list; default: the scene file's "
+        "integrator, else pt-mis");
     app.add_option_function<int>("--spp", [&o](const int& v) { o.spp = v, o.spp_given = true; },
                                  fmt::format("Samples per pixel (default {}, or unlimited with --time)", kDefaultSpp));
     app.add_option("--time", o.time_limit, "Time budget in seconds per scene (stops at --spp if that comes first)");
@@ -98,16 +96,9 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
 }
 
 int run_render_command(const RenderCommandOptions& o) {
-    if (o.algorithm_given) integrator_or_usage_error(o.algorithm);
-    SceneDefines defines;
-    for (const std::string& d : o.defines) {
-        const size_t eq = d.find('=');
-        if (eq == std::string::npos || eq == 0)
-            throw UsageError(fmt::format("invalid -D '{}': expected name=value", d));
-        defines[d.substr(0, eq)] = d.substr(eq + 1);
-    }
+    std::vector<const IntegratorInfo*> algorithms;
+    if (o.algorithm_given) algorithms = parse_algorithm_list(o.algorithm);
     JobRequest request;
-    if (o.algorithm_given) request.algorithm = o.algorithm;
     if (o.spp_given) {
         if (o.spp <= 0) throw UsageError(fmt::format("--spp must be a positive number of samples, got {}", o.spp));
         request.spp = uint64_t(o.spp);
@@ -141,7 +132,16 @@ int run_render_command(const RenderCommandOptions& o) {
     if (o.no_merging && o.no_connections) throw UsageError("--no-merging and --no-connections together leave vcm no strategy");
 
     std::vector<RenderJob> jobs;
-    for (SceneChoice& choice : resolve_scenes(o.scene, defines)) jobs.emplace_back(std::move(choice), request);
+    for (SceneChoice& choice : resolve_scene_arguments(o.scenes)) {
+        if (algorithms.empty()) {
+            jobs.emplace_back(std::move(choice), request);
+            continue;
+        }
+        for (const IntegratorInfo* info : algorithms) {
+            request.algorithm = info->name;
+            jobs.emplace_back(choice, request);
+        }
+    }
 
     std::vector<std::string> patterns(o.outputs.begin(), o.outputs.end());
     if (patterns.empty()) patterns.assign(std::begin(kDefaultOutputs), std::end(kDefaultOutputs));
@@ -154,8 +154,9 @@ int run_render_command(const RenderCommandOptions& o) {
         for (size_t k = 0; k < j; ++k)
             for (const std::string& path : jobs[j].outputs)
                 if (std::find(jobs[k].outputs.begin(), jobs[k].outputs.end(), path) != jobs[k].outputs.end())
-                    throw UsageError(fmt::format("scenes {} and {} would both write {}: add {{scene}} or {{index}} to -o",
-                                                 jobs[k].scene_choice().name, jobs[j].scene_choice().name, path));
+                    throw UsageError(fmt::format("{} / {} and {} / {} would both write {}: add {{scene}}, {{index}} or {{algorithm}} to -o",
+                                                 jobs[k].scene_choice().name, jobs[k].integrator_info().name,
+                                                 jobs[j].scene_choice().name, jobs[j].integrator_info().name, path));
         for (const std::string& path : jobs[j].outputs) paths.output(path, "the output", /*image=*/true);
         if (!o.stats_path.empty()) paths.output(jobs[j].expand(o.stats_path), "--stats", /*image=*/false);
         const std::string& algorithm = jobs[j].integrator_info().name;
@@ -205,7 +206,8 @@ int run_render_command(const RenderCommandOptions& o) {
         RenderJob& job = jobs[j];
         job.settings.progress = show_progress;
         job.settings.cancel = &InterruptGuard::flag();
-        const std::string& name = job.scene_choice().name;
+        const std::string name =
+            job.scene_choice().name + (algorithms.size() > 1 ? " / " + job.integrator_info().name : std::string());
         if (show_progress) fmt::print(stderr, "{} / {}\n", name, job.integrator_info().name);
         RenderResult result;
         try {
@@ -232,11 +234,11 @@ int run_render_command(const RenderCommandOptions& o) {
                        }(), ", ")),
                        fmt::join(job.outputs, ", "));
         if (s.interrupted) {
-            if (j + 1 < jobs.size()) fmt::print(stderr, "pathlab: interrupted; {} scene(s) not rendered\n", jobs.size() - j - 1);
+            if (j + 1 < jobs.size()) fmt::print(stderr, "pathlab: interrupted; {} render(s) not done\n", jobs.size() - j - 1);
             return interrupted_exit_code();
         }
     }
-    if (failed && jobs.size() > 1) fmt::print(stderr, "pathlab: {} of {} scenes failed\n", failed, jobs.size());
+    if (failed && jobs.size() > 1) fmt::print(stderr, "pathlab: {} of {} renders failed\n", failed, jobs.size());
     return failed ? 1 : 0;
 }
 

@@ -2,7 +2,8 @@
 # Installs every Debian package pathlab needs to build and test.
 # Usage: scripts/install-deps.sh
 # Chromium is installed for the test that opens `pathlab report`'s HTML in a headless browser
-# (the test is skipped where /usr/bin/chromium is absent).
+# (the test is skipped where /usr/bin/chromium is absent). pybind11, NumPy, pytest and
+# matplotlib are for the Python module (python/), its tests and the example in examples/.
 set -euo pipefail
 
 packages=(
@@ -10,6 +11,7 @@ packages=(
   libembree-dev libtbb-dev libopenexr-dev libstb-dev
   libcli11-dev libfmt-dev nlohmann-json3-dev libpugixml-dev libtinyobjloader-dev libnanoflann-dev
   libgtest-dev libbenchmark-dev
+  pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib
   chromium
 )
 

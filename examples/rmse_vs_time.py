@@ -17,6 +17,7 @@ import matplotlib
 
 matplotlib.use("Agg")  # no display needed
 import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.ticker  # noqa: E402
 
 import pathlab  # noqa: E402
 
@@ -45,6 +46,7 @@ def main():
         if args.images:
             os.makedirs(args.images, exist_ok=True)
             pathlab.write(os.path.join(args.images, f"{name}-reference.exr"), reference)
+        first_points, last_times = [], []
         for algorithm in algorithms:
             seconds, errors = [], []
             for budget in budgets:
@@ -54,11 +56,18 @@ def main():
                 errors.append(pathlab.rmse(img, reference, reference_se))
             print(f"  {algorithm:8s} RMSE " + " ".join(f"{e:.4f}" for e in errors), flush=True)
             ax.loglog(seconds, errors, marker="o", label=algorithm)
+            first_points.append((seconds[0], errors[0]))
+            last_times.append(seconds[-1])
             if args.images:
                 pathlab.write(os.path.join(args.images, f"{name}-{algorithm}.exr"), img)
-        # The Monte Carlo rate, error ~ time^-1/2, through the last estimator's first point.
-        t0, e0 = seconds[0], errors[0]
-        ax.loglog([t0, t0 * 16], [e0 * 1.5, e0 * 1.5 / 4], "k--", linewidth=0.8, label="slope −1/2")
+        # The Monte Carlo rate, error ~ time^-1/2, under the curves: from the lowest first point.
+        t0, e0 = min(first_points, key=lambda p: p[1])
+        t1 = max(last_times)
+        ax.loglog([t0, t1], [e0 / 1.6, e0 / 1.6 * (t0 / t1) ** 0.5], "k--", linewidth=0.8, label="slope −1/2")
+        for axis in (ax.xaxis, ax.yaxis):  # ticks at 1, 2, 5 x 10^k as plain numbers (0.05, 0.1, 0.2)
+            axis.set_major_locator(matplotlib.ticker.LogLocator(subs=(1, 2, 5)))
+            axis.set_major_formatter(matplotlib.ticker.FormatStrFormatter("%g"))
+            axis.set_minor_formatter(matplotlib.ticker.NullFormatter())
         ax.set_title(f"scene {scene.index} {name}, {width}x{height}")
         ax.set_xlabel("render time (s)")
         ax.set_ylabel("RMSE against the reference")

@@ -76,7 +76,7 @@ void add_scene_arguments(CLI::App& app, SceneArguments& a) {
                    "(also comma-separated)");
     app.add_option("-s,--scene", a.option,
                    "The same as an option: course index, name, scene file (.xml), a comma-separated list, or 'all'");
-    app.add_option("-D,--define", a.defines, "name=value for $name in scene files (repeatable; overrides <default>)");
+    app.add_option("-D,--define", a.defines, "name=value for $name in scene files (repeatable; overrides <default>; a name no scene uses is an error)");
 }
 
 std::string scene_spec(const SceneArguments& a) {

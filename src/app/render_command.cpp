@@ -208,7 +208,7 @@ int run_render_command(const RenderCommandOptions& o) {
         job.settings.cancel = &InterruptGuard::flag();
         const std::string name =
             job.scene_choice().name + (algorithms.size() > 1 ? " / " + job.integrator_info().name : std::string());
-        if (show_progress) fmt::print(stderr, "{} / {}\n", name, job.integrator_info().name);
+        if (show_progress) fmt::print(stderr, "{} / {}\n", job.scene_choice().name, job.integrator_info().name);
         RenderResult result;
         try {
             result = job.run();

@@ -5,8 +5,11 @@ Rules the documents follow (this test enforces them):
   - a fenced block marked ```sh (or bash, shell) is run, command by command, in document order;
     lines ending in a backslash continue the command; `#` comments are the shell's;
   - a fenced block marked ```python is run as one script, with the module on PYTHONPATH;
-  - ```sh no-test marks a block that is shown but not run (installing packages, the whole test
-    suite, benchmarks of many minutes); the test lists them, so none hides;
+  - ```sh no-test: REASON marks a block that is shown but not run, and says why (installing
+    packages, a cluster that mpirun needs); the test prints each with its reason, so none hides,
+    and a no-test without a reason fails;
+  - mpirun runs on this machine (as root if need be, ranks oversubscribed on its cores), so
+    the documents' one-machine mpirun examples are run like any other command;
   - a fenced block of another kind must not hold pathlab commands (mark it sh).
 
 Each document runs in a fresh directory that looks like the repository (build/, scenes/,
@@ -34,7 +37,18 @@ RUN_INFO = {"sh", "bash", "shell"}
 # Every render at most 2 samples per pixel, 0.1 s and 128 pixels on its longer side.
 CAPS = {"PATHLAB_SPP_CAP": "2", "PATHLAB_TIME_CAP": "0.1", "PATHLAB_RESOLUTION_CAP": "128"}
 VERDICT_COMMANDS = re.compile(r"(^|\s)(build/)?pathlab\s+(compare|check)\s")
-PATHLAB_LINE = re.compile(r"^\s*(build/pathlab\s|pathlab\s|PYTHONPATH=\S+\s+python3\s|make\s)")
+PATHLAB_LINE = re.compile(r"^\s*(build/pathlab\s|pathlab\s|PYTHONPATH=\S+\s+python3\s|make\s|mpirun\s)")
+# mpirun on one machine: as root (CI and containers run as root), more ranks than cores.
+MPI_ENV = {"OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1", "OMPI_MCA_rmaps_base_oversubscribe": "1"}
+
+
+def no_test_reason(info):
+    """None for a block that runs; else the reason after `no-test` ("" when none is given)."""
+    words = info.split(None, 1)
+    rest = words[1].strip() if len(words) > 1 else ""
+    if not rest.startswith("no-test"):
+        return None
+    return rest[len("no-test"):].lstrip(" :").strip()
 
 
 def blocks(text):
@@ -112,12 +126,19 @@ def main():
         with tempfile.TemporaryDirectory(prefix="pathlab-docs-") as t:
             tmp = pathlib.Path(t)
             root, bindir = make_root(tmp, source, build, shared, args.python)
-            env = dict(os.environ, PATH=f"{bindir}:{os.environ.get('PATH', '')}", **CAPS)
+            env = dict(os.environ, PATH=f"{bindir}:{os.environ.get('PATH', '')}", **CAPS, **MPI_ENV)
             env.pop("PYTHONPATH", None)
             for start, info, lines in blocks(doc.read_text()):
                 words = info.split()
                 kind = words[0] if words else ""
-                if kind == "python" and "no-test" not in words[1:]:
+                reason = no_test_reason(info)
+                if reason == "":
+                    failures.append(f"{rel}:{start}: a no-test block must say why it is not run (```{kind} no-test: REASON)")
+                    continue
+                if reason is not None and kind in RUN_INFO | {"python"}:
+                    skipped.append(f"{rel}:{start} ({reason})")
+                    continue
+                if kind == "python":
                     script = tmp / f"block-{start}.py"
                     script.write_text("\n".join(lines) + "\n")
                     try:
@@ -130,18 +151,12 @@ def main():
                     if r.returncode != 0:
                         failures.append(f"{rel}:{start}: the python block exited with {r.returncode}\n{r.stdout[-2000:]}{r.stderr[-2000:]}")
                     continue
-                if kind == "python":
-                    skipped.append(f"{rel}:{start}")
-                    continue
                 if kind not in RUN_INFO:
                     for line in lines:
                         if PATHLAB_LINE.match(line):
                             failures.append(f"{rel}:{start}: a ```{info} block holds the command '{line.strip()}': mark the block sh "
                                             "(run by this test) or sh no-test")
                             break
-                    continue
-                if "no-test" in words[1:]:
-                    skipped.append(f"{rel}:{start}")
                     continue
                 for command in commands(lines):
                     if "../shared" in command and not shared.exists():
@@ -169,7 +184,9 @@ def main():
         if r.returncode != 0 or len(made) != 16:
             failures.append(f"make render: exit code {r.returncode}, {len(made)} of 16 pictures\n{r.stdout[-2000:]}{r.stderr[-2000:]}")
 
-    print(f"\n{ran} commands in {time.monotonic() - total_start:.1f} s; not run (marked no-test): {', '.join(skipped) or 'none'}")
+    print(f"\n{ran} commands in {time.monotonic() - total_start:.1f} s; not run (marked no-test):")
+    for s in skipped:
+        print(f"  {s}")
     if failures:
         print(f"\n{len(failures)} failed:\n" + "\n\n".join(failures))
         return 1

@@ -212,7 +212,7 @@ TEST_F(Lab, AReferenceOfAnotherSceneSizeOrFamilyIsRefused) {
     std::ofstream(scene_file, std::ios::app) << "<!-- edited -->\n";
     r = run({"report", scene_file, "-a", "3", "--spp", "2", "--reference", path("refs/ball.exr"), "-q", "-o", path("r.html")});
     EXPECT_EQ(r.code, 2);
-    EXPECT_TRUE(contains(r.err, "the file has changed since")) << r.err;
+    EXPECT_TRUE(contains(r.err, "it or a file it reads has changed since")) << r.err;
     // The fitting ones are accepted.
     r = run({"check", "2", "-a", "1", "--references", path("refs"), "--spp", "4"});
     EXPECT_EQ(r.code, 0) << r.out << r.err;
@@ -224,6 +224,48 @@ TEST_F(Lab, AReferenceOfAnotherSceneSizeOrFamilyIsRefused) {
     r = run({"report", "3", "-a", "3", "--spp", "2", "--reference", path("own_files/reference.exr"), "-q", "-o", path("again.html")});
     EXPECT_EQ(r.code, 2);
     EXPECT_TRUE(contains(r.err, "not of scene 3")) << r.err;
+}
+
+// One scene hash for everything: the manifest's equals the render's EXR header (pathlab:sceneHash),
+// and it changes with a file the scene only includes or a mesh it reads.
+TEST_F(Lab, TheSceneHashCoversIncludedFilesAndMeshesAndIsTheRendersOwn) {
+    fs::create_directories(path("parts"));
+    std::ofstream(path("parts/light.xml")) << "<scene version=\"3.0.0\"><emitter type=\"constant\"/></scene>\n";
+    std::ofstream(path("parts/tri.obj")) << "v 0 0 0\nv 1 0 0\nv 0 0 1\nf 1 2 3\n";
+    std::ofstream(path("inc.xml")) << "<scene version=\"3.0.0\">\n"
+                                      "  <sensor type=\"perspective\"><transform name=\"to_world\"><lookat origin=\"0,-3,0\" target=\"0,0,0\" up=\"0,0,1\"/></transform>\n"
+                                      "    <film type=\"hdrfilm\"><integer name=\"width\" value=\"8\"/><integer name=\"height\" value=\"6\"/></film></sensor>\n"
+                                      "  <include filename=\"parts/light.xml\"/>\n"
+                                      "  <shape type=\"obj\"><string name=\"filename\" value=\"parts/tri.obj\"/></shape>\n"
+                                      "</scene>\n";
+    CliResult r = run({"reference", path("inc.xml"), "-a", "direct-mis", "--out", path("refs"), "--spp", "4", "-q"});
+    ASSERT_EQ(r.code, 0) << r.err;
+    const auto manifest = nlohmann::json::parse(std::ifstream(path("refs/manifest.json")));
+    const std::string hash = manifest["scenes"][0]["scene_hash"].get<std::string>();
+    ASSERT_EQ(hash.size(), 16u);
+    r = run({path("inc.xml"), "-a", "direct-mis", "--spp", "2", "-q", "-o", path("inc.exr")});
+    ASSERT_EQ(r.code, 0) << r.err;
+    ExrExtras extras;
+    read_exr(path("inc.exr"), extras);
+    std::string header_hash;
+    for (const auto& [k, v] : extras.attributes)
+        if (k == "pathlab:sceneHash") header_hash = v;
+    EXPECT_EQ(header_hash, hash);
+    // The reference fits as long as nothing the scene reads changes...
+    r = run({"check", path("inc.xml"), "-a", "3", "--references", path("refs"), "--spp", "2"});
+    EXPECT_NE(r.code, 2) << r.err;
+    // ... then an edit of the included file, and of the mesh, makes it another scene.
+    std::ofstream(path("parts/light.xml")) << "<scene version=\"3.0.0\"><emitter type=\"constant\"><rgb name=\"radiance\" value=\"2\"/></emitter></scene>\n";
+    r = run({"check", path("inc.xml"), "-a", "3", "--references", path("refs"), "--spp", "2"});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_TRUE(contains(r.err, "it or a file it reads has changed since")) << r.err;
+    std::ofstream(path("parts/light.xml")) << "<scene version=\"3.0.0\"><emitter type=\"constant\"/></scene>\n";
+    r = run({"check", path("inc.xml"), "-a", "3", "--references", path("refs"), "--spp", "2"});
+    EXPECT_NE(r.code, 2) << r.err;
+    std::ofstream(path("parts/tri.obj"), std::ios::app) << "# edited\n";
+    r = run({"check", path("inc.xml"), "-a", "3", "--references", path("refs"), "--spp", "2"});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_TRUE(contains(r.err, "it or a file it reads has changed since")) << r.err;
 }
 
 TEST_F(Lab, ReportSaysHowLongItsReferenceTakesBeforeItsAlgorithms) {

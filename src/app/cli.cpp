@@ -7,6 +7,7 @@
 #include "app/command_arguments.hpp"
 #include "app/render_command.hpp"
 #include "app/tool_commands.hpp"
+#include "job/rank_group.hpp"
 #include "job/usage_error.hpp"
 #include "integrators/integrator.hpp"
 #include "scene/builtin_scenes.hpp"
@@ -39,7 +40,7 @@ void print_algorithms() {
 
 }  // namespace
 
-int run_cli(int argc, const char* const* argv) {
+int run_cli(int argc, const char* const* argv, RankGroup* ranks) {
     CLI::App app{"pathlab: a physically based Monte Carlo renderer and light-transport laboratory.\n"
                  "Renders the 8 NPGR010 Cornell-box scenes (or scene files) with a chosen estimator.\n"
                  "Usage: pathlab SCENE [options]   (or pathlab render SCENE [options]; pathlab COMMAND --help)\n"
@@ -70,6 +71,8 @@ int run_cli(int argc, const char* const* argv) {
     CLI::App* convert_cmd = add_convert_command(app, convert_opt);
     InfoOptions info_opt;
     CLI::App* info_cmd = add_info_command(app, info_opt);
+    MergeOptions merge_opt;
+    CLI::App* merge_cmd = add_merge_command(app, merge_opt);
 
     // No arguments: the usage, not a render of everything.
     if (argc <= 1) {
@@ -98,6 +101,9 @@ int run_cli(int argc, const char* const* argv) {
     }
 
     try {
+        if (ranks && ranks->size() > 1 && !app.get_subcommands().empty() && !*render_cmd)
+            throw UsageError(fmt::format("only rendering runs across processes; start `pathlab {}` without mpirun",
+                                         app.get_subcommands().front()->get_name()));
         if (*scenes_cmd) {
             print_scenes();
             return 0;
@@ -116,7 +122,8 @@ int run_cli(int argc, const char* const* argv) {
         if (*report_cmd) return run_report_command(report_opt);
         if (*convert_cmd) return run_convert_command(convert_opt);
         if (*info_cmd) return run_info_command(info_opt);
-        return run_render_command(render_opt);
+        if (*merge_cmd) return run_merge_command(merge_opt);
+        return run_render_command(render_opt, ranks);
     } catch (const UsageError& e) {
         fmt::print(stderr, "pathlab: {}\n", e.what());
         return 2;

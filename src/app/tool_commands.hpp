@@ -98,5 +98,15 @@ struct InfoOptions {
 CLI::App* add_info_command(CLI::App& app, InfoOptions& o);
 int run_info_command(const InfoOptions& o);
 
+// `pathlab merge OUT.exr IN...`: one image from renders of the same scene and settings with
+// disjoint passes or different seeds (app/merge_command.cpp).
+struct MergeOptions {
+    std::string output;
+    std::vector<std::string> inputs;
+    bool quiet = false;
+};
+CLI::App* add_merge_command(CLI::App& app, MergeOptions& o);
+int run_merge_command(const MergeOptions& o);
+
 
 }  // namespace pathlab

@@ -1,6 +1,9 @@
 #include "job/scene_choice.hpp"
 
+#include <xxhash.h>
+
 #include <algorithm>
+#include <array>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -17,22 +20,82 @@ bool looks_like_scene_file(const std::string& key) {
 }
 
 SceneChoice builtin_scene_choice(int index) {
-    return {builtin_scenes()[size_t(index)].name, std::to_string(index), index, "", make_builtin_scene(index), {}, ""};
+    SceneChoice c{builtin_scenes()[size_t(index)].name, std::to_string(index), index, "", make_builtin_scene(index), {}, {}, ""};
+    c.hash = scene_hash(c);
+    return c;
 }
 
 SceneChoice scene_choice_of(SceneDescription desc) {
     std::string name = desc.name;
-    return {name, name, std::nullopt, "", std::move(desc), {}, ""};
+    SceneChoice c{name, name, std::nullopt, "", std::move(desc), {}, {}, ""};
+    c.hash = scene_hash(c);
+    return c;
 }
 
-std::string scene_file_hash(const std::string& path, const SceneParameters& parameters) {
-    uint64_t h = 14695981039346656037ull;  // FNV-1a offset basis
-    const auto add = [&h](unsigned char c) { h = (h ^ c) * 1099511628211ull; };
-    std::ifstream in(path, std::ios::binary);
-    for (std::istreambuf_iterator<char> it(in), end; it != end; ++it) add(static_cast<unsigned char>(*it));
-    for (const auto& [name, value] : parameters)
-        for (const char c : "\n" + name + "=" + value) add(static_cast<unsigned char>(c));
-    return fmt::format("{:016x}", h);
+namespace {
+
+class Hasher {
+public:
+    Hasher() : state_(XXH3_createState()) { XXH3_64bits_reset(state_); }
+    ~Hasher() { XXH3_freeState(state_); }
+    Hasher(const Hasher&) = delete;
+    Hasher& operator=(const Hasher&) = delete;
+    void bytes(const void* p, size_t n) { XXH3_64bits_update(state_, p, n); }
+    template <class T>
+    void values(const std::vector<T>& v) {
+        const uint64_t n = v.size();
+        bytes(&n, sizeof n);
+        if (!v.empty()) bytes(v.data(), v.size() * sizeof(T));
+    }
+    void text(const std::string& s) {
+        const uint64_t n = s.size();
+        bytes(&n, sizeof n);
+        bytes(s.data(), s.size());
+    }
+    void floats(std::initializer_list<float> f) {
+        for (float x : f) bytes(&x, sizeof x);
+    }
+    std::string hex() const { return fmt::format("{:016x}", XXH3_64bits_digest(state_)); }
+
+private:
+    XXH3_state_t* state_;
+};
+
+}  // namespace
+
+std::string scene_hash(const SceneChoice& c) {
+    Hasher h;
+    h.text(c.builtin ? fmt::format("builtin:{}", *c.builtin) : "");
+    // Every file read, in the order read, by content; one that cannot be read counts as empty.
+    std::vector<std::string> files = c.files;
+    if (files.empty() && !c.file.empty()) files.push_back(c.file);
+    const uint64_t count = files.size();
+    h.bytes(&count, sizeof count);
+    for (const std::string& f : files) {
+        std::ifstream in(f, std::ios::binary);
+        h.text(std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()));
+    }
+    for (const auto& [name, value] : c.parameters) h.text(name + "=" + value);
+    const SceneDescription& d = c.description;
+    h.text(d.name);
+    h.floats({d.camera.position.x, d.camera.position.y, d.camera.position.z, d.camera.forward.x, d.camera.forward.y,
+              d.camera.forward.z, d.camera.up.x, d.camera.up.y, d.camera.up.z, d.camera.fov_degrees});
+    // Vec3f, Vec2f and the triangles' index triples have no padding.
+    static_assert(sizeof(Vec3f) == 12 && sizeof(Vec2f) == 8 && sizeof(std::array<uint32_t, 3>) == 12);
+    for (const MeshDesc& m : d.meshes) {
+        h.values(m.positions), h.values(m.normals), h.values(m.uvs), h.values(m.triangles);
+        h.bytes(&m.material, sizeof m.material);
+        h.floats({m.emission.x, m.emission.y, m.emission.z});
+    }
+    for (const SphereDesc& s : d.spheres) {
+        h.floats({s.center.x, s.center.y, s.center.z, s.radius, s.emission.x, s.emission.y, s.emission.z});
+        h.bytes(&s.material, sizeof s.material);
+        const uint8_t flip = s.flip_normals;
+        h.bytes(&flip, 1);
+    }
+    const uint64_t counts[2] = {d.materials.size(), d.lights.size()};
+    h.bytes(counts, sizeof counts);
+    return h.hex();
 }
 
 namespace {
@@ -71,10 +134,12 @@ std::vector<SceneChoice> resolve_scenes(const std::string& spec, const SceneDefi
         if (allow_files && looks_like_scene_file(key)) {
             try {
                 const std::string stem = std::filesystem::path(key).stem().string();
-                SceneParameters used;
-                SceneDescription description = load_scene_file(key, defines, &used);
-                std::string hash = scene_file_hash(key, used);
-                out.push_back({stem, stem, std::nullopt, key, std::move(description), std::move(used), std::move(hash)});
+                SceneFileInputs inputs;
+                SceneDescription description = load_scene_file(key, defines, &inputs);
+                SceneChoice c{stem, stem, std::nullopt, key, std::move(description), std::move(inputs.parameters),
+                              std::move(inputs.files), ""};
+                c.hash = scene_hash(c);
+                out.push_back(std::move(c));
             } catch (const SceneFileError& e) {
                 throw UsageError(e.what());
             }

@@ -18,13 +18,17 @@ struct SceneChoice {
     std::string file;            // the scene file, if any
     SceneDescription description;
     SceneParameters parameters;  // a scene file's $name parameters, with the values they took
-    std::string hash;            // a scene file's identity (scene_file_hash); empty for a built-in scene
+    std::vector<std::string> files;  // every file the scene read: the scene file, its includes, spectra, meshes, emitters' files
+    std::string hash;            // scene_hash(*this), when it was resolved
 };
 
-// A scene file's identity for reference manifests: FNV-1a (64 bits, hex) of the file's bytes
-// followed by each parameter's "name=value" line, so that the same file with another -D value
-// is another scene.
-std::string scene_file_hash(const std::string& path, const SceneParameters& parameters);
+// What a scene is, as 16 hex digits (XXH3, 64 bits), for everything that must know whether two
+// renders or a render and a reference are of the same scene (reference manifests, the EXR's
+// pathlab:sceneHash, checkpoints, merge): the bytes of every file the scene read (a built-in
+// scene: its index), its $parameters' values, and its description's camera and geometry. The
+// same file with another -D value, or with an included file or a mesh edited, is another scene;
+// the files' names and folders do not count (a copied scene is the same scene).
+std::string scene_hash(const SceneChoice& scene);
 
 // True for a key that names a scene file (ends in .xml).
 bool looks_like_scene_file(const std::string& key);

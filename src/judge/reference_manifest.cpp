@@ -122,7 +122,7 @@ void record_reference(const std::string& dir, const ReferenceRecord& record) {
 std::string reference_mismatch(const ReferenceRecord& r, const std::string& image_path, const SceneChoice& scene,
                                const std::string& family, int width, int height) {
     const std::string redo = "render a matching one with `pathlab reference`, or leave the reference out";
-    // The scene: built-in by index; a scene file by its hash (bytes and parameters).
+    // The scene: built-in by index; a scene file by its hash (every file it read, its parameters).
     const bool same_scene = scene.builtin ? (r.index && *r.index == *scene.builtin)
                                           : (!r.index && !r.scene_hash.empty() && r.scene_hash == scene.hash);
     if (!same_scene) {
@@ -131,7 +131,7 @@ std::string reference_mismatch(const ReferenceRecord& r, const std::string& imag
             why = r.parameters != scene.parameters
                       ? fmt::format("{} is a reference of {} with the parameters {}, not {}", image_path, describe_scene(r),
                                     describe_parameters(r.parameters), describe_parameters(scene.parameters))
-                      : fmt::format("{} is a reference of {} as it was then (hash {}); the file has changed since (hash {})",
+                      : fmt::format("{} is a reference of {} as it was then (hash {}); it or a file it reads has changed since (hash {})",
                                     image_path, describe_scene(r), r.scene_hash.empty() ? "unknown" : r.scene_hash, scene.hash);
         }
         return why + ": " + redo;

@@ -23,7 +23,7 @@ struct ReferenceRecord {
     std::string scene;                  // {scene}: the built-in name or the scene file's stem
     std::optional<int> index;           // a built-in scene's course index
     std::string scene_file;             // a scene file, as it was given
-    std::string scene_hash;             // scene_file_hash() of that file
+    std::string scene_hash;             // scene_hash() of that scene (job/scene_choice.hpp)
     std::map<std::string, std::string> parameters;  // the scene file's $name values
     std::string algorithm;
     std::string family;                 // integrator_family()

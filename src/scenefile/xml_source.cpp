@@ -25,8 +25,18 @@ double srgb_to_linear(double v) { return v <= 0.04045 ? v / 12.92 : std::pow((v 
 
 }  // namespace
 
+namespace {
+
+std::shared_ptr<LoadContext> context_with(SceneDefines defines) {
+    auto c = std::make_shared<LoadContext>();
+    c->defines = std::move(defines);
+    return c;
+}
+
+}  // namespace
+
 XmlSource::XmlSource(const std::string& text, std::string file, SceneDefines defines)
-    : XmlSource(text, std::move(file), std::make_shared<LoadContext>(LoadContext{std::move(defines)})) {}
+    : XmlSource(text, std::move(file), context_with(std::move(defines))) {}
 
 XmlSource::XmlSource(const std::string& text, std::string file, std::shared_ptr<LoadContext> context)
     : text_(text), file_(std::move(file)), context_(std::move(context)) {

@@ -2,7 +2,8 @@
 # Installs every Debian package pathlab needs to build and test.
 # Usage: scripts/install-deps.sh
 # Chromium is installed for the test that opens `pathlab report`'s HTML in a headless browser
-# (the test is skipped where /usr/bin/chromium is absent).
+# (the test is skipped where /usr/bin/chromium is absent). pybind11, NumPy, pytest and
+# matplotlib are for the Python module (python/), its tests and the example in examples/.
 set -euo pipefail
 
 packages=(
@@ -12,6 +13,7 @@ packages=(
   libopenvdb-dev libassimp-dev zlib1g-dev
   libgtest-dev libbenchmark-dev
   libopenmpi-dev openmpi-bin libxxhash-dev
+  pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib
   chromium
 )
 

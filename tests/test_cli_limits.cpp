@@ -98,7 +98,7 @@ uint64_t available_memory() {
 }
 
 // A film too large for memory is refused before it is allocated, saying how much it needs;
-// the other scenes of the command still render, and `check` goes on too.
+// the other scenes of the command still render.
 TEST_F(CliLimits, AFilmTooLargeForMemoryFailsThatSceneOnly) {
     if (available_memory() == 0 || available_memory() > (uint64_t(90) << 30))
         GTEST_SKIP() << "this machine could allocate a 32768x32768 film (or does not say how much memory it has)";
@@ -111,11 +111,12 @@ TEST_F(CliLimits, AFilmTooLargeForMemoryFailsThatSceneOnly) {
     EXPECT_TRUE(contains(r.err, "a 32768x32768 render needs 208.0 GiB of memory")) << r.err;
     EXPECT_TRUE(fs::exists(path("point-diffuse.pfm"))) << "the other scene must still render";
     EXPECT_FALSE(fs::exists(path("huge.pfm")));
+    // check renders at its references' size: a --resolution of another size (here one too large
+    // for memory) is refused before anything renders.
     const CliResult c = run({"check", "-a", "1", "-s", "0,1", "--references", std::string(PATHLAB_SHARED_DIR) + "/npgr010-refs/direct",
                              "--spp", "1", "--resolution", "32768x32768"});
-    EXPECT_EQ(c.code, 1);
-    EXPECT_EQ(std::count(c.out.begin(), c.out.end(), '\n'), 4) << c.out;  // header, two scenes, the summary
-    EXPECT_TRUE(contains(c.out, "1 point-glossy     ERROR")) << c.out;
+    EXPECT_EQ(c.code, 2);
+    EXPECT_TRUE(contains(c.err, "is 512x512, but --resolution asks for 32768x32768")) << c.err;
 }
 
 // Sample counts are 64-bit: a pixel past 2^32 samples keeps counting and averaging.

@@ -329,16 +329,22 @@ TEST_F(Tools, ReferenceThenCheckReportsOkMissingAndBlackByDesign) {
     EXPECT_EQ(r.code, 0) << r.out << r.err;
     EXPECT_TRUE(std::regex_search(r.out, std::regex("0 point-diffuse +BLACK-BY-DESIGN "))) << r.out;
 
-    // pt-mis (global illumination) against direct-illumination references: biased, FAIL, exit 1.
+    // pt-mis (global illumination) against direct-illumination references: refused by the
+    // manifest (exit 2) before rendering.
+    r = run({"check", "-a", "pt-mis", "--references", path("refs"), "--scene", "2", "--spp", "16"});
+    EXPECT_EQ(r.code, 2) << r.out << r.err;
+    EXPECT_TRUE(contains(r.err, "rendered with direct-mis (direct illumination)")) << r.err;
+    // Without the manifest, nothing says what the references are of: judged, biased, FAIL (exit 1).
+    fs::rename(path("refs/manifest.json"), path("manifest.json"));
     r = run({"check", "-a", "pt-mis", "--references", path("refs"), "--scene", "2", "--spp", "16"});
     EXPECT_EQ(r.code, 1) << r.out << r.err;
     EXPECT_TRUE(std::regex_search(r.out, std::regex("2 ceiling-diffuse +FAIL "))) << r.out;
+    fs::rename(path("manifest.json"), path("refs/manifest.json"));
 
-    // A reference of another size: an error (exit 1) that names both sizes.
+    // A reference of another size: refused (exit 2), naming both sizes.
     r = run({"check", "-a", "1", "--references", path("refs"), "--scene", "2", "--spp", "4", "--resolution", "12x10"});
-    EXPECT_EQ(r.code, 1);
-    EXPECT_TRUE(contains(r.out, "ERROR")) << r.out;
-    EXPECT_TRUE(contains(r.out, "12x10")) << r.out;
+    EXPECT_EQ(r.code, 2);
+    EXPECT_TRUE(contains(r.err, "is 24x20, but --resolution asks for 12x10")) << r.err;
 
     // An unreadable reference: an error naming the file, without rendering.
     std::ofstream(path("refs/6-env-diffuse.exr")) << "not an EXR";
@@ -478,7 +484,7 @@ TEST_F(ToolsReport, WritesValidHtmlWhoseImagesExist) {
     EXPECT_TRUE(contains(html_, "id=\"exposure\""));
     EXPECT_TRUE(contains(html_, "rendered here with pt-mis --max-depth 1"));  // the reference, said so
     EXPECT_TRUE(contains(html_, "<td>direct-mis</td>"));
-    EXPECT_EQ(count(html_, "<polyline"), 2);
+    EXPECT_EQ(count(html_, "<polyline"), 4);  // each algorithm over time and over samples
     EXPECT_TRUE(fs::exists(path("out/report_files/reference.exr")));
     EXPECT_TRUE(fs::exists(path("out/report_files/convergence.svg")));
 }
@@ -494,10 +500,10 @@ TEST_F(Tools, ReportsOnASceneFileWithThePhotonMethods) {
     EXPECT_TRUE(contains(html, "sds-caustic (" + scene + ")"));
     EXPECT_TRUE(contains(html, "rendered here with vcm at 16 spp"));
     EXPECT_TRUE(contains(html, "<td>vcm</td>"));
-    EXPECT_EQ(count(html, "<polyline"), 3);
+    EXPECT_EQ(count(html, "<polyline"), 6);
     const CliResult all = run({"report", "--scene", "all", "--algorithms", "vcm", "--spp", "4", "-o", path("out/all.html")});
     EXPECT_EQ(all.code, 2);
-    EXPECT_TRUE(contains(all.err, "report takes one --scene")) << all.err;
+    EXPECT_TRUE(contains(all.err, "add {scene} or {index} to -o")) << all.err;
     const CliResult bad = run({"report", "--scene", "2", "--algorithms", "vcm", "--spp", "4", "--reference-algorithm", "nope", "-o",
                                path("out/bad.html")});
     EXPECT_EQ(bad.code, 2);

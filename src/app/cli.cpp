@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include "app/command_arguments.hpp"
 #include "app/render_command.hpp"
 #include "app/tool_commands.hpp"
 #include "job/rank_group.hpp"
@@ -41,12 +42,19 @@ void print_algorithms() {
 
 int run_cli(int argc, const char* const* argv, RankGroup* ranks) {
     CLI::App app{"pathlab: a physically based Monte Carlo renderer and light-transport laboratory.\n"
-                 "Renders the 8 NPGR010 Cornell-box scenes (or a scene file) with a chosen estimator."};
+                 "Renders the 8 NPGR010 Cornell-box scenes (or scene files) with a chosen estimator.\n"
+                 "Usage: pathlab SCENE [options]   (or pathlab render SCENE [options]; pathlab COMMAND --help)\n"
+                 "e.g.   pathlab 3 -a pt-mis --spp 256 -o glossy.png",
+                 "pathlab"};
     app.set_version_flag("--version", PATHLAB_VERSION);
     app.require_subcommand(0, 1);
+    app.footer(kInterruptHelp);
 
     RenderCommandOptions render_opt;
     add_render_options(app, render_opt);
+    CLI::App* render_cmd = app.add_subcommand("render", "Render scenes (the same as without a command): pathlab render SCENE [options]");
+    add_render_options(*render_cmd, render_opt);
+    render_cmd->footer(kInterruptHelp);
     CLI::App* scenes_cmd = app.add_subcommand("scenes", "List the built-in scenes, one per line");
     CLI::App* algorithms_cmd = app.add_subcommand("algorithms", "List the estimators (--algorithm values)");
     CLI::App* plugins_cmd =
@@ -59,9 +67,18 @@ int run_cli(int argc, const char* const* argv, RankGroup* ranks) {
     CLI::App* check_cmd = add_check_command(app, check_opt);
     ReportOptions report_opt;
     CLI::App* report_cmd = add_report_command(app, report_opt);
+    ConvertOptions convert_opt;
+    CLI::App* convert_cmd = add_convert_command(app, convert_opt);
+    InfoOptions info_opt;
+    CLI::App* info_cmd = add_info_command(app, info_opt);
     MergeOptions merge_opt;
     CLI::App* merge_cmd = add_merge_command(app, merge_opt);
 
+    // No arguments: the usage, not a render of everything.
+    if (argc <= 1) {
+        fmt::print(stderr, "{}", app.help());
+        return 2;
+    }
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
@@ -84,7 +101,7 @@ int run_cli(int argc, const char* const* argv, RankGroup* ranks) {
     }
 
     try {
-        if (ranks && ranks->size() > 1 && !app.get_subcommands().empty())
+        if (ranks && ranks->size() > 1 && !app.get_subcommands().empty() && !*render_cmd)
             throw UsageError(fmt::format("only rendering runs across processes; start `pathlab {}` without mpirun",
                                          app.get_subcommands().front()->get_name()));
         if (*scenes_cmd) {
@@ -103,6 +120,8 @@ int run_cli(int argc, const char* const* argv, RankGroup* ranks) {
         if (*reference_cmd) return run_reference_command(reference_opt);
         if (*check_cmd) return run_check_command(check_opt);
         if (*report_cmd) return run_report_command(report_opt);
+        if (*convert_cmd) return run_convert_command(convert_opt);
+        if (*info_cmd) return run_info_command(info_opt);
         if (*merge_cmd) return run_merge_command(merge_opt);
         return run_render_command(render_opt, ranks);
     } catch (const UsageError& e) {

@@ -65,4 +65,64 @@ size_t thread_count_or_cap(int requested) {
     return cap;
 }
 
+const char* const kInterruptHelp =
+    "Ctrl-C (or SIGTERM): the first stops after the current pass and writes what was rendered, normalised by the samples "
+    "taken (exit code 130; 143 for SIGTERM); a second one aborts at once, prints that it aborted and writes no image "
+    "(exit code 130; 143 for SIGTERM).\nOutput directories that do not exist are created.";
+
+void add_scene_arguments(CLI::App& app, SceneArguments& a) {
+    app.add_option("scene", a.positional,
+                   "Scene(s): course index 0-7, name or acronym (see `pathlab scenes`), a scene file (.xml), 'all', or several "
+                   "(also comma-separated)");
+    app.add_option("-s,--scene", a.option,
+                   "The same as an option: course index, name, scene file (.xml), a comma-separated list, or 'all'");
+    app.add_option("-D,--define", a.defines, "name=value for $name in scene files (repeatable; overrides <default>; a name no scene uses is an error)");
+}
+
+std::string scene_spec(const SceneArguments& a) {
+    if (!a.positional.empty() && !a.option.empty())
+        throw UsageError(fmt::format("the scene is given twice ({} and --scene {}): give it once", fmt::join(a.positional, " "), a.option));
+    return a.positional.empty() ? a.option : fmt::format("{}", fmt::join(a.positional, ","));
+}
+
+SceneDefines parse_defines(const std::vector<std::string>& list) {
+    SceneDefines defines;
+    for (const std::string& d : list) {
+        const size_t eq = d.find('=');
+        if (eq == std::string::npos || eq == 0) throw UsageError(fmt::format("invalid -D '{}': expected name=value", d));
+        defines[d.substr(0, eq)] = d.substr(eq + 1);
+    }
+    return defines;
+}
+
+std::vector<SceneChoice> resolve_scene_arguments(const SceneArguments& a, const std::string& fallback) {
+    const std::string given = scene_spec(a);
+    const std::string spec = given.empty() ? fallback : given;
+    if (spec.empty())
+        throw UsageError("no scene given: pathlab SCENE [options], where SCENE is a course index 0-7, a name (see `pathlab "
+                         "scenes`), a scene file (.xml), a comma-separated list, or 'all'");
+    return resolve_scenes(spec, parse_defines(a.defines));
+}
+
+PixelRect parse_crop_option(const std::string& text) {
+    const std::vector<std::string> items = split_comma_list(text);
+    std::vector<uint64_t> v;
+    for (const std::string& item : items)
+        if (const auto n = parse_whole_number(item, 0, kMaxResolution)) v.push_back(*n);
+    if (items.size() != 4 || v.size() != 4 || v[2] == 0 || v[3] == 0)
+        throw UsageError(fmt::format("invalid --crop '{}': expected X,Y,W,H in pixels from the top left, e.g. 100,80,64,48", text));
+    return {int(v[0]), int(v[1]), int(v[2]), int(v[3])};
+}
+
+std::vector<const IntegratorInfo*> parse_algorithm_list(const std::string& spec) {
+    std::vector<const IntegratorInfo*> infos;
+    for (const std::string& name : split_comma_list(spec)) {
+        const IntegratorInfo* e = &integrator_or_usage_error(name);
+        if (std::find(infos.begin(), infos.end(), e) != infos.end())
+            throw UsageError(fmt::format("algorithm '{}' is listed twice", name));
+        infos.push_back(e);
+    }
+    return infos;
+}
+
 }  // namespace pathlab

@@ -8,7 +8,9 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <vector>
 
+#include "image/image.hpp"
 #include "job/render_job.hpp"
 #include "job/scene_choice.hpp"
 
@@ -28,5 +30,32 @@ uint64_t parse_seed_option(const std::string& text);
 // kMaxThreadsPerCore x the cores, with a message, before it limits the thread pool.
 void add_threads_option(CLI::App& app, int& threads);
 size_t thread_count_or_cap(int requested);
+
+// The scenes of every scene command, the same way everywhere: `pathlab SCENE... [options]`
+// (Mitsuba's and pbrt's habit), or -s/--scene; each a built-in scene (index, name, acronym), a
+// scene file, a comma-separated list of them, or 'all'; -D name=value for $name in scene files.
+struct SceneArguments {
+    std::vector<std::string> positional;
+    std::string option;                 // -s/--scene
+    std::vector<std::string> defines;   // -D name=value
+};
+void add_scene_arguments(CLI::App& app, SceneArguments& a);
+// The list as one comma-separated spec ("" when no scene was given); both forms at once are a
+// UsageError.
+std::string scene_spec(const SceneArguments& a);
+// The scenes, loaded: `fallback` (e.g. "all") when none was given, else a UsageError; also for
+// unknown names, malformed files and defines no scene uses.
+std::vector<SceneChoice> resolve_scene_arguments(const SceneArguments& a, const std::string& fallback = "");
+SceneDefines parse_defines(const std::vector<std::string>& defines);
+
+// --crop X,Y,W,H (pixels, from the top left; whole numbers, W and H positive). Whether it fits
+// an image is checked against the image.
+PixelRect parse_crop_option(const std::string& text);
+
+// -a/--algorithm in every command: one estimator or a comma-separated list (repeats refused).
+std::vector<const IntegratorInfo*> parse_algorithm_list(const std::string& spec);
+
+// The help text's note on signals, shared by every command that renders.
+extern const char* const kInterruptHelp;
 
 }  // namespace pathlab

@@ -9,6 +9,7 @@
 #include "image/image_io.hpp"
 #include "judge/false_colour.hpp"
 #include "judge/image_compare.hpp"
+#include "judge/image_compare_json.hpp"
 
 namespace pathlab {
 namespace {
@@ -19,10 +20,6 @@ Image read_input(const std::string& path) {
     } catch (const ImageIoError& e) {
         throw UsageError(e.what());  // names the file
     }
-}
-
-nlohmann::json statistics_json(const ChannelStatistics& s) {
-    return {{"mean_diff", s.mean_diff}, {"mae", s.mae}, {"rmse", s.rmse}, {"relmse", s.relmse}, {"max_abs_diff", s.max_abs_diff}};
 }
 
 void print_table(const CompareOptions& o, const ImageDifference& d) {
@@ -93,11 +90,8 @@ int run_compare_command(const CompareOptions& o) {
     }
 
     if (o.json) {
-        nlohmann::json j = {{"a", o.a}, {"b", o.b}, {"width", d.width}, {"height", d.height},
-                            {"channels", nlohmann::json::array()}, {"all", statistics_json(d.all)},
-                            {"compared", d.compared},
-                            {"nan", {{"a", d.nan_a}, {"b", d.nan_b}}}, {"inf", {{"a", d.inf_a}, {"b", d.inf_b}}}};
-        for (const ChannelStatistics& c : d.channel) j["channels"].push_back(statistics_json(c));
+        nlohmann::json j = {{"a", o.a}, {"b", o.b}};
+        j.update(image_difference_json(d));
         if (o.threshold_given) j["threshold"] = {{"metric", o.metric}, {"value", value}, {"limit", o.threshold}, {"pass", pass}};
         if (!o.diff_path.empty()) j["diff"] = {{"path", o.diff_path}, {"scale", scale}};
         fmt::print("{}\n", j.dump(2));

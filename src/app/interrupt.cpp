@@ -14,17 +14,18 @@ static_assert(std::atomic<bool>::is_always_lock_free && std::atomic<int>::is_alw
 struct sigaction g_previous_int {}, g_previous_term {};
 
 extern "C" void on_stop_signal(int sig) {
-    // From now on either signal gets its default action: a second one ends the process.
-    struct sigaction dfl {};
-    dfl.sa_handler = SIG_DFL;
-    sigemptyset(&dfl.sa_mask);
-    sigaction(SIGINT, &dfl, nullptr);
-    sigaction(SIGTERM, &dfl, nullptr);
+    if (g_interrupted.load()) {
+        // The second signal: abort at once, writing nothing (outputs are written through
+        // temporaries, so no half-written image is left under an output's name).
+        static const char abort_msg[] = "\npathlab: aborted; no image written\n";
+        [[maybe_unused]] const ssize_t n = write(STDERR_FILENO, abort_msg, sizeof(abort_msg) - 1);
+        _exit(128 + (sig == SIGTERM ? SIGTERM : SIGINT));
+    }
     int none = 0;
     g_signal.compare_exchange_strong(none, sig);
     g_interrupted.store(true);
-    static const char int_msg[] = "\npathlab: interrupted; finishing the current pass and writing the image (Ctrl-C again to abort)\n";
-    static const char term_msg[] = "\npathlab: terminated (SIGTERM); finishing the current pass and writing the image (a second signal aborts)\n";
+    static const char int_msg[] = "\npathlab: interrupted; finishing the current pass and writing the image (Ctrl-C again to abort without it)\n";
+    static const char term_msg[] = "\npathlab: terminated (SIGTERM); finishing the current pass and writing the image (a second signal aborts without it)\n";
     const bool term = sig == SIGTERM;
     [[maybe_unused]] const ssize_t n =
         write(STDERR_FILENO, term ? term_msg : int_msg, (term ? sizeof(term_msg) : sizeof(int_msg)) - 1);
@@ -38,10 +39,10 @@ InterruptGuard::InterruptGuard() {
     struct sigaction sa {};
     sa.sa_handler = on_stop_signal;
     sigemptyset(&sa.sa_mask);
-    // While the handler runs, the other signal waits; it then finds the default action.
+    // While the handler runs, the other signal waits; it then finds the flag set and aborts.
     sigaddset(&sa.sa_mask, SIGINT);
     sigaddset(&sa.sa_mask, SIGTERM);
-    sa.sa_flags = SA_RESETHAND;
+    sa.sa_flags = 0;
     sigaction(SIGINT, &sa, &g_previous_int);
     sigaction(SIGTERM, &sa, &g_previous_term);
 }

@@ -1,6 +1,7 @@
 // Ctrl-C and SIGTERM handling for long renders: the first SIGINT or SIGTERM asks the render to
 // stop after its current pass (the image so far is then written, normalised by the samples
-// taken); a second one of either kills the process (the default action).
+// taken); a second one of either prints that it aborted and exits at once (128 + the signal)
+// without writing an image.
 //
 // The exit code of an interrupted command is 128 + the signal, as shells report a process
 // killed by it: 130 after Ctrl-C (SIGINT), 143 after SIGTERM (what job schedulers and `kill`

@@ -116,8 +116,8 @@ CLI::App* add_merge_command(CLI::App& app, MergeOptions& o) {
     CLI::App* cmd = app.add_subcommand("merge",
                                        "Combine renders of the same scene and settings with disjoint samples (--first-sample ranges, "
                                        "other seeds) into one EXR with its standard errors, weighting by sample counts");
-    cmd->add_option("output", o.output, "The merged image (.exr: mean, the stderr layer and the pathlab:* attributes)")->required();
-    cmd->add_option("inputs", o.inputs, "Renders' EXRs (as pathlab writes them) or checkpoints (exact)")->required();
+    cmd->add_option("OUT", o.output, "The merged image (.exr: mean, the stderr layer and the pathlab:* attributes)")->required();
+    cmd->add_option("IN", o.inputs, "Renders' EXRs (as pathlab writes them) or checkpoints (exact); two or more")->required();
     cmd->add_flag("-q,--quiet", o.quiet, "No summary");
     return cmd;
 }

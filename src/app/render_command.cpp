@@ -68,13 +68,11 @@ void write_stats(const std::string& path, RenderJob& job, const RenderResult& r,
 }  // namespace
 
 void add_render_options(CLI::App& app, RenderCommandOptions& o) {
-    app.add_option("-s,--scene", o.scene,
-                   "Scene: course index 0-7, name (see `pathlab scenes`), a scene file (.xml), a comma-separated list, or 'all'")
-        ->capture_default_str();
+    add_scene_arguments(app, o.scenes);
     app.add_option_function<std::string>(
         "-a,--algorithm", [&o](const std::string& v) { o.algorithm = v, o.algorithm_given = true; },
-        "Estimator name or course alias (see `pathlab algorithms`); default: the scene file's integrator, else pt-mis");
-    app.add_option("-D,--define", o.defines, "name=value for $name in scene files (repeatable; overrides <default>)");
+        "Estimator name or course alias (see `pathlab algorithms`), or a comma-separated list; default: the scene file's "
+        "integrator, else pt-mis");
     app.add_option_function<int>("--spp", [&o](const int& v) { o.spp = v, o.spp_given = true; },
                                  fmt::format("Samples per pixel (default {}, or unlimited with --time)", kDefaultSpp));
     app.add_option("--time", o.time_limit, "Time budget in seconds per scene (stops at --spp if that comes first)");
@@ -127,20 +125,13 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
 
 namespace {
 
-// The jobs of a render command, validated (UsageError on bad usage); `check_paths`: the outputs
-// are checked for writability (by the rank that writes them).
+// The jobs of a render command (one per scene and algorithm), validated (UsageError on bad
+// usage); `check_paths`: the outputs are checked for writability (by the rank that writes them).
 std::vector<RenderJob> make_jobs(const RenderCommandOptions& o, bool check_paths, std::vector<std::string>& checkpoints,
                                  std::vector<std::string>& resumes, bool distributed) {
-    if (o.algorithm_given) integrator_or_usage_error(o.algorithm);
-    SceneDefines defines;
-    for (const std::string& d : o.defines) {
-        const size_t eq = d.find('=');
-        if (eq == std::string::npos || eq == 0)
-            throw UsageError(fmt::format("invalid -D '{}': expected name=value", d));
-        defines[d.substr(0, eq)] = d.substr(eq + 1);
-    }
+    std::vector<const IntegratorInfo*> algorithms;
+    if (o.algorithm_given) algorithms = parse_algorithm_list(o.algorithm);
     JobRequest request;
-    if (o.algorithm_given) request.algorithm = o.algorithm;
     if (o.spp_given) {
         if (o.spp <= 0) throw UsageError(fmt::format("--spp must be a positive number of samples, got {}", o.spp));
         request.spp = uint64_t(o.spp);
@@ -174,7 +165,16 @@ std::vector<RenderJob> make_jobs(const RenderCommandOptions& o, bool check_paths
     if (o.no_merging && o.no_connections) throw UsageError("--no-merging and --no-connections together leave vcm no strategy");
 
     std::vector<RenderJob> jobs;
-    for (SceneChoice& choice : resolve_scenes(o.scene, defines)) jobs.emplace_back(std::move(choice), request);
+    for (SceneChoice& choice : resolve_scene_arguments(o.scenes)) {
+        if (algorithms.empty()) {
+            jobs.emplace_back(std::move(choice), request);
+            continue;
+        }
+        for (const IntegratorInfo* info : algorithms) {
+            request.algorithm = info->name;
+            jobs.emplace_back(choice, request);
+        }
+    }
     for (RenderJob& job : jobs) job.settings.first_sample = o.first_sample;
     if (!(o.checkpoint_every >= 0) || !std::isfinite(o.checkpoint_every))
         throw UsageError("--checkpoint-every must be zero (only at the end) or a positive number of seconds");
@@ -204,16 +204,19 @@ std::vector<RenderJob> make_jobs(const RenderCommandOptions& o, bool check_paths
         for (size_t k = 0; k < j; ++k)
             for (const std::string& path : jobs[j].outputs)
                 if (std::find(jobs[k].outputs.begin(), jobs[k].outputs.end(), path) != jobs[k].outputs.end())
-                    throw UsageError(fmt::format("scenes {} and {} would both write {}: add {{scene}} or {{index}} to -o",
-                                                 jobs[k].scene_choice().name, jobs[j].scene_choice().name, path));
+                    throw UsageError(fmt::format("{} / {} and {} / {} would both write {}: add {{scene}}, {{index}} or {{algorithm}} to -o",
+                                                 jobs[k].scene_choice().name, jobs[k].integrator_info().name,
+                                                 jobs[j].scene_choice().name, jobs[j].integrator_info().name, path));
         if (check_paths) {
             for (const std::string& path : jobs[j].outputs) paths.output(path, "the output", /*image=*/true);
             if (!o.stats_path.empty()) paths.output(jobs[j].expand(o.stats_path), "--stats", /*image=*/false);
             if (!checkpoints[j].empty()) {
                 for (size_t k = 0; k < j; ++k)
                     if (checkpoints[k] == checkpoints[j])
-                        throw UsageError(fmt::format("scenes {} and {} would both checkpoint to {}: add {{scene}} or {{index}} to it",
-                                                     jobs[k].scene_choice().name, jobs[j].scene_choice().name, checkpoints[j]));
+                        throw UsageError(fmt::format("{} / {} and {} / {} would both checkpoint to {}: add {{scene}}, {{index}} or "
+                                                     "{{algorithm}} to it",
+                                                     jobs[k].scene_choice().name, jobs[k].integrator_info().name,
+                                                     jobs[j].scene_choice().name, jobs[j].integrator_info().name, checkpoints[j]));
                 if (resumes[j].empty() && std::filesystem::exists(checkpoints[j]))
                     throw UsageError(fmt::format("{} exists: continue that render with --resume {}, or remove it first", checkpoints[j],
                                                  checkpoints[j]));
@@ -269,8 +272,7 @@ void print_messages(const std::string& messages) {
     }
 }
 
-void print_summary(const RenderJob& job, const RenderStats& s) {
-    const std::string& name = job.scene_choice().name;
+void print_summary(const RenderJob& job, const std::string& name, const RenderStats& s) {
     fmt::print(stderr, "{}: {} spp{} in {:.2f}s ({:.2f} Msamples/s, {:.2f} Mrays/s){}{} -> {}\n", name, s.spp,
                s.resumed_spp ? fmt::format(" ({} resumed)", s.resumed_spp) : "", s.seconds,
                s.seconds > 0 ? double(s.samples) / s.seconds * 1e-6 : 0.0, s.seconds > 0 ? double(s.rays) / s.seconds * 1e-6 : 0.0,
@@ -319,8 +321,7 @@ int run_render_command(const RenderCommandOptions& o, RankGroup* ranks) {
             return agreed;
         }
     }
-    std::string defines_text;
-    for (const std::string& d : o.defines) defines_text += " -D " + d;
+    const bool several_algorithms = o.algorithm_given && parse_algorithm_list(o.algorithm).size() > 1;
 
     std::optional<tbb::global_control> thread_limit;
     if (o.threads != 0) thread_limit.emplace(tbb::global_control::max_allowed_parallelism, thread_count_or_cap(o.threads));
@@ -337,8 +338,10 @@ int run_render_command(const RenderCommandOptions& o, RankGroup* ranks) {
         job.settings.progress = show_progress;
         job.settings.cancel = &InterruptGuard::flag();
         job.settings.ranks = &group;
-        const std::string& name = job.scene_choice().name;
-        if (show_progress) fmt::print(stderr, "{} / {}\n", name, job.integrator_info().name);
+        // The scene, and the estimator when there are several.
+        const std::string name =
+            job.scene_choice().name + (several_algorithms ? " / " + job.integrator_info().name : std::string());
+        if (show_progress) fmt::print(stderr, "{} / {}\n", job.scene_choice().name, job.integrator_info().name);
 
         // Every rank loads the scene from the same path and makes its film; the root takes up
         // the checkpoint to resume.
@@ -354,7 +357,7 @@ int run_render_command(const RenderCommandOptions& o, RankGroup* ranks) {
                 const Scene& scene = job.scene();
                 width = job.settings.width > 0 ? job.settings.width : scene.default_width();
                 height = job.settings.height > 0 ? job.settings.height : scene.default_height();
-                identity = render_identity(job, width, height, defines_text);
+                identity = render_identity(job, width, height);
                 if (root && !resumes[j].empty()) {
                     Checkpoint c = read_checkpoint(resumes[j]);
                     const std::string diff = c.info.identity.differences(identity, kIdentityFields, "the checkpoint", "this render");
@@ -424,14 +427,14 @@ int run_render_command(const RenderCommandOptions& o, RankGroup* ranks) {
                 ++failed;
                 continue;
             }
-            if (!o.quiet) print_summary(job, s);
+            if (!o.quiet) print_summary(job, name, s);
         }
         if (s.interrupted) {
-            if (root && j + 1 < jobs.size()) fmt::print(stderr, "pathlab: interrupted; {} scene(s) not rendered\n", jobs.size() - j - 1);
+            if (root && j + 1 < jobs.size()) fmt::print(stderr, "pathlab: interrupted; {} render(s) not done\n", jobs.size() - j - 1);
             return interrupted_exit_code();
         }
     }
-    if (root && failed && jobs.size() > 1) fmt::print(stderr, "pathlab: {} of {} scenes failed\n", failed, jobs.size());
+    if (root && failed && jobs.size() > 1) fmt::print(stderr, "pathlab: {} of {} renders failed\n", failed, jobs.size());
     return failed ? 1 : 0;
 }
 

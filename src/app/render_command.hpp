@@ -1,4 +1,5 @@
-// `pathlab [options]`: render built-in scenes (or scene files) with a chosen estimator.
+// `pathlab SCENE [options]` (or `pathlab render SCENE [options]`): render built-in scenes or
+// scene files with one or several estimators.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -7,11 +8,13 @@
 #include <string>
 #include <vector>
 
+#include "app/command_arguments.hpp"
+
 namespace pathlab {
 
 struct RenderCommandOptions {
-    std::string scene = "all";
-    std::string algorithm = "pt-mis";  // a scene file's <integrator> is used unless given
+    SceneArguments scenes;
+    std::string algorithm = "pt-mis";  // one or a comma-separated list; a scene file's <integrator> is used unless given
     bool algorithm_given = false;
     int spp = 0;
     bool spp_given = false;  // otherwise 64, or unlimited when --time is given
@@ -25,7 +28,6 @@ struct RenderCommandOptions {
     std::string stats_path;
     int max_depth = -1;
     bool max_depth_given = false;
-    std::vector<std::string> defines;  // -D name=value, for scene files
     int rr_depth = 3;
     bool rr_depth_given = false;
     bool quiet = false;

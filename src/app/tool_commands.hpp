@@ -1,13 +1,17 @@
 // The image-judging subcommands: `pathlab compare`, `reference`, `check` and `report`
-// (README, "Judging images"). Each adds itself to the CLI11 app and runs from its options;
-// bad usage throws UsageError (exit code 2).
+// (README, "Judging images"), and the image tools `convert` and `info`. Each adds itself to the
+// CLI11 app and runs from its options; bad usage throws UsageError (exit code 2). The scene
+// commands take their scenes (SceneArguments) and -a lists the same way as the renderer.
 #pragma once
 
 #include <CLI/CLI.hpp>
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
+
+#include "app/command_arguments.hpp"
 
 namespace pathlab {
 
@@ -25,14 +29,14 @@ CLI::App* add_compare_command(CLI::App& app, CompareOptions& o);
 int run_compare_command(const CompareOptions& o);
 
 struct ReferenceOptions {
-    std::string out_dir;
-    std::string scenes = "all";
-    std::string algorithm = "pt-mis";
+    std::string out_dir;               // may hold {algorithm} (required for several)
+    SceneArguments scenes;             // default: all built-in scenes
+    std::string algorithm = "pt-mis";  // one or a comma-separated list
     int spp = 0;  // 0: the default (kDefaultReferenceSpp), unless --time
     double time_limit = 0;
     std::string resolution;
     std::string seed = "4321";  // not the renderer's default 1234, so `check` renders independent samples
-    int max_depth = -1;
+    std::optional<int> max_depth;  // default: the scene file's, else -1 (unlimited)
     int threads = 0;
     bool quiet = false;
 };
@@ -40,14 +44,14 @@ CLI::App* add_reference_command(CLI::App& app, ReferenceOptions& o);
 int run_reference_command(const ReferenceOptions& o);
 
 struct CheckOptions {
-    std::string algorithm;
+    std::string algorithm;  // one or a comma-separated list
     std::string references;
     std::string mapping;
-    std::string scenes = "all";
+    SceneArguments scenes;  // default: all built-in scenes
     int spp = 64;
     std::string resolution;
     std::string seed = "1234";
-    int max_depth = -1;
+    std::optional<int> max_depth;  // default: the scene file's, else -1 (unlimited)
     int threads = 0;
     std::string json_path;
     bool quiet = false;
@@ -58,22 +62,41 @@ CLI::App* add_check_command(CLI::App& app, CheckOptions& o);
 int run_check_command(const CheckOptions& o);
 
 struct ReportOptions {
-    std::string scene;
-    std::vector<std::string> algorithms;
+    SceneArguments scenes;   // several: one report each (-o then needs {scene})
+    std::string algorithms;  // -a/--algorithm (or --algorithms): one or a comma-separated list
     double time_limit = 0;
     int spp = 0;
     std::string output;
-    std::string reference;
+    std::string reference;   // an image (one scene), or a directory of references (as check's)
     int reference_spp = 1024;
     std::string reference_algorithm = "pt-mis";
     std::string resolution;
     std::string seed = "1234";
-    int max_depth = -1;
+    std::optional<int> max_depth;  // default: the scene file's, else -1 (unlimited)
     int threads = 0;
     bool quiet = false;
+    std::vector<std::string> crops;  // --crop X,Y,W,H: inset crops, magnified
 };
 CLI::App* add_report_command(CLI::App& app, ReportOptions& o);
 int run_report_command(const ReportOptions& o);
+
+// `pathlab convert IN OUT`: any of .exr .hdr .pfm .png to any, with an exposure and a crop.
+struct ConvertOptions {
+    std::string input, output;
+    float exposure = 0;  // stops: the values are scaled by 2^exposure (for every output format)
+    std::string crop;    // "X,Y,W,H" in pixels from the top left; empty: the whole image
+};
+CLI::App* add_convert_command(CLI::App& app, ConvertOptions& o);
+int run_convert_command(const ConvertOptions& o);
+
+// `pathlab info IMG...`: size, channels, metadata (every header attribute), per-channel mean,
+// minimum and maximum, NaN/Inf counts.
+struct InfoOptions {
+    std::vector<std::string> images;
+    bool json = false;
+};
+CLI::App* add_info_command(CLI::App& app, InfoOptions& o);
+int run_info_command(const InfoOptions& o);
 
 // `pathlab merge OUT.exr IN...`: one image from renders of the same scene and settings with
 // disjoint passes or different seeds (app/merge_command.cpp).

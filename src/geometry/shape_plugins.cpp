@@ -178,7 +178,9 @@ ShapeDesc read_cylinder(Properties& p, const ShapeContext&) {
 }  // namespace
 
 std::string ShapeContext::resolve(const std::string& name) const {
-    return find_in_dirs(name, search_dirs.empty() ? std::vector<std::string>{base_dir} : search_dirs);
+    std::string path = find_in_dirs(name, search_dirs.empty() ? std::vector<std::string>{base_dir} : search_dirs);
+    if (files_read) files_read->push_back(path);
+    return path;
 }
 
 const std::vector<ShapePlugin>& shape_plugins() {

@@ -19,6 +19,8 @@ struct ShapeContext {
     // Where else relative file names are searched, in order (the scene file's folder and its
     // <path> folders); base_dir when empty.
     std::vector<std::string> search_dirs = {};
+    // If set, every file resolved is appended (the scene's identity hashes the files it read).
+    std::vector<std::string>* files_read = nullptr;
 
     // A relative file name: the first of search_dirs (or base_dir) where it exists, else its
     // place in the first, so that the error names a path.

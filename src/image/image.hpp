@@ -47,5 +47,16 @@ float decode_gamma8(uint8_t v, float gamma);  // (v/255)^gamma
 
 // Tone-maps a linear image for display: multiply by 2^exposure, then the sRGB curve.
 Image8 to_srgb8(const Image& img, float exposure_stops);
+// The inverse of encode_srgb8 on its 256 codes: decode_srgb8(encode_srgb8(v)) re-encodes to the same code.
+float decode_srgb8(uint8_t v);
+// A PNG's 8-bit sRGB values as linear RGB.
+Image from_srgb8(const Image8& img);
+
+// A rectangle of pixels, from the top-left corner.
+struct PixelRect {
+    int x = 0, y = 0, width = 0, height = 0;
+};
+// The pixels of `rect`, which must lie inside the image (std::invalid_argument otherwise).
+Image crop(const Image& img, const PixelRect& rect);
 
 }  // namespace pathlab

@@ -3,8 +3,6 @@
 #include <xxhash.h>
 
 #include <cctype>
-#include <fstream>
-#include <iterator>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -57,61 +55,9 @@ std::string RenderIdentity::differences(const RenderIdentity& ours, const std::v
 
 namespace {
 
-class Hasher {
-public:
-    Hasher() : state_(XXH3_createState()) { XXH3_64bits_reset(state_); }
-    ~Hasher() { XXH3_freeState(state_); }
-    Hasher(const Hasher&) = delete;
-    Hasher& operator=(const Hasher&) = delete;
-    void bytes(const void* p, size_t n) { XXH3_64bits_update(state_, p, n); }
-    template <class T>
-    void values(const std::vector<T>& v) {
-        const uint64_t n = v.size();
-        bytes(&n, sizeof n);
-        if (!v.empty()) bytes(v.data(), v.size() * sizeof(T));
-    }
-    void text(const std::string& s) { values(std::vector<char>(s.begin(), s.end())); }
-    void floats(std::initializer_list<float> f) {
-        for (float x : f) bytes(&x, sizeof x);
-    }
-    std::string hex() const { return fmt::format("{:016x}", XXH3_64bits_digest(state_)); }
-
-private:
-    XXH3_state_t* state_;
-};
-
 std::string hex_float(double v) { return fmt::format("{:a}", v); }
 
 }  // namespace
-
-std::string scene_hash(const std::string& file, const SceneDescription& d, const std::string& extra) {
-    Hasher h;
-    if (!file.empty()) {
-        std::ifstream in(file, std::ios::binary);
-        const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-        h.text(bytes);
-    }
-    h.text(extra);
-    h.text(d.name);
-    h.floats({d.camera.position.x, d.camera.position.y, d.camera.position.z, d.camera.forward.x, d.camera.forward.y,
-              d.camera.forward.z, d.camera.up.x, d.camera.up.y, d.camera.up.z, d.camera.fov_degrees});
-    // Vec3f, Vec2f and the triangles' index triples have no padding.
-    static_assert(sizeof(Vec3f) == 12 && sizeof(Vec2f) == 8 && sizeof(std::array<uint32_t, 3>) == 12);
-    for (const MeshDesc& m : d.meshes) {
-        h.values(m.positions), h.values(m.normals), h.values(m.uvs), h.values(m.triangles);
-        h.bytes(&m.material, sizeof m.material);
-        h.floats({m.emission.x, m.emission.y, m.emission.z});
-    }
-    for (const SphereDesc& s : d.spheres) {
-        h.floats({s.center.x, s.center.y, s.center.z, s.radius, s.emission.x, s.emission.y, s.emission.z});
-        h.bytes(&s.material, sizeof s.material);
-        const uint8_t flip = s.flip_normals;
-        h.bytes(&flip, 1);
-    }
-    const uint64_t counts[2] = {d.materials.size(), d.lights.size()};
-    h.bytes(counts, sizeof counts);
-    return h.hex();
-}
 
 std::string options_text(const IntegratorOptions& o) {
     return fmt::format("max_depth={} rr_depth={} only_length={} mis={} photons={} radius={} alpha={} merging={} connections={} "
@@ -143,12 +89,11 @@ std::vector<std::pair<std::string, std::string>> render_metadata(const RenderIde
     return m;
 }
 
-RenderIdentity render_identity(RenderJob& job, int width, int height, const std::string& scene_extra) {
+RenderIdentity render_identity(RenderJob& job, int width, int height) {
     const SceneChoice& c = job.scene_choice();
-    const std::string source = c.file.empty() ? (c.builtin ? fmt::format("builtin:{}", *c.builtin) : "") : "";
     RenderIdentity id;
     id.fields = {{"scene", c.name},
-                 {"scene hash", scene_hash(c.file, c.description, source + scene_extra)},
+                 {"scene hash", scene_hash(c)},
                  {"integrator", job.integrator_info().name},
                  {"options", options_text(job.integrator_options())},
                  {"resolution", fmt::format("{}x{}", width, height)},

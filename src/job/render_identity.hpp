@@ -1,6 +1,6 @@
-// What a render's samples are a function of, field by field: the scene (its name and a hash of
-// its file and geometry), the integrator and its options, the resolution, the seed and the
-// sampler. Two renders with equal identities and disjoint passes are parts of one render; a
+// What a render's samples are a function of, field by field: the scene (its name and its
+// scene_hash(): every file it read, its parameters, its geometry), the integrator and its
+// options, the resolution, the seed and the sampler. Two renders with equal identities and disjoint passes are parts of one render; a
 // checkpoint is resumed only by a render of the same identity, and `merge` combines renders
 // whose identities differ in the seed alone. The fields are kept apart so that a refusal can say
 // which differ.
@@ -41,9 +41,6 @@ extern const std::vector<std::string> kIdentityFields;
 // ... all but the seed: what renders that `merge` combines must share.
 extern const std::vector<std::string> kMergeFields;
 
-// XXH3 of the scene: the scene file's bytes (or the built-in scene's index), `extra` (the -D
-// definitions) and the description's geometry (so that a changed mesh file counts), as 16 hex digits.
-std::string scene_hash(const std::string& file, const SceneDescription& description, const std::string& extra);
 // The integrator options that change its samples, as "name=value" words (floats exactly, in hex).
 std::string options_text(const IntegratorOptions& o);
 
@@ -56,7 +53,9 @@ std::vector<std::pair<std::string, std::string>> render_metadata(const RenderIde
 // The attribute name of an identity field ("scene hash" -> "pathlab:sceneHash").
 std::string metadata_key(const std::string& field);
 
-// The identity of `job` (the scene is not built).
-RenderIdentity render_identity(RenderJob& job, int width, int height, const std::string& scene_extra = "");
+// The identity of `job` (the scene is not built); its scene hash is scene_hash() of the job's
+// scene (job/scene_choice.hpp: every file it read, its parameters, its geometry), the one that
+// reference manifests record.
+RenderIdentity render_identity(RenderJob& job, int width, int height);
 
 }  // namespace pathlab

@@ -1,6 +1,9 @@
 #include "job/render_job.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <optional>
 
 #include <fmt/format.h>
 
@@ -15,6 +18,44 @@ const IntegratorInfo& integrator_or_usage_error(const std::string& name) {
     if (!info) throw UsageError(fmt::format("unknown algorithm '{}'. Valid algorithms: {}", name, integrator_names()));
     return *info;
 }
+
+std::string integrator_family(const IntegratorInfo& info, int max_depth) {
+    if (info.name == "eyelight") return info.name;
+    if (info.name.rfind("direct-", 0) == 0 || max_depth == 1) return "direct illumination";
+    return max_depth > 1 ? fmt::format("global illumination, at most {} bounces", max_depth) : "global illumination";
+}
+
+namespace {
+
+// A positive number from the environment variable `name`, if set.
+std::optional<double> environment_cap(const char* name) {
+    const char* text = std::getenv(name);
+    if (!text || !*text) return std::nullopt;
+    char* end = nullptr;
+    const double v = std::strtod(text, &end);
+    if (*end != 0 || !(v > 0)) throw UsageError(fmt::format("{}={}: expected a positive number", name, text));
+    return v;
+}
+
+// PATHLAB_SPP_CAP, PATHLAB_TIME_CAP and PATHLAB_RESOLUTION_CAP (see the header).
+void apply_environment_caps(RenderSettings& s, const SceneDescription& d) {
+    if (const auto cap = environment_cap("PATHLAB_RESOLUTION_CAP")) {
+        int w = s.width > 0 ? s.width : d.width, h = s.height > 0 ? s.height : d.height;
+        const int longest = std::max(w, h), limit = std::max(1, int(*cap));
+        if (longest > limit) {
+            w = std::max(1, int(std::lround(double(w) * limit / longest)));
+            h = std::max(1, int(std::lround(double(h) * limit / longest)));
+        }
+        s.width = w, s.height = h;
+    }
+    if (const auto cap = environment_cap("PATHLAB_SPP_CAP")) {
+        const uint64_t spp = uint64_t(std::max(1.0, *cap));
+        s.spp = s.spp > 0 ? std::min(s.spp, spp) : spp;
+    }
+    if (const auto seconds = environment_cap("PATHLAB_TIME_CAP")) s.time_limit = s.time_limit > 0 ? std::min(s.time_limit, *seconds) : *seconds;
+}
+
+}  // namespace
 
 RenderJob::RenderJob(SceneChoice scene, const JobRequest& r) : choice_(std::move(scene)) {
     const SceneDescription& d = choice_.description;
@@ -58,6 +99,7 @@ RenderJob::RenderJob(SceneChoice scene, const JobRequest& r) : choice_(std::move
     settings.time_limit = r.time_limit;
     settings.seed = r.seed;
     settings.sampler = r.sampler;
+    apply_environment_caps(settings, d);
 }
 
 const Scene& RenderJob::scene() {

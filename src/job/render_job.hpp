@@ -6,6 +6,10 @@
 //              else the request's default_spp (64 for renders)
 //   max_depth  the request's, else the scene file's, else -1 (unlimited)
 //   rr_depth   the request's, else the scene file's, else 3
+// For smoke tests of whole commands (the docs test runs every command of README this way), the
+// environment variables PATHLAB_SPP_CAP=N, PATHLAB_TIME_CAP=S and PATHLAB_RESOLUTION_CAP=P cap
+// every render at N samples per pixel, S seconds and P pixels on its longer side (the aspect
+// kept), whatever the command asked for.
 #pragma once
 
 #include <memory>
@@ -45,6 +49,12 @@ struct JobRequest {
 // The integrator `name` (or an alias); a UsageError listing them all otherwise.
 const IntegratorInfo& integrator_or_usage_error(const std::string& name);
 
+// What an estimator's image converges to, so that a reference is only used for what it is a
+// reference of: "direct illumination" (the direct-* estimators, or any at --max-depth 1),
+// "global illumination" (", at most N bounces" with a depth limit), or the integrator's own
+// name for a debug view (eyelight).
+std::string integrator_family(const IntegratorInfo& info, int max_depth);
+
 class RenderJob {
 public:
     // Makes the integrator (the scene is built when first needed). Unknown algorithms and
@@ -64,6 +74,11 @@ public:
     // The integrator is made when first needed, so its options may still be changed before.
     Integrator& integrator();
     const IntegratorOptions& integrator_options() const { return options_; }
+    // The image size: the settings' (after the request and the caps), else the scene's.
+    int width() const { return settings.width > 0 ? settings.width : choice_.description.width; }
+    int height() const { return settings.height > 0 ? settings.height : choice_.description.height; }
+    // integrator_family() of this job's integrator and depth.
+    std::string family() const { return integrator_family(*info_, options_.max_depth); }
     IntegratorOptions& integrator_options() { return options_; }
     // Progress, cancellation, callbacks and the size may be adjusted before run().
     RenderSettings settings;

@@ -24,4 +24,12 @@ Image8 false_colour_difference(const Image& a, const Image& b, double scale);
 // A horizontal colour bar (-scale left, +scale right) for legends.
 Image8 diverging_colour_bar(int width, int height);
 
+// Magnitudes (per-pixel standard errors) on a sequential map (viridis: dark blue at 0, green,
+// yellow at `scale` and beyond); the mean of a pixel's three channels is shown, NaN/Inf in red.
+std::array<uint8_t, 3> sequential_colour(double t);  // t in [0, 1] (clamped)
+// The `quantile` of the per-pixel channel mean over finite pixels (1 if all are 0).
+double magnitude_scale(const Image& img, double quantile = 0.99);
+Image8 false_colour_magnitude(const Image& img, double scale);
+Image8 sequential_colour_bar(int width, int height);
+
 }  // namespace pathlab

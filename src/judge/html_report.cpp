@@ -63,7 +63,11 @@ figure { margin: 0; background: #fff; padding: 6px; border: 1px solid #ddd; }
 figcaption { font-size: 13px; margin-top: 4px; line-height: 1.4; }
 .view { position: relative; overflow: hidden; cursor: zoom-in; background: #000; }
 .view.zoomed { cursor: zoom-out; }
-.view img { position: absolute; left: 0; top: 0; transform-origin: 0 0; image-rendering: pixelated; }
+.view .layer { position: absolute; left: 0; top: 0; transform-origin: 0 0; }
+.view img { position: absolute; left: 0; top: 0; image-rendering: pixelated; }
+.view .crop { position: absolute; border-style: solid; border-color: #ffd400; box-sizing: border-box; pointer-events: none; }
+.inset img { image-rendering: pixelated; display: block; }
+.plots { display: flex; flex-wrap: wrap; gap: 12px; }
 .bar { display: flex; align-items: center; gap: 6px; font-size: 13px; margin: 8px 0; }
 .bar img { height: 14px; width: 256px; image-rendering: pixelated; }
 table { border-collapse: collapse; background: #fff; font-size: 14px; }
@@ -91,7 +95,7 @@ constexpr const char* kScript = R"(
   }
   function layout() {
     views.forEach(function (view) {
-      const img = view.querySelector('img');
+      const layer = view.querySelector('.layer');
       const w = Number(view.dataset.w), h = Number(view.dataset.h);
       const dw = view.clientWidth, dh = view.clientHeight, base = dw / w;
       let s = base, tx = 0, ty = 0;
@@ -100,7 +104,7 @@ constexpr const char* kScript = R"(
         tx = Math.min(0, Math.max(dw - w * s, dw / 2 - (focus.x + 0.5) * s));
         ty = Math.min(0, Math.max(dh - h * s, dh / 2 - (focus.y + 0.5) * s));
       }
-      img.style.transform = 'translate(' + tx + 'px, ' + ty + 'px) scale(' + s + ')';
+      layer.style.transform = 'translate(' + tx + 'px, ' + ty + 'px) scale(' + s + ')';
       view.classList.toggle('zoomed', focus !== null);
     });
     pixelText.textContent = focus ? 'zoomed at pixel (' + focus.x + ', ' + focus.y + ')' : '';
@@ -137,16 +141,38 @@ struct Figure {
     std::string alt, caption;
 };
 
-std::string figure_html(const Figure& f, int w, int h) {
+// An image at most kMaxDisplayWidth wide, zoomable; `crops` are outlined on it.
+std::string figure_html(const Figure& f, int w, int h, const std::vector<PixelRect>& crops = {}) {
     const int dw = std::min(w, kMaxDisplayWidth);
     const int dh = int(std::lround(double(h) * dw / w));
     const std::string img = f.stem.empty()
                                 ? fmt::format("<img src=\"{}\" width=\"{}\" height=\"{}\" alt=\"{}\">", xml_escape(f.src), w, h, xml_escape(f.alt))
                                 : fmt::format("<img data-stem=\"{0}\" src=\"{0}_e0.png\" width=\"{1}\" height=\"{2}\" alt=\"{3}\">",
                                               xml_escape(f.stem), w, h, xml_escape(f.alt));
-    return fmt::format("<figure style=\"width:{}px\"><div class=\"view\" style=\"width:{}px;height:{}px\" data-w=\"{}\" data-h=\"{}\">{}</div>"
-                       "<figcaption>{}</figcaption></figure>\n",
-                       dw, dw, dh, w, h, img, f.caption);
+    // Outlines about 2 display pixels wide (the layer is scaled by dw / w).
+    const double border = 2.0 * double(w) / double(dw);
+    std::string boxes;
+    for (const PixelRect& c : crops)
+        boxes += fmt::format("<div class=\"crop\" style=\"left:{}px;top:{}px;width:{}px;height:{}px;border-width:{:.2f}px\"></div>", c.x, c.y,
+                             c.width, c.height, border);
+    return fmt::format("<figure style=\"width:{}px\"><div class=\"view\" style=\"width:{}px;height:{}px\" data-w=\"{}\" data-h=\"{}\">"
+                       "<div class=\"layer\" style=\"width:{}px;height:{}px\">{}{}</div></div><figcaption>{}</figcaption></figure>\n",
+                       dw, dw, dh, w, h, w, h, img, boxes, f.caption);
+}
+
+// A magnified inset (no zoom): the crop shown about 192 pixels wide, pixelated.
+std::string inset_html(const std::string& stem, const PixelRect& c, const std::string& caption) {
+    const int scale = std::max(1, 192 / c.width);
+    return fmt::format("<figure class=\"inset\"><img data-stem=\"{0}\" src=\"{0}_e0.png\" width=\"{1}\" height=\"{2}\" alt=\"inset\">"
+                       "<figcaption>{3}</figcaption></figure>\n",
+                       xml_escape(stem), c.width * scale, c.height * scale, caption);
+}
+
+std::string csv_field(const std::string& s) {
+    if (s.find_first_of(",\"\n") == std::string::npos) return s;
+    std::string out = "\"";
+    for (const char c : s) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+    return out + "\"";
 }
 
 }  // namespace
@@ -161,9 +187,15 @@ std::vector<std::string> write_html_report(const ReportData& data, const std::st
     // Links to the images: relative, percent-encoded (and, in attributes, HTML-escaped).
     const std::string files_rel = url_path(files_dir.filename().string());
     const int w = data.reference.width(), h = data.reference.height();
+    for (const PixelRect& c : data.crops) crop(data.reference, c);  // throws std::invalid_argument if outside
     std::vector<std::string> written{html_path};
     const auto write_png = [&](const Image8& img, const std::string& name) {
         write_png8(img, (files_dir / name).string());
+        written.push_back((files_dir / name).string());
+        return files_rel + "/" + url_path(name);
+    };
+    const auto write_text = [&](const std::string& text, const std::string& name) {
+        write_text_file((files_dir / name).string(), text);
         written.push_back((files_dir / name).string());
         return files_rel + "/" + url_path(name);
     };
@@ -175,58 +207,121 @@ std::vector<std::string> write_html_report(const ReportData& data, const std::st
     };
 
     // Statistics, and the error images on one shared scale: the largest of the renders'
-    // 99th percentiles of |difference| (so the noisiest render just saturates).
+    // 99th percentiles of |difference| (so the noisiest render just saturates); the same for
+    // the standard errors.
     std::vector<ImageDifference> diffs;
-    std::vector<double> rmses;
-    double scale = 0;
+    std::vector<double> rmses, efficiencies;
+    double scale = 0, se_scale = 0;
     for (const ReportRender& r : data.renders) {
         diffs.push_back(compare_images(r.mean, data.reference));
         rmses.push_back(rmse_against_reference(r.mean, data.reference, data.reference_se));
+        // Efficiency: the inverse of the work needed for a given error, 1 / (MSE x time).
+        const double mse_seconds = rmses.back() * rmses.back() * r.stats.seconds;
+        efficiencies.push_back(mse_seconds > 0 ? 1.0 / mse_seconds : 0.0);
         scale = std::max(scale, difference_scale(r.mean, data.reference));
+        if (r.std_error.pixel_count() == r.mean.pixel_count() && r.mean.pixel_count() > 0)
+            se_scale = std::max(se_scale, magnitude_scale(r.std_error));
     }
     if (!(scale > 0)) scale = 1;
+    if (!(se_scale > 0)) se_scale = 1;
     const size_t best = rmses.empty() ? 0 : size_t(std::min_element(rmses.begin(), rmses.end()) - rmses.begin());
+    const size_t most_efficient =
+        efficiencies.empty() ? 0 : size_t(std::max_element(efficiencies.begin(), efficiencies.end()) - efficiencies.begin());
 
-    std::string images, errors;
+    std::string images, errors, std_errors, insets;
     images += figure_html({write_exposures(data.reference, "reference"), "", "reference",
                            "<b>reference</b><br>" + xml_escape(data.reference_label)},
-                          w, h);
+                          w, h, data.crops);
+    std::vector<std::string> inset_rows(data.crops.size());
+    for (size_t k = 0; k < data.crops.size(); ++k)
+        inset_rows[k] += inset_html(write_exposures(crop(data.reference, data.crops[k]), fmt::format("reference_crop{}", k)), data.crops[k],
+                                    "<b>reference</b>");
     for (size_t i = 0; i < data.renders.size(); ++i) {
         const ReportRender& r = data.renders[i];
         const std::string name = slug(r.algorithm);
         const std::string caption = fmt::format("<b>{}</b><br>{} spp, {:.2f} s{}<br>RMSE {:.4g}", xml_escape(r.algorithm), r.stats.spp,
                                                 r.stats.seconds, r.stats.interrupted ? " (interrupted)" : "", rmses[i]);
-        images += figure_html({write_exposures(r.mean, name), "", r.algorithm, caption}, w, h);
+        images += figure_html({write_exposures(r.mean, name), "", r.algorithm, caption}, w, h, data.crops);
         errors += figure_html({"", write_png(false_colour_difference(r.mean, data.reference, scale), name + "_error.png"),
                                r.algorithm + " error", fmt::format("<b>{}</b> − reference", xml_escape(r.algorithm))},
                               w, h);
+        if (r.std_error.pixel_count() == r.mean.pixel_count() && r.mean.pixel_count() > 0)
+            std_errors += figure_html({"", write_png(false_colour_magnitude(r.std_error, se_scale), name + "_stderr.png"),
+                                       r.algorithm + " standard error",
+                                       fmt::format("<b>{}</b><br>mean standard error {:.3g}", xml_escape(r.algorithm),
+                                                   [&] {
+                                                       double sum = 0;
+                                                       size_t n = 0;
+                                                       for (size_t p = 0; p < r.std_error.pixel_count(); ++p)
+                                                           for (int c = 0; c < 3; ++c)
+                                                               if (std::isfinite(r.std_error[p][c])) sum += r.std_error[p][c], ++n;
+                                                       return n ? sum / double(n) : 0.0;
+                                                   }())},
+                                      w, h);
+        for (size_t k = 0; k < data.crops.size(); ++k)
+            inset_rows[k] += inset_html(write_exposures(crop(r.mean, data.crops[k]), fmt::format("{}_crop{}", name, k)), data.crops[k],
+                                        fmt::format("<b>{}</b>", xml_escape(r.algorithm)));
+    }
+    for (size_t k = 0; k < data.crops.size(); ++k) {
+        const PixelRect& c = data.crops[k];
+        insets += fmt::format("<p>Crop {}: {}x{} pixels at ({}, {}), magnified {}x.</p>\n<div class=\"grid\">\n{}</div>\n", k + 1, c.width,
+                              c.height, c.x, c.y, std::max(1, 192 / c.width), inset_rows[k]);
     }
     const std::string bar = write_png(diverging_colour_bar(256, 1), "colourbar.png");
+    const std::string se_bar = write_png(sequential_colour_bar(256, 1), "colourbar_stderr.png");
 
     std::string table =
         "<table>\n<tr><th>algorithm</th><th>spp</th><th>seconds</th><th>Msamples/s</th><th>RMSE</th><th>relMSE</th>"
-        "<th>mean diff (R, G, B)</th><th>NaN/Inf samples</th></tr>\n";
+        "<th>efficiency 1/(MSE·s)</th><th>mean diff (R, G, B)</th><th>NaN/Inf samples</th></tr>\n";
+    std::string table_csv = "algorithm,spp,seconds,msamples_per_second,rmse,relmse,efficiency,mean_diff_r,mean_diff_g,mean_diff_b,invalid_samples\n";
     for (size_t i = 0; i < data.renders.size(); ++i) {
         const ReportRender& r = data.renders[i];
         const ImageDifference& d = diffs[i];
-        table += fmt::format("<tr><td>{}</td><td>{}</td><td>{:.2f}</td><td>{:.2f}</td><td{}>{:.4g}</td><td>{:.4g}</td>"
+        const double msps = r.stats.seconds > 0 ? double(r.stats.samples) / r.stats.seconds * 1e-6 : 0.0;
+        table += fmt::format("<tr><td>{}</td><td>{}</td><td>{:.2f}</td><td>{:.2f}</td><td{}>{:.4g}</td><td>{:.4g}</td><td{}>{:.4g}</td>"
                              "<td>{:+.2e}, {:+.2e}, {:+.2e}</td><td>{}</td></tr>\n",
-                             xml_escape(r.algorithm), r.stats.spp, r.stats.seconds,
-                             r.stats.seconds > 0 ? double(r.stats.samples) / r.stats.seconds * 1e-6 : 0.0,
-                             i == best ? " class=\"best\"" : "", rmses[i], d.all.relmse, d.channel[0].mean_diff,
+                             xml_escape(r.algorithm), r.stats.spp, r.stats.seconds, msps, i == best ? " class=\"best\"" : "", rmses[i],
+                             d.all.relmse, i == most_efficient ? " class=\"best\"" : "", efficiencies[i], d.channel[0].mean_diff,
                              d.channel[1].mean_diff, d.channel[2].mean_diff, r.stats.invalid_samples);
+        table_csv += fmt::format("{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{}\n", csv_field(r.algorithm), r.stats.spp,
+                                 r.stats.seconds, msps, rmses[i], d.all.relmse, efficiencies[i], d.channel[0].mean_diff,
+                                 d.channel[1].mean_diff, d.channel[2].mean_diff, r.stats.invalid_samples);
     }
     table += "</table>\n";
+    const std::string table_link = write_text(table_csv, "table.csv");
 
-    std::vector<PlotSeries> series;
-    for (size_t i = 0; i < data.renders.size(); ++i)
-        series.push_back({data.renders[i].algorithm, series_colour(i), data.renders[i].convergence});
-    const std::string svg = log_log_svg({"RMSE against the reference over render time", "render time (s)", "RMSE", 720, 420, true}, series);
-    write_text_file((files_dir / "convergence.svg").string(), svg);
-    written.push_back((files_dir / "convergence.svg").string());
+    std::vector<PlotSeries> by_time, by_spp;
+    std::string curves_csv = "algorithm,seconds,spp,rmse\n";
+    for (size_t i = 0; i < data.renders.size(); ++i) {
+        const ReportRender& r = data.renders[i];
+        PlotSeries t{r.algorithm, series_colour(i), {}}, n{r.algorithm, series_colour(i), {}};
+        for (const ConvergencePoint& p : r.convergence) {
+            t.points.push_back({p.seconds, p.rmse});
+            n.points.push_back({double(p.spp), p.rmse});
+            curves_csv += fmt::format("{},{:.6g},{},{:.6g}\n", csv_field(r.algorithm), p.seconds, p.spp, p.rmse);
+        }
+        by_time.push_back(std::move(t));
+        by_spp.push_back(std::move(n));
+    }
+    const std::string curves_link = write_text(curves_csv, "convergence.csv");
+    const std::string svg = log_log_svg({"RMSE against the reference over render time", "render time (s)", "RMSE", 640, 400, true}, by_time);
+    const std::string svg_spp =
+        log_log_svg({"RMSE against the reference over samples per pixel", "samples per pixel", "RMSE", 640, 400, true}, by_spp);
+    write_text(svg, "convergence.svg");
+    write_text(svg_spp, "convergence_spp.svg");
 
     std::string notes;
     for (const std::string& n : data.notes) notes += "<p class=\"note\">" + xml_escape(n) + "</p>\n";
+    const std::string inset_section =
+        insets.empty() ? "" : "<h2>Insets</h2>\n<p>The crops outlined in yellow on the images above, side by side.</p>\n" + insets;
+    const std::string se_section =
+        std_errors.empty()
+            ? ""
+            : fmt::format("<h2>Per-pixel standard error</h2>\n<p>The standard error of each pixel's mean, from its samples' variance (the "
+                          "mean of its three channels), on one scale for all: where an estimator is noisy. Red: NaN/Inf.</p>\n"
+                          "<div class=\"bar\"><span>0</span><img src=\"{}\" alt=\"colour scale\"><span>{:.3g}</span></div>\n"
+                          "<div class=\"grid\">\n{}</div>\n",
+                          xml_escape(se_bar), se_scale, std_errors);
 
     const std::string html = fmt::format(
         R"(<!DOCTYPE html>
@@ -249,21 +344,24 @@ std::vector<std::string> write_html_report(const ReportData& data, const std::st
 <h2>Images</h2>
 <div class="grid">
 {images}</div>
-<h2>Error against the reference</h2>
+{insets}<h2>Error against the reference</h2>
 <p>Luminance of each render minus the reference's, on one scale for all (blue: darker than the reference, red: brighter;
 green: NaN/Inf). Noise shows as speckle; bias as a coloured region.</p>
 <div class="bar"><span>−{scale:.3g}</span><img src="{bar}" alt="colour scale"><span>+{scale:.3g}</span></div>
 <div class="grid">
 {errors}</div>
-<h2>Statistics</h2>
-<p>RMSE over all pixels and channels against the reference{rmse_note}; relMSE = mean((render − reference)² / (reference² + 0.01)).
-Lowest RMSE in bold.</p>
+{se_section}<h2>Statistics</h2>
+<p>RMSE over all pixels and channels against the reference{rmse_note}; relMSE = mean((render − reference)² / (reference² + 0.01));
+efficiency = 1 / (MSE × seconds), the inverse of the time an estimator needs for a given error (higher is better; it stays
+constant as an unbiased estimator converges). Lowest RMSE and highest efficiency in bold.
+As CSV: <a href="{table_csv}">the table</a>, <a href="{curves_csv}">the convergence curves</a>.</p>
 {table}
 <h2>Convergence</h2>
-<p>RMSE against the reference at checkpoints of each progressive render (log-log). Unbiased estimators fall with slope −1/2
-(error ∝ 1/√time); a lower line is a more efficient estimator; a line that flattens out is biased, or has reached the
-reference's own noise.</p>
-{svg}
+<p>RMSE against the reference at checkpoints of each progressive render (log-log), over time and over samples per pixel.
+Unbiased estimators fall with slope −1/2 (error ∝ 1/√time); a lower line is a more efficient estimator; a line that flattens
+out is biased, or has reached the reference's own noise.</p>
+<div class="plots">
+{svg}{svg_spp}</div>
 <script>{script}</script>
 </body>
 </html>
@@ -272,9 +370,11 @@ reference's own noise.</p>
         fmt::arg("w", w), fmt::arg("h", h), fmt::arg("reference_note", xml_escape(data.reference_note)),
         fmt::arg("version", PATHLAB_VERSION), fmt::arg("date", utc_now()), fmt::arg("command", xml_escape(data.command)),
         fmt::arg("notes", notes), fmt::arg("emin", kReportMinExposure), fmt::arg("emax", kReportMaxExposure),
-        fmt::arg("images", images), fmt::arg("scale", scale), fmt::arg("bar", xml_escape(bar)), fmt::arg("errors", errors),
+        fmt::arg("images", images), fmt::arg("insets", inset_section), fmt::arg("scale", scale), fmt::arg("bar", xml_escape(bar)),
+        fmt::arg("errors", errors), fmt::arg("se_section", se_section),
         fmt::arg("rmse_note", data.reference_se.pixel_count() ? " with the reference's own noise (its mean squared standard error) removed" : ""),
-        fmt::arg("table", table), fmt::arg("svg", svg), fmt::arg("script", kScript));
+        fmt::arg("table_csv", xml_escape(table_link)), fmt::arg("curves_csv", xml_escape(curves_link)), fmt::arg("table", table),
+        fmt::arg("svg", svg), fmt::arg("svg_spp", svg_spp), fmt::arg("script", kScript));
     write_text_file(html_path, html);
     return written;
 }

@@ -5,9 +5,12 @@
 //    exposure slider swaps them; tone mapping stays pathlab's own sRGB encoding);
 //  - click-to-zoom at pixel level (CSS image-rendering: pixelated), synchronised over all
 //    images, so the same pixels of every estimator are seen side by side;
+//  - inset crops (--crop X,Y,W,H) of every image side by side, magnified, outlined on the images;
 //  - per algorithm a false-colour signed error image (render - reference luminance, one scale
-//    for all, tools/false_colour.hpp) and RMSE / relMSE / mean difference in a table;
-//  - the RMSE-vs-time convergence plot (log-log SVG) from the renders' checkpoints.
+//    for all, judge/false_colour.hpp) and a per-pixel standard-error image (one scale for all);
+//  - a table of spp, time, RMSE, relMSE, mean difference and the efficiency 1/(MSE x seconds),
+//    exported with the curves as CSV (report_files/table.csv, convergence.csv);
+//  - RMSE against time and against samples per pixel (log-log SVG) from the renders' checkpoints.
 #pragma once
 
 #include <string>
@@ -19,11 +22,18 @@
 
 namespace pathlab {
 
+struct ConvergencePoint {
+    double seconds = 0;
+    uint64_t spp = 0;
+    double rmse = 0;  // against the reference, its own noise removed
+};
+
 struct ReportRender {
     std::string algorithm;
     Image mean;
+    Image std_error;  // per-pixel standard errors of the mean (may be empty)
     RenderStats stats;
-    std::vector<std::pair<double, double>> convergence;  // (seconds, RMSE against the reference)
+    std::vector<ConvergencePoint> convergence;
 };
 
 struct ReportData {
@@ -36,6 +46,7 @@ struct ReportData {
     std::vector<ReportRender> renders;
     std::vector<std::string> notes;  // shown prominently (e.g. "interrupted: ...")
     std::string command;             // the command line that made the report
+    std::vector<PixelRect> crops;    // inset crops (inside the image)
 };
 
 constexpr int kReportMinExposure = -4, kReportMaxExposure = 4;

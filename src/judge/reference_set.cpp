@@ -32,6 +32,15 @@ ReferenceFile make_reference_file(const std::string& path) {
     return ref;
 }
 
+std::optional<ReferenceFile> first_existing(const std::string& dir, const std::vector<std::string>& names, std::string* tried) {
+    for (const std::string& name : names) {
+        const fs::path p = fs::path(dir) / name;
+        if (fs::is_regular_file(p)) return make_reference_file(p.string());
+    }
+    if (tried) *tried = fmt::format("{}/{{{}}}", dir, fmt::join(names, ","));
+    return std::nullopt;
+}
+
 }  // namespace
 
 std::vector<std::string> expected_reference_names(int scene) {
@@ -83,12 +92,11 @@ std::optional<ReferenceFile> find_reference(const std::string& dir, int scene, c
         return std::nullopt;
     }
     const std::vector<std::string> names = expected_reference_names(scene);
-    for (const std::string& name : names) {
-        const fs::path p = fs::path(dir) / name;
-        if (fs::is_regular_file(p)) return make_reference_file(p.string());
-    }
-    if (tried) *tried = fmt::format("{}/{{{}}}", dir, fmt::join(names, ","));
-    return std::nullopt;
+    return first_existing(dir, names, tried);
+}
+
+std::optional<ReferenceFile> find_reference_named(const std::string& dir, const std::string& stem, std::string* tried) {
+    return first_existing(dir, {stem + ".exr", stem + ".pfm", stem + ".hdr", stem + ".png"}, tried);
 }
 
 }  // namespace pathlab

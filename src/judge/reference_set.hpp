@@ -54,5 +54,8 @@ std::map<int, std::string> read_reference_mapping(const std::string& path);
 // what was looked for.
 std::optional<ReferenceFile> find_reference(const std::string& dir, int scene, const std::map<int, std::string>& mapping,
                                             std::string* tried = nullptr);
+// The reference of a scene file in `dir`: "{stem}" (what `pathlab reference` writes for
+// scenes/{stem}.xml) with .exr, .pfm, .hdr, then .png.
+std::optional<ReferenceFile> find_reference_named(const std::string& dir, const std::string& stem, std::string* tried = nullptr);
 
 }  // namespace pathlab

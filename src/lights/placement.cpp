@@ -13,7 +13,9 @@ std::string emitter_file(Properties& p, const EmitterContext& ctx, const char* w
     if (!p.has("filename")) p.fail(fmt::format("<emitter type=\"{}\"> needs <string name=\"filename\" value=\"...\"/>", what));
     const std::string filename = p.get_string("filename");
     if (!ctx.allow_files) p.fail("filename", fmt::format("this loader does not read files ({} emitters are disabled)", what));
-    return find_in_dirs(filename, ctx.search_dirs.empty() ? std::vector<std::string>{ctx.base_dir} : ctx.search_dirs);
+    std::string path = find_in_dirs(filename, ctx.search_dirs.empty() ? std::vector<std::string>{ctx.base_dir} : ctx.search_dirs);
+    if (ctx.files_read) ctx.files_read->push_back(path);
+    return path;
 }
 
 Frame rotation_frame(Properties& p, const char* what) {

@@ -17,6 +17,8 @@ struct EmitterContext {
     // Where else relative file names are searched, in order (the scene file's folder and its
     // <path> folders); base_dir when empty.
     std::vector<std::string> search_dirs = {};
+    // If set, every file found is appended (the scene's identity hashes the files it read).
+    std::vector<std::string>* files_read = nullptr;
 };
 
 // The path of the emitter's required `filename`, resolved against the search folders;

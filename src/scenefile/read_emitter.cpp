@@ -22,7 +22,7 @@ void read_free_emitter(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b)
                                 "area inside a shape)",
                                 type));
     Properties p = xml.properties(n, plugin->info());
-    EmitterContext files{b.shapes.base_dir, b.shapes.allow_files};
+    EmitterContext files{b.shapes.base_dir, b.shapes.allow_files, {}, b.shapes.files_read};
     if (files.allow_files) files.search_dirs = xml.search_dirs();
     const FreeLight light = reading([&] {
         FreeLight l = plugin->read(p, files);

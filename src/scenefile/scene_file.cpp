@@ -150,7 +150,7 @@ void Loader::include(XmlSource& xml, const pugi::xml_node& n) {
 }  // namespace
 
 SceneDescription load_scene_text(const std::string& text, const std::string& file_name, const std::string& base_dir,
-                                 const SceneDefines& defines, bool allow_files) {
+                                 const SceneDefines& defines, bool allow_files, SceneFileInputs* inputs) {
     Loader loader;
     loader.context = std::make_shared<LoadContext>();
     loader.context->defines = defines;
@@ -165,6 +165,7 @@ SceneDescription load_scene_text(const std::string& text, const std::string& fil
 
     SceneBuilder& b = loader.b;
     b.shapes = ShapeContext{base_dir, allow_files};
+    b.shapes.files_read = &loader.context->files;
     b.desc.name = std::filesystem::path(file_name).stem().string();
     use_default_sensor(b);  // Mitsuba's default sensor and film, unless the file has its own
     std::error_code ec;
@@ -172,10 +173,11 @@ SceneDescription load_scene_text(const std::string& text, const std::string& fil
     loader.read_children(xml, scene);
     if (b.desc.meshes.empty() && b.desc.spheres.empty() && b.desc.instances.empty()) xml.fail_file("the scene has no shapes");
     b.desc.notes = loader.context->notes;
+    if (inputs) inputs->parameters = loader.context->used, inputs->files = loader.context->files;
     return std::move(b.desc);
 }
 
-SceneDescription load_scene_file(const std::string& path, const SceneDefines& defines) {
+SceneDescription load_scene_file(const std::string& path, const SceneDefines& defines, SceneFileInputs* inputs) {
     std::error_code ec;
     if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
         throw SceneFileError(path, 0, 0, "not a regular file");
@@ -184,7 +186,9 @@ SceneDescription load_scene_file(const std::string& path, const SceneDefines& de
     std::ostringstream text;
     text << in.rdbuf();
     const std::filesystem::path p(path);
-    return load_scene_text(text.str(), path, p.has_parent_path() ? p.parent_path().string() : ".", defines);
+    SceneDescription d = load_scene_text(text.str(), path, p.has_parent_path() ? p.parent_path().string() : ".", defines, true, inputs);
+    if (inputs) inputs->files.insert(inputs->files.begin(), path);
+    return d;
 }
 
 }  // namespace pathlab

@@ -20,6 +20,7 @@
 #include <map>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "scene/scene_description.hpp"
 
@@ -35,13 +36,24 @@ struct SceneFileError : std::runtime_error {
 // Values for $name substitution: command-line -D name=value pairs; a <default> in the file
 // applies only to names not given here.
 using SceneDefines = std::map<std::string, std::string>;
+// The $name parameters a scene file uses, each with the value it took (-D, else <default>).
+using SceneParameters = std::map<std::string, std::string>;
 
-// Loads a scene file; relative mesh paths are resolved against the file's directory.
-SceneDescription load_scene_file(const std::string& path, const SceneDefines& defines = {});
+// What a scene was made of, for its identity (the scene hash): the $name parameters it used,
+// with the values they took, and every file it read, in order: the scene file (by
+// load_scene_file), its <include>s, spectrum files, meshes and emitters' files (envmap, ies).
+struct SceneFileInputs {
+    SceneParameters parameters;
+    std::vector<std::string> files;
+};
+
+// Loads a scene file; relative mesh paths are resolved against the file's directory. `inputs`,
+// if given, receives the parameters and files the scene used.
+SceneDescription load_scene_file(const std::string& path, const SceneDefines& defines = {}, SceneFileInputs* inputs = nullptr);
 
 // Loads a scene from text (`file_name` is used in messages). With allow_files = false, shapes
 // that read files (obj) are an error: the fuzzer uses this.
 SceneDescription load_scene_text(const std::string& text, const std::string& file_name, const std::string& base_dir,
-                                 const SceneDefines& defines = {}, bool allow_files = true);
+                                 const SceneDefines& defines = {}, bool allow_files = true, SceneFileInputs* inputs = nullptr);
 
 }  // namespace pathlab

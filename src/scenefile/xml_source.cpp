@@ -94,6 +94,7 @@ std::string XmlSource::substitute(const pugi::xml_node& n, const std::string& va
             fail(n, fmt::format("undefined parameter ${} (define it with <default name=\"{}\" value=\"...\"/> or -D {}=...)", name,
                                 name, name));
         out += it->second;
+        context_->used[name] = it->second;
         i = j;
     }
     return out;
@@ -142,12 +143,16 @@ std::string XmlSource::find_file(const pugi::xml_node& n, const std::string& nam
     std::error_code ec;
     if (p.is_absolute()) {
         if (!std::filesystem::exists(p, ec)) fail(n, fmt::format("{} '{}' does not exist", what, name));
+        context_->files.push_back(name);
         return name;
     }
     const std::vector<std::string> dirs = search_dirs();
     for (const std::string& d : dirs) {
         const std::filesystem::path candidate = std::filesystem::path(d) / p;
-        if (std::filesystem::exists(candidate, ec)) return candidate.string();
+        if (std::filesystem::exists(candidate, ec)) {
+            context_->files.push_back(candidate.string());
+            return candidate.string();
+        }
     }
     fail(n, fmt::format("cannot find {} '{}' (searched: {})", what, name, fmt::join(dirs, ", ")));
 }

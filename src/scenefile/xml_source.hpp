@@ -18,9 +18,12 @@ namespace pathlab {
 
 // What every file of one load shares (the main file and its <include>s): the $name values, the
 // folders that file names are searched in, whether files may be read at all, the scene's
-// version, and the notes about what was accepted but ignored.
+// version, the notes about what was accepted but ignored, and what the scene's identity is made
+// of (the $name parameters used and every file read).
 struct LoadContext {
     SceneDefines defines;
+    SceneParameters used;                   // the $name parameters substituted, with their values
+    std::vector<std::string> files;         // every file read: the main file, includes, spectra, meshes, emitters' files
     std::vector<std::string> search_paths;  // <path> folders, the latest first
     std::string scene_dir = ".";            // the main file's folder, searched last
     bool allow_files = true;

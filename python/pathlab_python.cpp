@@ -1,0 +1,314 @@
+// The Python module `pathlab` (pybind11 + NumPy): scenes, estimators, renders as float32 arrays
+// of shape (height, width, 3), compare's statistics, image files. A render is the command
+// line's RenderJob with the same settings, so it gives the same bytes as `pathlab SCENE ...`.
+//
+//   import pathlab
+//   scene = pathlab.load("scenes/example.xml", defines={"spp": "16"})   # or load(3), load("ceiling-glossy")
+//   img, stderr = pathlab.render(scene, algorithm="pt-mis", spp=64, seed=1, threads=0)
+//   stats = pathlab.compare(img, reference)          # as `pathlab compare --json`
+//   pathlab.write("out.exr", img)
+//
+// While rendering, the GIL is released (other Python threads run) and Ctrl-C is honoured: the
+// render stops after its current batch of passes and KeyboardInterrupt is raised.
+#include <pybind11/pybind11.h>
+#include <pybind11/numpy.h>
+#include <pybind11/stl.h>
+
+#include <tbb/global_control.h>
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <exception>
+#include <mutex>
+#include <optional>
+#include <thread>
+
+#include <fmt/format.h>
+
+#include "image/image_io.hpp"
+#include "integrators/integrator.hpp"
+#include "job/render_job.hpp"
+#include "job/scene_choice.hpp"
+#include "job/usage_error.hpp"
+#include "judge/image_compare.hpp"
+#include "judge/image_compare_json.hpp"
+#include "scene/builtin_scenes.hpp"
+#include "scene/scene.hpp"
+
+namespace py = pybind11;
+using namespace pathlab;
+
+namespace {
+
+// A loaded scene: what the command line resolves from a name or a file, and its built form
+// (the accelerator), made at the first render and shared by the later ones.
+struct PyScene {
+    SceneChoice choice;
+    std::shared_ptr<const Scene> built;
+};
+
+std::string scene_names() {
+    std::string s;
+    for (const BuiltinSceneInfo& b : builtin_scenes()) s += fmt::format("{}{} {}", s.empty() ? "" : ", ", b.index, b.name);
+    return s;
+}
+
+std::string algorithm_names() {
+    std::string s;
+    for (const IntegratorInfo& e : integrators()) s += (s.empty() ? "" : ", ") + e.name;
+    return s;
+}
+
+// A usage problem from the C++ side is a ValueError (an unknown name, a malformed file).
+template <typename F>
+auto translating(F&& f) {
+    try {
+        return f();
+    } catch (const UsageError& e) {
+        throw py::value_error(e.what());
+    } catch (const ImageIoError& e) {
+        throw py::value_error(e.what());
+    }
+}
+
+std::shared_ptr<PyScene> py_load(const py::object& what, const std::map<std::string, std::string>& defines) {
+    std::string spec;
+    if (py::isinstance<py::bool_>(what)) {
+        throw py::type_error("scene must be a course index (int 0-7), a scene name or a scene file (str); valid scenes: " + scene_names());
+    } else if (py::isinstance<py::int_>(what)) {
+        spec = std::to_string(what.cast<long long>());
+    } else if (py::isinstance<py::str>(what)) {
+        spec = what.cast<std::string>();
+    } else if (py::hasattr(what, "__fspath__")) {
+        spec = py::str(what.attr("__fspath__")()).cast<std::string>();
+    } else {
+        throw py::type_error(fmt::format("scene must be a course index (int 0-7), a scene name or a scene file (str or path), not {}; "
+                                         "valid scenes: {}, or a scene file ending in .xml",
+                                         py::str(py::type::of(what).attr("__name__")).cast<std::string>(), scene_names()));
+    }
+    if (spec.empty() || spec == "all" || spec.find(',') != std::string::npos)
+        throw py::value_error("load() takes one scene: a course index, a name (" + scene_names() + ") or a scene file");
+    std::vector<SceneChoice> scenes = translating([&] { return resolve_scenes(spec, defines); });
+    return std::make_shared<PyScene>(PyScene{std::move(scenes.front()), nullptr});
+}
+
+std::shared_ptr<PyScene> scene_argument(const py::object& scene) {
+    if (py::isinstance<PyScene>(scene)) return scene.cast<std::shared_ptr<PyScene>>();
+    return py_load(scene, {});
+}
+
+std::string string_argument(const py::object& v, const char* name, const std::string& valid) {
+    if (!py::isinstance<py::str>(v))
+        throw py::type_error(fmt::format("{} must be a str, not {}; valid: {}", name, py::str(py::type::of(v).attr("__name__")).cast<std::string>(),
+                                         valid));
+    return v.cast<std::string>();
+}
+
+// An image as a float32 array of shape (height, width, 3) that owns its copy of the pixels.
+py::array_t<float> to_array(const Image& img) {
+    py::array_t<float> a({py::ssize_t(img.height()), py::ssize_t(img.width()), py::ssize_t(3)});
+    std::copy(img.data(), img.data() + img.pixel_count() * 3, a.mutable_data());
+    return a;
+}
+
+// An (H, W, 3) array of numbers (any float or int dtype, converted to float32), or an image file.
+Image to_image(const py::object& v, const char* name) {
+    if (py::isinstance<py::str>(v) || py::hasattr(v, "__fspath__")) {
+        const std::string path = py::isinstance<py::str>(v) ? v.cast<std::string>() : py::str(v.attr("__fspath__")()).cast<std::string>();
+        return translating([&] { return read_image(path); });
+    }
+    if (!py::isinstance<py::array>(v) && !py::isinstance<py::list>(v))
+        throw py::type_error(fmt::format("{} must be a NumPy array of shape (height, width, 3) or an image file name (str), not {}", name,
+                                         py::str(py::type::of(v).attr("__name__")).cast<std::string>()));
+    py::array_t<float, py::array::c_style | py::array::forcecast> a;
+    try {
+        a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(v);
+    } catch (const py::error_already_set&) {
+        a = {};
+    }
+    if (!a) throw py::type_error(fmt::format("{} must be an array of numbers of shape (height, width, 3)", name));
+    if (a.ndim() != 3 || a.shape(2) != 3 || a.shape(0) < 1 || a.shape(1) < 1)
+        throw py::value_error(fmt::format("{} must have shape (height, width, 3), not {}", name,
+                                          py::str(py::tuple(py::cast(std::vector<py::ssize_t>(a.shape(), a.shape() + a.ndim())))).cast<std::string>()));
+    Image img(int(a.shape(1)), int(a.shape(0)));
+    std::copy(a.data(), a.data() + img.pixel_count() * 3, img.data());
+    return img;
+}
+
+// Runs the job on a worker thread while this (Python's) thread, with the GIL released, waits and
+// every 20 ms lets Python run its signal handlers: a KeyboardInterrupt (or any exception a
+// handler raises) cancels the render after its current batch of passes and is raised here.
+RenderResult run_interruptibly(RenderJob& job) {
+    std::atomic<bool> cancel{false};
+    job.settings.cancel = &cancel;
+    std::mutex m;
+    std::condition_variable cv;
+    bool done = false;
+    std::optional<RenderResult> result;
+    std::exception_ptr failure;
+    bool python_error = false;
+    {
+        py::gil_scoped_release release;
+        std::thread worker([&] {
+            try {
+                result = job.run();
+            } catch (...) {
+                failure = std::current_exception();
+            }
+            std::lock_guard<std::mutex> lock(m);
+            done = true;
+            cv.notify_all();
+        });
+        std::unique_lock<std::mutex> lock(m);
+        while (!done) {
+            cv.wait_for(lock, std::chrono::milliseconds(20));
+            if (done || python_error) continue;
+            lock.unlock();
+            {
+                py::gil_scoped_acquire acquire;
+                if (PyErr_CheckSignals() != 0) {
+                    python_error = true;  // the error stays set until it is raised below
+                    cancel = true;
+                }
+            }
+            lock.lock();
+        }
+        lock.unlock();
+        worker.join();
+    }
+    if (python_error) throw py::error_already_set();
+    if (failure) {
+        try {
+            std::rethrow_exception(failure);
+        } catch (const UsageError& e) {
+            throw py::value_error(e.what());
+        }
+    }
+    return std::move(*result);
+}
+
+py::tuple py_render(const py::object& scene_obj, const py::object& algorithm, std::optional<uint64_t> spp, uint64_t seed, int threads,
+                 double time, const py::object& resolution, std::optional<int> max_depth, const py::object& sampler) {
+    std::shared_ptr<PyScene> scene = scene_argument(scene_obj);
+    JobRequest request;
+    if (!algorithm.is_none()) {
+        const std::string name = string_argument(algorithm, "algorithm", algorithm_names());
+        request.algorithm = translating([&] { return integrator_or_usage_error(name).name; });
+    }
+    if (spp) {
+        if (*spp == 0) throw py::value_error("spp must be a positive number of samples");
+        request.spp = *spp;
+    }
+    if (time < 0 || !std::isfinite(time)) throw py::value_error("time must be a positive number of seconds (0: none)");
+    request.time_limit = time;
+    request.seed = seed;
+    request.max_depth = max_depth;
+    if (!resolution.is_none()) {
+        const auto size = py::isinstance<py::tuple>(resolution) || py::isinstance<py::list>(resolution)
+                              ? std::optional<std::vector<int>>(resolution.cast<std::vector<int>>())
+                              : std::nullopt;
+        if (!size || size->size() != 2) throw py::type_error("resolution must be a (width, height) pair of ints");
+        if ((*size)[0] < 1 || (*size)[1] < 1) throw py::value_error("resolution must be positive");
+        request.width = (*size)[0], request.height = (*size)[1];
+    }
+    const std::string sampler_name = string_argument(sampler, "sampler", "independent, sobol");
+    if (sampler_name != "independent" && sampler_name != "sobol")
+        throw py::value_error(fmt::format("unknown sampler '{}'; valid: independent, sobol", sampler_name));
+    request.sampler = sampler_name == "sobol" ? SamplerKind::Sobol : SamplerKind::Independent;
+    if (threads < 0) throw py::value_error("threads must be 0 (all cores) or positive");
+
+    if (!scene->built) scene->built = std::shared_ptr<const Scene>(Scene::build(scene->choice.description));
+    RenderJob job = translating([&] { return RenderJob(scene->choice, request, scene->built); });
+    std::optional<tbb::global_control> limit;
+    if (threads > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, size_t(threads));
+    const RenderResult r = run_interruptibly(job);
+    return py::make_tuple(to_array(r.film.mean()), to_array(r.film.standard_error()));
+}
+
+// nlohmann::json -> Python objects.
+py::object to_python(const nlohmann::json& j) {
+    if (j.is_object()) {
+        py::dict d;
+        for (const auto& [k, v] : j.items()) d[py::str(k)] = to_python(v);
+        return d;
+    }
+    if (j.is_array()) {
+        py::list l;
+        for (const auto& v : j) l.append(to_python(v));
+        return l;
+    }
+    if (j.is_boolean()) return py::bool_(j.get<bool>());
+    if (j.is_number_integer()) return py::int_(j.get<long long>());
+    if (j.is_number()) return py::float_(j.get<double>());
+    if (j.is_string()) return py::str(j.get<std::string>());
+    return py::none();
+}
+
+}  // namespace
+
+PYBIND11_MODULE(pathlab, m) {
+    m.doc() = "pathlab: a physically based Monte Carlo renderer and light-transport laboratory (see README, Python)";
+    m.attr("__version__") = PATHLAB_VERSION;
+
+    py::class_<PyScene, std::shared_ptr<PyScene>>(m, "Scene", "A built-in scene or a scene file, loaded by pathlab.load()")
+        .def_property_readonly("name", [](const PyScene& s) { return s.choice.name; })
+        .def_property_readonly("index", [](const PyScene& s) -> py::object { return s.choice.builtin ? py::object(py::int_(*s.choice.builtin)) : py::object(py::none()); },
+                               "The course index of a built-in scene, else None")
+        .def_property_readonly("file", [](const PyScene& s) -> py::object { return s.choice.file.empty() ? py::object(py::none()) : py::object(py::str(s.choice.file)); })
+        .def_property_readonly("resolution", [](const PyScene& s) { return py::make_tuple(s.choice.description.width, s.choice.description.height); },
+                               "(width, height)")
+        .def_property_readonly("parameters", [](const PyScene& s) { return s.choice.parameters; },
+                               "A scene file's $name parameters and the values they took")
+        .def_property_readonly("hash", [](const PyScene& s) { return s.choice.hash; }, "A scene file's identity (as in reference manifests)")
+        .def("__repr__", [](const PyScene& s) {
+            return s.choice.builtin ? fmt::format("<pathlab.Scene {} {}>", *s.choice.builtin, s.choice.name)
+                                    : fmt::format("<pathlab.Scene {}>", s.choice.file);
+        });
+
+    m.def("scenes", [] {
+        std::vector<std::string> names;
+        for (const BuiltinSceneInfo& b : builtin_scenes()) names.push_back(b.name);
+        return names;
+    }, "The built-in (course) scenes' names, by course index");
+    m.def("algorithms", [] {
+        std::vector<std::string> names;
+        for (const IntegratorInfo& e : integrators()) names.push_back(e.name);
+        return names;
+    }, "The estimators' names (the values of algorithm=)");
+    m.def("load", &py_load, py::arg("scene"), py::arg("defines") = std::map<std::string, std::string>{},
+          "A built-in scene (course index, name or acronym) or a scene file, with values for its $name parameters");
+    m.def("render", &py_render, py::arg("scene"), py::arg("algorithm") = py::none(), py::arg("spp") = py::none(), py::arg("seed") = 1234,
+          py::arg("threads") = 0, py::kw_only(), py::arg("time") = 0.0, py::arg("resolution") = py::none(), py::arg("max_depth") = py::none(),
+          py::arg("sampler") = "independent",
+          "Renders a scene (a pathlab.Scene, or what load() takes) and returns (image, standard_error), float32 arrays of shape\n"
+          "(height, width, 3). As the command line: algorithm defaults to the scene file's integrator, else pt-mis; spp to the\n"
+          "scene file's sample count, else 64 (unlimited with time=seconds); seed to 1234; threads=0 uses all cores. The same\n"
+          "settings give the same bytes as `pathlab SCENE -a ALGORITHM --spp N --seed S -o out.exr`.");
+    m.def("compare", [](const py::object& a, const py::object& b) {
+        const Image ia = to_image(a, "a"), ib = to_image(b, "b");
+        if (ia.width() != ib.width() || ia.height() != ib.height())
+            throw py::value_error(fmt::format("a is {}x{} but b is {}x{}: images of different sizes cannot be compared", ia.width(), ia.height(),
+                                              ib.width(), ib.height()));
+        return to_python(image_difference_json(compare_images(ia, ib)));
+    }, py::arg("a"), py::arg("b"),
+          "The statistics of a - b (b the reference), as `pathlab compare A B --json` prints them: per channel and over all, the mean\n"
+          "difference, MAE, RMSE, relMSE and largest difference, and the NaN/Inf counts. a and b are arrays or image files.");
+    m.def("rmse", [](const py::object& img, const py::object& reference, const py::object& reference_se) {
+        const Image a = to_image(img, "image"), r = to_image(reference, "reference");
+        const Image se = reference_se.is_none() ? Image() : to_image(reference_se, "reference_se");
+        if (a.width() != r.width() || a.height() != r.height()) throw py::value_error("image and reference differ in size");
+        return rmse_against_reference(a, r, se);
+    }, py::arg("image"), py::arg("reference"), py::arg("reference_se") = py::none(),
+          "RMSE against a reference with the reference's own noise (its standard errors, if given) removed, as pathlab report computes it");
+    m.def("write", [](const std::string& path, const py::object& img, float exposure) {
+        const Image image = to_image(img, "image");
+        translating([&] {
+            write_image(image, path, exposure);
+            return 0;
+        });
+    }, py::arg("path"), py::arg("image"), py::arg("exposure") = 0.0f,
+          "Writes an (H, W, 3) array; the format follows the extension: .exr, .hdr, .pfm, .png (sRGB, with exposure in stops)");
+    m.def("read", [](const std::string& path) { return to_array(translating([&] { return read_image(path); })); }, py::arg("path"),
+          "Reads a linear image (.exr, .hdr, .pfm) as a float32 array of shape (height, width, 3)");
+}

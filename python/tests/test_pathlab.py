@@ -1,0 +1,157 @@
+"""Tests of the Python module (run by ctest with pytest: ctest -R Python).
+
+The module must give the command line's bytes for the same settings, compare's statistics
+under the same names, a KeyboardInterrupt within a pass after Ctrl-C, and TypeErrors that name
+the valid values.
+"""
+import json
+import os
+import signal
+import subprocess
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import pathlab
+
+BINARY = os.environ["PATHLAB_BINARY"]
+SOURCE = os.environ["PATHLAB_SOURCE_DIR"]
+
+
+def cli(*args):
+    r = subprocess.run([BINARY, *map(str, args)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    return r.stdout
+
+
+def same_bits(a, b):
+    return a.shape == b.shape and a.dtype == b.dtype and np.array_equal(a.view(np.uint32), b.view(np.uint32))
+
+
+def test_lists_the_scenes_and_the_estimators():
+    assert pathlab.scenes()[3] == "ceiling-glossy"
+    assert len(pathlab.scenes()) == 8
+    assert {"pt-mis", "direct-mis", "bdpt", "vcm"} <= set(pathlab.algorithms())
+
+
+def test_load_takes_indices_names_and_files_with_defines():
+    assert pathlab.load(3).name == "ceiling-glossy"
+    assert pathlab.load("ceiling-glossy").index == 3
+    scene = pathlab.load(os.path.join(SOURCE, "scenes/example.xml"), defines={"spp": "8"})
+    assert scene.index is None and scene.name == "example"
+    assert scene.parameters == {"spp": "8"}
+    assert scene.resolution == (320, 240)
+    with pytest.raises(ValueError, match="no scene uses \\$sp"):
+        pathlab.load(os.path.join(SOURCE, "scenes/example.xml"), defines={"sp": "8"})
+
+
+@pytest.mark.parametrize("scene,algorithm,extra", [
+    ("3", "pt-mis", []),
+    ("4", "bdpt", []),  # splats: the light-tracing strategy
+    ("scenes/example.xml", "direct-mis", ["-D", "spp=2"]),
+])
+def test_render_equals_the_command_line_bit_for_bit(tmp_path, scene, algorithm, extra):
+    path = os.path.join(SOURCE, scene) if scene.endswith(".xml") else scene
+    out = tmp_path / "cli.exr"
+    cli(path, "-a", algorithm, "--spp", 3, "--seed", 77, "--resolution", "20x14", "-q", "-o", out, *extra)
+    defines = dict([extra[1].split("=")]) if extra else {}
+    img, stderr = pathlab.render(pathlab.load(path, defines=defines), algorithm=algorithm, spp=3, seed=77, resolution=(20, 14))
+    assert img.dtype == np.float32 and img.shape == (14, 20, 3) and stderr.shape == (14, 20, 3)
+    assert same_bits(img, pathlab.read(str(out)))
+    # Any thread count, and a scene reused for a second render, give the same bytes.
+    again, _ = pathlab.render(pathlab.load(path, defines=defines), algorithm=algorithm, spp=3, seed=77, resolution=(20, 14), threads=1)
+    assert same_bits(img, again)
+
+
+def test_a_scene_files_own_settings_as_on_the_command_line(tmp_path):
+    path = os.path.join(SOURCE, "scenes/example.xml")
+    cli(path, "-D", "spp=2", "--resolution", "16x12", "-q", "-o", tmp_path / "a.pfm")
+    img, _ = pathlab.render(pathlab.load(path, defines={"spp": "2"}), resolution=(16, 12))
+    assert same_bits(img, pathlab.read(str(tmp_path / "a.pfm")))
+
+
+def test_compare_gives_the_command_lines_statistics(tmp_path):
+    a, _ = pathlab.render(2, spp=2, seed=1, resolution=(16, 16))
+    b, _ = pathlab.render(2, spp=8, seed=2, resolution=(16, 16))
+    pathlab.write(str(tmp_path / "a.exr"), a)
+    pathlab.write(str(tmp_path / "b.exr"), b)
+    expected = json.loads(cli("compare", tmp_path / "a.exr", tmp_path / "b.exr", "--json"))
+    for key in ("a", "b"):
+        del expected[key]
+    assert pathlab.compare(a, b) == expected
+    assert pathlab.compare(str(tmp_path / "a.exr"), b) == expected
+    assert pathlab.compare(a, a)["all"]["rmse"] == 0
+
+
+def test_write_and_read_round_trip(tmp_path):
+    rng = np.random.default_rng(5)
+    img = rng.random((7, 9, 3), dtype=np.float32) * 4
+    for ext in ("exr", "pfm"):
+        pathlab.write(str(tmp_path / f"x.{ext}"), img)
+        assert same_bits(pathlab.read(str(tmp_path / f"x.{ext}")), img)
+    pathlab.write(str(tmp_path / "x.png"), img.astype(np.float64), exposure=-1)  # float64 converted
+    assert (tmp_path / "x.png").stat().st_size > 0
+    with pytest.raises(ValueError, match="shape"):
+        pathlab.write(str(tmp_path / "y.exr"), np.zeros((4, 4)))
+    with pytest.raises(ValueError, match=".exr, .hdr, .pfm, .png"):
+        pathlab.write(str(tmp_path / "y.jpg"), img)
+
+
+def test_ctrl_c_stops_the_render_with_keyboard_interrupt_within_a_pass():
+    scene = pathlab.load(3)
+    pathlab.render(scene, spp=1, resolution=(64, 64))  # build the scene first
+    sent = []
+
+    def interrupt():
+        sent.append(time.monotonic())
+        os.kill(os.getpid(), signal.SIGINT)
+
+    timer = threading.Timer(0.5, interrupt)
+    timer.start()
+    start = time.monotonic()
+    with pytest.raises(KeyboardInterrupt):  # (a render that ignored Ctrl-C would end after its 20 s)
+        pathlab.render(scene, time=20, resolution=(64, 64))
+    stopped = time.monotonic()
+    timer.join()
+    assert sent, "the signal was not sent"
+    # A pass of 64x64 takes milliseconds; the render stops after its current batch of them.
+    assert stopped - sent[0] < 2.0, f"stopped {stopped - sent[0]:.2f} s after Ctrl-C"
+    assert stopped - start < 10
+
+
+def test_the_gil_is_released_while_rendering():
+    ticks = [0]
+    stop = threading.Event()
+
+    def count():
+        while not stop.is_set():
+            ticks[0] += 1
+            time.sleep(0.001)
+
+    t = threading.Thread(target=count)
+    t.start()
+    pathlab.render(2, time=0.5, resolution=(32, 32))
+    stop.set()
+    t.join()
+    assert ticks[0] > 50, "the other thread did not run while rendering"
+
+
+def test_wrong_types_raise_type_error_naming_the_valid_values():
+    with pytest.raises(TypeError, match="pt-mis"):
+        pathlab.render(3, algorithm=4)
+    with pytest.raises(TypeError, match="ceiling-glossy"):
+        pathlab.render([3])
+    with pytest.raises(TypeError, match="ceiling-glossy"):
+        pathlab.load(3.5)
+    with pytest.raises(TypeError, match="spp"):  # pybind11 lists the signature: names and types
+        pathlab.render(3, spp="many")
+    with pytest.raises(TypeError, match="independent, sobol"):
+        pathlab.render(3, sampler=1)
+    with pytest.raises(TypeError, match="shape"):
+        pathlab.compare({"a": 1}, np.zeros((2, 2, 3)))
+    with pytest.raises(ValueError, match="(?s)unknown algorithm 'pt-magic'.*pt-mis"):
+        pathlab.render(3, algorithm="pt-magic", spp=1)
+    with pytest.raises(ValueError, match="(?s)unknown scene 'kitchen'.*ceiling-glossy"):
+        pathlab.load("kitchen")

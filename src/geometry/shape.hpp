@@ -7,9 +7,14 @@
 #include <string>
 #include <vector>
 
+#include "core/transform.hpp"
 #include "core/vec.hpp"
 
 namespace pathlab {
+
+// How a mesh's surface coordinates uv are found at a hit: interpolated from its per-vertex
+// `uvs`, or (a disk's triangle fan) computed from the hit point as Mitsuba 3's disk does.
+enum class UvMap : unsigned char { Vertices, Disk };
 
 struct MeshDesc {
     std::string name;
@@ -19,6 +24,8 @@ struct MeshDesc {
     std::vector<std::array<uint32_t, 3>> triangles;
     uint32_t material = 0;
     Rgb emission{0.0f};  // radiance of a one-sided area emitter on the winding-normal side
+    UvMap uv_map = UvMap::Vertices;
+    Transform to_world, to_object;  // UvMap::Disk: the unit disk's placement and its inverse
 };
 
 struct SphereDesc {
@@ -27,6 +34,9 @@ struct SphereDesc {
     uint32_t material = 0;
     bool flip_normals = false;  // normals point inwards
     Rgb emission{0.0f};         // radiance of a one-sided area emitter on the normal side
+    // The world directions of the sphere's own x, y, z axes (its to_world's rotation), which
+    // its uv parameterisation (the poles on z, u = 0 towards x) follows.
+    std::array<Vec3f, 3> axes{{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
 };
 
 }  // namespace pathlab

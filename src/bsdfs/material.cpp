@@ -1,17 +1,111 @@
 #include "bsdfs/material.hpp"
 
 namespace pathlab {
+namespace {
+
+// Radiance-mode values of a model (std::visit: the hot loop's inlined dispatch is visit_model).
+Rgb eval_of(const MaterialModel& m, const Vec3f& wi, const Vec3f& wo) {
+    return std::visit([&](const auto& x) { return x.eval(wi, wo); }, m);
+}
+float pdf_of(const MaterialModel& m, const Vec3f& wi, const Vec3f& wo) {
+    return std::visit([&](const auto& x) { return x.pdf(wi, wo); }, m);
+}
+Rgb eval_and_pdf_of(const MaterialModel& m, const Vec3f& wi, const Vec3f& wo, float& pdf) {
+    return std::visit(
+        [&](const auto& x) {
+            if constexpr (requires { x.eval_and_pdf(wi, wo, pdf); }) {
+                return x.eval_and_pdf(wi, wo, pdf);
+            } else {
+                pdf = x.pdf(wi, wo);
+                return x.eval(wi, wo);
+            }
+        },
+        m);
+}
+
+// Both directions on the same side of the geometric surface as of the shading one.
+bool sides_agree(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo) {
+    const Vec3f ng = ctx.frame.to_local(ctx.ng);
+    return dot(wi, ng) * wi.z > 0 && dot(wo, ng) * wo.z > 0;
+}
+
+}  // namespace
+
+void Material::prepare() {
+    varies = textures != nullptr;
+    // Anisotropic microfacets (alpha_u != alpha_v, or either given by a texture) act along dp/du.
+    const MicrofacetDistribution* d = nullptr;
+    if (const auto* r = std::get_if<RoughConductorMaterial>(&model)) d = &r->distribution;
+    if (const auto* r = std::get_if<RoughDielectricMaterial>(&model)) d = &r->distribution;
+    bool anisotropic = d && d->is_anisotropic();
+    if (d && textures)
+        for (const TextureBinding& b : textures->bindings)
+            anisotropic = anisotropic || b.slot == MicrofacetDistribution::kSlotAlphaU || b.slot == MicrofacetDistribution::kSlotAlphaV;
+    tangent_frame = anisotropic || perturbed();
+    surface_coordinates = varies || tangent_frame;
+}
+
+MaterialModel Material::model_at(const Vec2f& uv) const {
+    MaterialModel m = model;
+    if (!textures || textures->bindings.empty()) return m;
+    for (const TextureBinding& b : textures->bindings) {
+        const Rgb v = b.scalar ? Rgb(b.texture->eval_1(uv)) : b.texture->eval(uv);
+        std::visit(
+            [&](auto& x) {
+                if constexpr (requires { x.set_texel(b.slot, v); }) x.set_texel(b.slot, v);
+            },
+            m);
+    }
+    std::visit(
+        [](auto& x) {
+            if constexpr (requires { x.texels_changed(); }) x.texels_changed();
+        },
+        m);
+    return m;
+}
+
+Frame Material::shading_frame(const Vec3f& n, const Vec3f& ng, bool back, const Vec3f& dpdu, const Vec3f& dpdv, const Vec2f& uv) const {
+    const Frame f = perturbed() ? perturbed_frame(*textures, n, ng, dpdu, dpdv, uv) : pathlab::tangent_frame(n, dpdu);
+    if (!back) return f;
+    Frame r;
+    r.n = -f.n;
+    r.s = f.s;
+    r.t = cross(r.n, r.s);
+    return r;
+}
+
+float Material::context_factor(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo) const {
+    if (ctx.mode == TransportMode::Importance) return importance_factor(ctx, wi, wo);
+    if (perturbed() && !sides_agree(ctx, wi, wo)) return 0.0f;
+    return 1.0f;
+}
+
+Rgb Material::eval_varying(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo) const {
+    return eval_of(model_at(ctx.uv), wi, wo) * context_factor(ctx, wi, wo);
+}
+
+float Material::pdf_varying(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo) const { return pdf_of(model_at(ctx.uv), wi, wo); }
+
+Rgb Material::eval_and_pdf_varying(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo, float& pdf) const {
+    return eval_and_pdf_of(model_at(ctx.uv), wi, wo, pdf) * context_factor(ctx, wi, wo);
+}
 
 std::optional<BsdfSample> Material::sample_adjusted(const BsdfContext& ctx, const Vec3f& wi, const Vec2f& u) const {
-    std::optional<BsdfSample> s = sample(wi, u);
-    if (!s) return s;
-    if (ctx.mode == TransportMode::Importance) {
-        const float k = importance_factor(ctx, wi, s->wo);
-        if (!(k > 0)) return std::nullopt;
-        s->f *= k;
-    }
-    if (ctx.reverse_pdf) s->pdf_rev = s->delta ? s->pdfW : pdf(s->wo, wi);
-    return s;
+    const auto adjust = [&](const MaterialModel& m) -> std::optional<BsdfSample> {
+        std::optional<BsdfSample> s = visit_model(m, [&](const auto& x) { return x.sample(wi, u); });
+        if (!s) return s;
+        if (ctx.mode == TransportMode::Importance) {
+            const float k = importance_factor(ctx, wi, s->wo);
+            if (!(k > 0)) return std::nullopt;
+            s->f *= k;
+        } else if (perturbed() && !sides_agree(ctx, wi, s->wo)) {
+            return std::nullopt;
+        }
+        if (ctx.reverse_pdf) s->pdf_rev = s->delta ? s->pdfW : pdf_of(m, s->wo, wi);
+        return s;
+    };
+    if (!varies) return adjust(model);
+    return adjust(model_at(ctx.uv));
 }
 
 float Material::importance_factor(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo) const {

@@ -9,10 +9,19 @@
 //  - pdf(wi, wo) and BsdfSample::pdfW are densities per unit solid angle of wo.
 //  - sample(wi, u) draws wo given two uniform numbers in [0,1).
 // The models (one header each) compute radiance-mode values. Material's functions that take a
-// BsdfContext apply the transport mode (bsdf_context.hpp) and fill the reverse pdf; the ones
-// without a context are the plain radiance-mode models.
+// BsdfContext apply the transport mode (bsdf_context.hpp), fill the reverse pdf and evaluate
+// the material's textures at the context's uv (material_textures.hpp); the ones without a
+// context are the plain radiance-mode models (of a textured material: the model of its
+// textures' largest values, which only its lobe flags and is_black() use).
+//
+// Normal and bump maps tilt the shading frame (make_shading_point builds it with
+// shading_frame()); it is then a shading normal like an interpolated vertex normal, with one
+// addition: directions on different sides of the geometric and the perturbed shading surface
+// are refused in radiance mode too (importance mode refuses them for every shading normal), so
+// that both modes see the same BSDF and bidirectional methods agree with path tracing.
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <variant>
 
@@ -20,6 +29,7 @@
 #include "bsdfs/conductor.hpp"
 #include "bsdfs/ior.hpp"
 #include "bsdfs/dielectric.hpp"
+#include "bsdfs/material_textures.hpp"
 #include "bsdfs/phong.hpp"
 #include "bsdfs/plastic.hpp"
 #include "bsdfs/roughconductor.hpp"
@@ -54,6 +64,27 @@ struct Material {
     // to face the incoming direction); one-sided ones are black from behind. A dielectric
     // is neither: both of its sides are meaningful, and its frame is never flipped.
     bool two_sided = true;
+    // Set by set_textures() and prepare() (Scene::build calls it), read at every hit:
+    bool varies = false;               // it has textures, a normal or a bump map
+    bool tangent_frame = false;        // its shading frame follows dp/du (anisotropic, normal or bump mapped)
+    bool surface_coordinates = false;  // either: it uses uv, dp/du and dp/dv
+    std::shared_ptr<const MaterialTextures> textures = nullptr;  // null: the same everywhere
+
+    // Binds textures (and a normal or bump map) to the material.
+    void set_textures(MaterialTextures t) {
+        textures = std::make_shared<const MaterialTextures>(std::move(t));
+        prepare();
+    }
+    // Computes the two flags above from the model and the textures.
+    void prepare();
+    bool perturbed() const { return textures && textures->perturbation != FramePerturbation::None; }
+    // The model at surface coordinates uv: the textured parameters set to their values there.
+    MaterialModel model_at(const Vec2f& uv) const;
+    // The shading frame at a hit whose front-side unit shading and geometric normals are n, ng
+    // (for tangent_frame materials; the others use Frame(n)): tangent_frame() or
+    // perturbed_frame() of material_textures.hpp, reversed (n -> -n) for the back of a
+    // two-sided material, which is the same tilted surface seen from behind.
+    Frame shading_frame(const Vec3f& n, const Vec3f& ng, bool back, const Vec3f& dpdu, const Vec3f& dpdv, const Vec2f& uv) const;
 
     Rgb eval(const Vec3f& wi, const Vec3f& wo) const {
         return std::visit([&](const auto& m) { return m.eval(wi, wo); }, model);
@@ -77,22 +108,33 @@ struct Material {
     [[gnu::always_inline]] std::optional<BsdfSample> sample(const Vec3f& wi, const Vec2f& u) const {
         return visit_model(model, [&](const auto& m) { return m.sample(wi, u); });
     }
-    // ---- with a shading context (transport mode, reverse pdf) ----------------------------
-    // Radiance mode without a reverse pdf is the plain model and stays inline (the path
-    // tracers' hot loop); the rest takes the out-of-line adjusted path.
+    // ---- with a shading context (transport mode, reverse pdf, uv) ------------------------
+    // Radiance mode without a reverse pdf, of a material that does not vary, is the plain
+    // model and stays inline (the path tracers' hot loop); the rest takes the out-of-line
+    // adjusted path.
     Rgb eval(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo) const {
-        if (ctx.mode == TransportMode::Radiance) [[likely]]
-            return eval(wi, wo);
-        return eval(wi, wo) * importance_factor(ctx, wi, wo);
+        if (!varies) [[likely]] {
+            if (ctx.mode == TransportMode::Radiance) [[likely]]
+                return eval(wi, wo);
+            return eval(wi, wo) * importance_factor(ctx, wi, wo);
+        }
+        return eval_varying(ctx, wi, wo);
     }
-    float pdf(const BsdfContext&, const Vec3f& wi, const Vec3f& wo) const { return pdf(wi, wo); }
+    float pdf(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo) const {
+        if (!varies) [[likely]]
+            return pdf(wi, wo);
+        return pdf_varying(ctx, wi, wo);
+    }
     Rgb eval_and_pdf(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo, float& pdf) const {
-        if (ctx.mode == TransportMode::Radiance) [[likely]]
-            return eval_and_pdf(wi, wo, pdf);
-        return eval_and_pdf(wi, wo, pdf) * importance_factor(ctx, wi, wo);
+        if (!varies) [[likely]] {
+            if (ctx.mode == TransportMode::Radiance) [[likely]]
+                return eval_and_pdf(wi, wo, pdf);
+            return eval_and_pdf(wi, wo, pdf) * importance_factor(ctx, wi, wo);
+        }
+        return eval_and_pdf_varying(ctx, wi, wo, pdf);
     }
     [[gnu::always_inline]] std::optional<BsdfSample> sample(const BsdfContext& ctx, const Vec3f& wi, const Vec2f& u) const {
-        if (ctx.mode == TransportMode::Radiance && !ctx.reverse_pdf) [[likely]]
+        if (ctx.mode == TransportMode::Radiance && !ctx.reverse_pdf && !varies) [[likely]]
             return sample(wi, u);
         return sample_adjusted(ctx, wi, u);
     }
@@ -120,6 +162,9 @@ struct Material {
     // The context's adjustments (material.cpp: out of line, so that the hot path's visit of the
     // model stays the only one in the integrators' code and is inlined there).
     std::optional<BsdfSample> sample_adjusted(const BsdfContext& ctx, const Vec3f& wi, const Vec2f& u) const;
+    Rgb eval_varying(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo) const;
+    float pdf_varying(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo) const;
+    Rgb eval_and_pdf_varying(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo, float& pdf) const;
 
     // What importance transport multiplies the radiance-mode BSDF by (bsdf_context.hpp): the
     // refraction factor (eta_wo / eta_wi)^2 and the shading-normal correction; 0 for directions
@@ -127,6 +172,11 @@ struct Material {
     float importance_factor(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo) const;
 
 private:
+    // What the context multiplies a varying material's radiance-mode BSDF by: importance mode's
+    // factor, or for a perturbed frame in radiance mode 0 where wi or wo lie on different sides
+    // of the geometric and the shading surface (1 elsewhere).
+    float context_factor(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo) const;
+
     static uint32_t lobes_of(const PhongMaterial& m) {
         return kLobeReflection | (pathlab::is_black(m.diffuse) ? 0u : kLobeDiffuse) | (pathlab::is_black(m.specular) ? 0u : kLobeGlossy);
     }

@@ -2,6 +2,9 @@
 
 #include <fmt/format.h>
 
+#include "bsdfs/bumpmap.hpp"
+#include "bsdfs/normalmap.hpp"
+
 namespace pathlab {
 namespace {
 
@@ -32,6 +35,8 @@ const std::vector<BsdfPlugin>& bsdf_plugins() {
         {plastic_plugin, one_sided<PlasticMaterial, read_plastic>},
         {roughplastic_plugin, one_sided<RoughPlasticMaterial, read_roughplastic>},
         {twosided_plugin, nullptr},
+        {normalmap_plugin, nullptr},
+        {bumpmap_plugin, nullptr},
     };
     return table;
 }

@@ -10,6 +10,7 @@
 #include "lights/registry.hpp"
 #include "render/film.hpp"
 #include "samplers/sampler.hpp"
+#include "textures/registry.hpp"
 
 namespace pathlab {
 namespace {
@@ -31,6 +32,7 @@ std::vector<PluginInfo> all_plugins() {
     out.push_back(independent_plugin());
     for (const ShapePlugin& s : shape_plugins()) out.push_back(s.info());
     for (const BsdfPlugin& b : bsdf_plugins()) out.push_back(b.info());
+    for (const TexturePlugin& t : texture_plugins()) out.push_back(t.info());
     for (const EmitterPlugin& e : emitter_plugins()) out.push_back(e.info());
     return out;
 }
@@ -51,7 +53,8 @@ std::string plugin_reference_markdown() {
         md += fmt::format("| {} | | | | {} |\n", type, cell(p.summary));
         for (const ParamInfo& q : p.params) {
             const std::string name = q.old_name.empty() ? fmt::format("`{}`", q.name) : fmt::format("`{}` (`{}`)", q.name, q.old_name);
-            md += fmt::format("| | {} | {} | {} | {} |\n", name, param_type_name(q.type), cell(q.default_value), cell(q.doc));
+            const std::string type = std::string(param_type_name(q.type)) + (q.texture_slot >= 0 ? " or texture" : "");
+            md += fmt::format("| | {} | {} | {} | {} |\n", name, type, cell(q.default_value), cell(q.doc));
         }
     }
     return md;

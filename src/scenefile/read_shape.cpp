@@ -26,11 +26,12 @@ void read_shape(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b) {
             if (material) xml.fail(c, "a shape can have only one BSDF");
             if (tag == "bsdf") {
                 if (c.attribute("id")) xml.fail(c, "a nested <bsdf> cannot have an id; declare it at the top level and use <ref>");
-                material = b.add_material(read_bsdf(xml, c));
+                material = b.add_material(read_bsdf(xml, c, b));
             } else {
                 xml.check_attributes(c, {"id", "name"});
                 const std::string id = xml.attr(c, "id");
                 const auto it = b.named_bsdfs.find(id);
+                if (b.named_textures.count(id)) xml.fail(c, fmt::format("'{}' is a texture, not a <bsdf>; textures are given to a BSDF's parameters", id));
                 if (it == b.named_bsdfs.end()) xml.fail(c, fmt::format("no <bsdf> with id '{}' is declared before this reference", id));
                 material = it->second;
             }

@@ -39,10 +39,11 @@ SceneDescription load_scene_text(const std::string& text, const std::string& fil
         else if (tag == "integrator") read_integrator(xml, n, b);
         else if (tag == "sensor") read_sensor(xml, n, b);
         else if (tag == "bsdf") read_named_bsdf(xml, n, b);
+        else if (tag == "texture") read_named_texture(xml, n, b);
         else if (tag == "shape") read_shape(xml, n, b);
         else if (tag == "emitter") read_free_emitter(xml, n, b);
         else xml.fail(n, fmt::format("unsupported element <{}> in <scene>; supported: <default>, <integrator>, <sensor>, "
-                                     "<bsdf>, <shape>, <emitter>", tag));
+                                     "<bsdf>, <texture>, <shape>, <emitter>", tag));
     }
     if (b.desc.meshes.empty() && b.desc.spheres.empty()) xml.fail_file("the scene has no shapes");
     return std::move(b.desc);

@@ -8,6 +8,7 @@
 //   pathlab_bench bdpt     bdpt against pt-mis: equal-time RMSE, and samples per second
 //   pathlab_bench pm       photons per second; hashed grid against k-d tree (build, query)
 //   pathlab_bench ic       irradiance caching against pt-mis and bdpt at short budgets
+//   pathlab_bench textures textured against constant materials per sample; texture lookups
 #include <CLI/CLI.hpp>
 
 #include "bidirectional.hpp"
@@ -16,6 +17,7 @@
 #include "irradiance_caching.hpp"
 #include "photon_mapping.hpp"
 #include "performance.hpp"
+#include "textures.hpp"
 
 int main(int argc, char** argv) {
     using namespace pathlab::bench;
@@ -73,7 +75,15 @@ int main(int argc, char** argv) {
     icc->add_option("--budgets", icopt.budgets, "Seconds per render")->delimiter(',')->capture_default_str();
     icc->add_option("--repeats", icopt.repeats, "Rounds (median reported)")->capture_default_str();
     icc->add_option("--scenes", icopt.scenes, "Course scene indices")->delimiter(',')->capture_default_str();
+    TexturesOptions tx;
+    CLI::App* txc = app.add_subcommand("textures", "Textured against constant materials per sample; texture lookups");
+    txc->add_option("--size", tx.size, "Image width and height")->capture_default_str();
+    txc->add_option("--seconds", tx.seconds, "Seconds per timed render")->capture_default_str();
+    txc->add_option("--repeats", tx.repeats, "Interleaved rounds (medians reported)")->capture_default_str();
+    txc->add_option("--lookups", tx.lookups, "Texture lookups per timing")->capture_default_str();
+    txc->add_option("--scene", tx.scene_file, "The textured scene file (default: scenes/textures.xml)");
     CLI11_PARSE(app, argc, argv);
+    if (*txc) textures_suite(tx);
     if (*icc) irradiance_caching_suite(icopt);
     if (*pmc) photon_mapping_suite(pm);
     if (*bd) bidirectional_suite(b);

@@ -5,8 +5,8 @@
 // value c in [0, 1]^3 is the normal 2 c - 1 in the tangent frame (s along dp/du, t = n x s, n
 // the shading normal; material_textures.hpp). The texture should be read with raw = true
 // (normal maps are linear data, not sRGB colours). A normal map of (0.5, 0.5, 1) everywhere is
-// the unperturbed frame. Can wrap twosided (or be wrapped by it) but not a dielectric's two sides
-// differently: the tilted normal is the same surface's from both sides.
+// the unperturbed frame. It may wrap twosided or be wrapped by it: either way the back of the
+// surface is the same tilted surface seen from behind (material.hpp).
 #pragma once
 
 #include "core/properties.hpp"

@@ -14,6 +14,15 @@ namespace {
 
 Rgb lerp(const Rgb& a, const Rgb& b, float t) { return a + (b - a) * t; }
 
+// floor(x) as an int where |x| < 2^30 (every lookup but those at absurd or non-finite uv),
+// without a call to floor().
+bool floor_int(double x, int& i) {
+    if (!(x > -1073741824.0 && x < 1073741824.0)) return false;
+    i = int(x);  // truncates towards zero
+    if (double(i) > x) --i;
+    return true;
+}
+
 }  // namespace
 
 BitmapTexture::BitmapTexture(int width, int height, std::vector<Rgb> texels, FilterType filter, WrapMode wrap, UvTransform to_uv,
@@ -30,7 +39,26 @@ BitmapTexture::BitmapTexture(int width, int height, std::vector<Rgb> texels, Fil
     }
 }
 
+int BitmapTexture::wrap_index(int i, int n) const {
+    if (unsigned(i) < unsigned(n)) return i;  // inside: every mode leaves it
+    switch (wrap_) {
+        case WrapMode::Clamp: return i < 0 ? 0 : n - 1;
+        case WrapMode::Repeat: {
+            const int m = i % n;
+            return m < 0 ? m + n : m;
+        }
+        case WrapMode::Mirror:
+        default: {
+            int m = i % (2 * n);  // 2n < 2^30: images have at most 2^28 texels
+            if (m < 0) m += 2 * n;
+            return m < n ? m : 2 * n - 1 - m;
+        }
+    }
+}
+
 int BitmapTexture::wrap(double i, int n) const {
+    int k;
+    if (floor_int(i, k)) return wrap_index(k, n);
     const double nd = n;
     double m;
     switch (wrap_) {
@@ -49,6 +77,10 @@ int BitmapTexture::wrap(double i, int n) const {
 BitmapTexture::Cell BitmapTexture::bilinear_cell(const Vec2f& uv) const {
     const Vec2f t = to_uv_.apply(uv);
     double x = double(t.x) * width_ - 0.5, y = double(t.y) * height_ - 0.5;
+    int i, j;
+    if (floor_int(x, i) && floor_int(y, j))  // the common case
+        return {wrap_index(i, width_), wrap_index(i + 1, width_), wrap_index(j, height_), wrap_index(j + 1, height_),
+                float(x - i), float(y - j)};
     if (!std::isfinite(x)) x = 0;
     if (!std::isfinite(y)) y = 0;
     const double x0 = std::floor(x), y0 = std::floor(y);
@@ -83,10 +115,14 @@ TexelFootprint BitmapTexture::footprint(const Vec2f& uv) const {
     TexelFootprint f;
     if (filter_ == FilterType::Nearest) {
         const Vec2f t = to_uv_.apply(uv);
-        double x = std::floor(double(t.x) * width_), y = std::floor(double(t.y) * height_);
-        if (!std::isfinite(x)) x = 0;
-        if (!std::isfinite(y)) y = 0;
-        f.index[0] = uint32_t(index(wrap(x, width_), wrap(y, height_)));
+        double x = double(t.x) * width_, y = double(t.y) * height_;
+        int i, j;
+        if (floor_int(x, i) && floor_int(y, j)) {
+            f.index[0] = uint32_t(index(wrap_index(i, width_), wrap_index(j, height_)));
+        } else {
+            x = std::isfinite(x) ? std::floor(x) : 0, y = std::isfinite(y) ? std::floor(y) : 0;
+            f.index[0] = uint32_t(index(wrap(x, width_), wrap(y, height_)));
+        }
         f.weight[0] = 1;
         f.count = 1;
         return f;

@@ -50,6 +50,7 @@ public:
     // The texel index that `i` (an integer, possibly outside [0, n)) wraps to along an axis of
     // n texels.
     int wrap(double i, int n) const;
+    int wrap_index(int i, int n) const;  // the same for an int (n < 2^29)
 
     int width() const { return width_; }
     int height() const { return height_; }

@@ -8,13 +8,17 @@
 //   pathlab_bench bdpt     bdpt against pt-mis: equal-time RMSE, and samples per second
 //   pathlab_bench pm       photons per second; hashed grid against k-d tree (build, query)
 //   pathlab_bench ic       irradiance caching against pt-mis and bdpt at short budgets
+//   pathlab_bench distributed  2 MPI ranks against 1 process, film reduction, checkpoints
+//   pathlab_bench lights   an environment map's cost per sample against the constant environment; spot and IES
 //   pathlab_bench textures textured against constant materials per sample; texture lookups
 #include <CLI/CLI.hpp>
 
 #include "bidirectional.hpp"
+#include "distributed.hpp"
 #include "estimator_efficiency.hpp"
 #include "light_tracing.hpp"
 #include "irradiance_caching.hpp"
+#include "lights.hpp"
 #include "photon_mapping.hpp"
 #include "performance.hpp"
 #include "textures.hpp"
@@ -75,6 +79,24 @@ int main(int argc, char** argv) {
     icc->add_option("--budgets", icopt.budgets, "Seconds per render")->delimiter(',')->capture_default_str();
     icc->add_option("--repeats", icopt.repeats, "Rounds (median reported)")->capture_default_str();
     icc->add_option("--scenes", icopt.scenes, "Course scene indices")->delimiter(',')->capture_default_str();
+    LightsOptions lo;
+    CLI::App* lic = app.add_subcommand("lights", "An environment map's cost per sample against the constant environment; spot and IES");
+    lic->add_option("--size", lo.size, "Image width and height")->capture_default_str();
+    lic->add_option("--seconds", lo.seconds, "Seconds per timed render")->capture_default_str();
+    lic->add_option("--repeats", lo.repeats, "Interleaved rounds (median reported)")->capture_default_str();
+    lic->add_option("--scenes", lo.scenes, "Course scene indices with an environment")->delimiter(',')->capture_default_str();
+    lic->add_option("--map-width", lo.map_width, "Width of the constant environment map")->capture_default_str();
+    DistributedOptions dopt;
+    CLI::App* dist = app.add_subcommand("distributed", "2 MPI ranks against 1 process, film reduction, checkpoint write and size");
+    dist->add_option("--size", dopt.size, "Image width and height of the speedup renders")->capture_default_str();
+    dist->add_option("--spp", dopt.spp, "Their samples per pixel")->capture_default_str();
+    dist->add_option("--scene", dopt.scene, "Their scene")->capture_default_str();
+    dist->add_option("--repeats", dopt.repeats, "Timed runs per figure (median reported)")->capture_default_str();
+    dist->add_option("--film-sizes", dopt.film_sizes, "Film sizes reduced and checkpointed")->delimiter(',')->capture_default_str();
+    CLI::App* worker = app.add_subcommand("distributed-reduce-worker", "(run by `distributed` under mpirun)");
+    worker->group("");
+    worker->add_option("--film-sizes", dopt.film_sizes)->delimiter(',');
+    worker->add_option("--repeats", dopt.repeats);
     TexturesOptions tx;
     CLI::App* txc = app.add_subcommand("textures", "Textured against constant materials per sample; texture lookups");
     txc->add_option("--size", tx.size, "Image width and height")->capture_default_str();
@@ -82,7 +104,15 @@ int main(int argc, char** argv) {
     txc->add_option("--repeats", tx.repeats, "Interleaved rounds (medians reported)")->capture_default_str();
     txc->add_option("--lookups", tx.lookups, "Texture lookups per timing")->capture_default_str();
     txc->add_option("--scene", tx.scene_file, "The textured scene file (default: scenes/textures.xml)");
+    // Under mpirun this program is one rank of the reduction benchmark.
+    std::vector<std::string> args(argv, argv + argc);
     CLI11_PARSE(app, argc, argv);
+    if (*worker) {
+        distributed_reduce_worker(dopt.film_sizes, dopt.repeats, argc, argv);
+        return 0;
+    }
+    if (*dist) distributed_suite(dopt, args[0]);
+    if (*lic) lights_suite(lo);
     if (*txc) textures_suite(tx);
     if (*icc) irradiance_caching_suite(icopt);
     if (*pmc) photon_mapping_suite(pm);

@@ -67,6 +67,7 @@ std::string checker(const std::string& param, const std::string& value) {
 
 TEST_F(TextureRendering, ConstantTexelsRenderBitForBitLikeTheConstant) {
     const std::string c1 = constant_exr("c1.exr", Rgb(0.3f, 0.5f, 0.7f)), c2 = constant_exr("c2.exr", Rgb(0.9f, 0.8f, 0.7f));
+    const std::string w = constant_exr("w.exr", Rgb(0.3f));
     const std::string a = constant_exr("a.exr", Rgb(0.2f)), au = constant_exr("au.exr", Rgb(0.08f)), av = constant_exr("av.exr", Rgb(0.35f));
     const std::vector<std::string> constant = {
         R"(<bsdf type="diffuse"><rgb name="reflectance" value="0.3, 0.5, 0.7"/></bsdf>)",
@@ -79,6 +80,9 @@ TEST_F(TextureRendering, ConstantTexelsRenderBitForBitLikeTheConstant) {
         R"(<bsdf type="plastic"><rgb name="diffuse_reflectance" value="0.3, 0.5, 0.7"/></bsdf>)",
         R"(<bsdf type="roughdielectric"><float name="alpha" value="0.2"/></bsdf>)",
         R"(<bsdf type="conductor"><rgb name="specular_reflectance" value="0.9, 0.8, 0.7"/></bsdf>)",
+        R"(<bsdf type="blendbsdf"><float name="weight" value="0.3"/><bsdf type="diffuse"><rgb name="reflectance" value="0.3, 0.5, 0.7"/></bsdf>
+             <bsdf type="conductor"><rgb name="specular_reflectance" value="0.9, 0.8, 0.7"/></bsdf></bsdf>)",
+        R"(<bsdf type="mask"><float name="opacity" value="0.6"/><bsdf type="roughplastic"><rgb name="diffuse_reflectance" value="0.3, 0.5, 0.7"/></bsdf></bsdf>)",
     };
     const std::vector<std::string> textured = {
         "<bsdf type=\"diffuse\">" + bitmap("reflectance", c1) + "</bsdf>",
@@ -90,6 +94,10 @@ TEST_F(TextureRendering, ConstantTexelsRenderBitForBitLikeTheConstant) {
         "<bsdf type=\"plastic\">" + bitmap("diffuse_reflectance", c1) + "</bsdf>",
         "<bsdf type=\"roughdielectric\">" + bitmap("alpha", a) + "</bsdf>",
         "<bsdf type=\"conductor\">" + bitmap("specular_reflectance", c2) + "</bsdf>",
+        "<bsdf type=\"blendbsdf\">" + bitmap("weight", w) + "<bsdf type=\"diffuse\">" + bitmap("reflectance", c1) +
+            "</bsdf><bsdf type=\"conductor\">" + bitmap("specular_reflectance", c2) + "</bsdf></bsdf>",
+        "<bsdf type=\"mask\">" + checker("opacity", "0.6") + "<bsdf type=\"roughplastic\">" + bitmap("diffuse_reflectance", c1) +
+            "</bsdf></bsdf>",
     };
     const SceneDescription plain = load(spheres_scene(constant)), tex = load(spheres_scene(textured));
     EXPECT_EQ(std::count_if(tex.materials.begin(), tex.materials.end(), [](const Material& m) { return m.varies; }),
@@ -103,6 +111,61 @@ TEST_F(TextureRendering, ConstantTexelsRenderBitForBitLikeTheConstant) {
         for (size_t i = 0; i < a0.film.mean().pixel_count(); ++i) sum += luminance(a0.film.mean()[i]);
         EXPECT_GT(sum, 0.0) << algorithm;  // not two black images
     }
+}
+
+// blendbsdf's weight and mask's opacity follow their textures, and the BSDFs nested in them are
+// evaluated at the same uv (a checkerboard weight of 0.2 / 0.9 over a textured diffuse and a
+// conductor; a checkerboard opacity of 0.25 / 1 over a textured diffuse).
+TEST_F(TextureRendering, BlendWeightAndMaskOpacityFollowTheirTexturesAtTheHitsUv) {
+    const auto two = [](const std::string& param, const std::string& c0, const std::string& c1) {
+        return "<texture type=\"checkerboard\" name=\"" + param + "\"><rgb name=\"color0\" value=\"" + c0 + "\"/><rgb name=\"color1\" value=\"" +
+               c1 + "\"/></texture>";
+    };
+    const SceneDescription d = load(R"(<bsdf type="blendbsdf" id="blend">)" + two("weight", "0.2", "0.9") + R"(<bsdf type="diffuse">)" +
+                                    two("reflectance", "0.1, 0.2, 0.3", "0.6, 0.5, 0.4") +
+                                    R"(</bsdf><bsdf type="conductor"/></bsdf>
+        <bsdf type="mask" id="mask">)" + two("opacity", "0.25", "1") + R"(<bsdf type="diffuse">)" +
+                                    two("reflectance", "0.1, 0.2, 0.3", "0.6, 0.5, 0.4") + R"(</bsdf></bsdf>
+        <shape type="sphere"><ref id="blend"/></shape>)");
+    ASSERT_EQ(d.materials.size(), 2u);
+    const Material &blend = d.materials[0], &mask = d.materials[1];
+    EXPECT_TRUE(blend.varies && mask.varies);
+    EXPECT_TRUE(blend.lobes() & kLobeSpecular);  // the conductor's, whatever the weight
+    const Vec3f wi = normalize(Vec3f(0.3f, -0.2f, 0.9f)), wo = normalize(Vec3f(-0.4f, 0.1f, 0.8f));
+    // color0 at [0, 1/2]^2 and [1/2, 1]^2, color1 elsewhere.
+    const struct {
+        Vec2f uv;
+        float weight, opacity;
+        Rgb rho;
+    } at[] = {{Vec2f(0.25f, 0.25f), 0.2f, 0.25f, Rgb(0.1f, 0.2f, 0.3f)}, {Vec2f(0.75f, 0.25f), 0.9f, 1.0f, Rgb(0.6f, 0.5f, 0.4f)}};
+    for (const auto& x : at) {
+        const MaterialModel bm = blend.model_at(x.uv);
+        EXPECT_FLOAT_EQ(std::get<BlendMaterial>(bm).weight, x.weight);
+        // The conductor adds nothing off its mirror direction: the blend is (1 - w) rho / pi.
+        const Rgb f = std::visit([&](const auto& m) { return m.eval(wi, wo); }, bm);
+        for (int k = 0; k < 3; ++k) EXPECT_NEAR(f[k], (1 - x.weight) * x.rho[k] / float(M_PI), 1e-6f) << k;
+        const MaterialModel mm = mask.model_at(x.uv);
+        EXPECT_FLOAT_EQ(std::get<MaskMaterial>(mm).opacity, x.opacity);
+        const Rgb g = std::visit([&](const auto& m) { return m.eval(wi, wo); }, mm);
+        for (int k = 0; k < 3; ++k) EXPECT_NEAR(g[k], x.opacity * x.rho[k] / float(M_PI), 1e-6f) << k;
+        // Sampling passes straight through with probability 1 - opacity.
+        const auto through = std::visit([&](const auto& m) { return m.sample(wi, Vec2f(0.999f, 0.5f)); }, mm);
+        EXPECT_EQ(bool(through && through->delta), x.opacity < 1);
+    }
+    // Values outside [0, 1] and normal maps inside a blend are refused.
+    const auto fails = [&](const std::string& body, const std::string& text) {
+        try {
+            load(body + R"(<shape type="sphere"/>)");
+            ADD_FAILURE() << "accepted: " << body;
+        } catch (const SceneFileError& e) {
+            EXPECT_NE(std::string(e.what()).find(text), std::string::npos) << e.what();
+        }
+    };
+    fails(R"(<bsdf type="mask">)" + two("opacity", "0.5", "1.5") + R"(<bsdf type="diffuse"/></bsdf>)", "between 0 and 1");
+    fails(R"(<bsdf type="blendbsdf">)" + two("weight", "0.5", "1") +
+              R"(<bsdf type="normalmap"><bsdf type="diffuse"/><texture type="checkerboard" name="normalmap"/></bsdf><bsdf type="diffuse"/></bsdf>)",
+          "not supported");
+    fails(R"(<bsdf type="mask">)" + two("alpha", "0.5", "1") + R"(<bsdf type="diffuse"/></bsdf>)", "must be named \"opacity\"");
 }
 
 // A white textured diffuse (a white PNG, sRGB 255 = 1; a white checkerboard) on a floor and a

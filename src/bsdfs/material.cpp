@@ -42,11 +42,25 @@ void Material::prepare() {
         for (const TextureBinding& b : textures->bindings)
             anisotropic = anisotropic || b.slot == MicrofacetDistribution::kSlotAlphaU || b.slot == MicrofacetDistribution::kSlotAlphaV;
     tangent_frame = anisotropic || perturbed();
+    // blendbsdf and mask vary where their nested materials do, and take their tangent frames.
+    const auto nested = [&](const Material& inner) {
+        Material c = inner;
+        c.prepare();
+        varies = varies || c.varies;
+        tangent_frame = tangent_frame || c.tangent_frame;
+    };
+    if (const auto* b = std::get_if<BlendMaterial>(&model)) nested(*b->first), nested(*b->second);
+    if (const auto* m = std::get_if<MaskMaterial>(&model)) nested(*m->inner);
     surface_coordinates = varies || tangent_frame;
 }
 
 MaterialModel Material::model_at(const Vec2f& uv) const {
     MaterialModel m = model;
+    std::visit(
+        [&](auto& x) {
+            if constexpr (requires { x.set_uv(uv); }) x.set_uv(uv);  // blendbsdf, mask: for their nested materials
+        },
+        m);
     if (!textures || textures->bindings.empty()) return m;
     for (const TextureBinding& b : textures->bindings) {
         const Rgb v = b.scalar ? Rgb(b.texture->eval_1(uv)) : b.texture->eval(uv);
@@ -89,6 +103,64 @@ float Material::pdf_varying(const BsdfContext& ctx, const Vec3f& wi, const Vec3f
 Rgb Material::eval_and_pdf_varying(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo, float& pdf) const {
     return eval_and_pdf_of(model_at(ctx.uv), wi, wo, pdf) * context_factor(ctx, wi, wo);
 }
+
+// The composite models (blendbsdf, mask) out of line: they call Material back, and inlined
+// into the dispatch they would make every caller of it larger (pt-mis's hot loop). A nested
+// material that varies is evaluated at the composite's uv (its radiance-mode model there: the
+// transport mode is applied once, by the composite's Material).
+namespace {
+Rgb eval_at(const Material& m, const Vec2f& uv, const Vec3f& wi, const Vec3f& wo) {
+    return m.varies ? eval_of(m.model_at(uv), wi, wo) : m.eval(wi, wo);
+}
+float pdf_at(const Material& m, const Vec2f& uv, const Vec3f& wi, const Vec3f& wo) {
+    return m.varies ? pdf_of(m.model_at(uv), wi, wo) : m.pdf(wi, wo);
+}
+std::optional<BsdfSample> sample_at(const Material& m, const Vec2f& uv, const Vec3f& wi, const Vec2f& u) {
+    if (!m.varies) return m.sample(wi, u);
+    return std::visit([&](const auto& x) { return x.sample(wi, u); }, m.model_at(uv));
+}
+}  // namespace
+
+Rgb BlendMaterial::eval(const Vec3f& wi, const Vec3f& wo) const {
+    return eval_at(*first, uv, wi, wo) * (1 - weight) + eval_at(*second, uv, wi, wo) * weight;
+}
+float BlendMaterial::pdf(const Vec3f& wi, const Vec3f& wo) const {
+    return (1 - weight) * pdf_at(*first, uv, wi, wo) + weight * pdf_at(*second, uv, wi, wo);
+}
+std::optional<BsdfSample> BlendMaterial::sample(const Vec3f& wi, Vec2f u) const {
+    const bool pick_second = u.x < weight;
+    const float p = pick_second ? weight : 1 - weight;
+    u.x = pick_second ? u.x / weight : (u.x - weight) / (1 - weight);
+    u.x = std::min(u.x, 0.99999994f);
+    std::optional<BsdfSample> s = sample_at(pick_second ? *second : *first, uv, wi, u);
+    if (!s) return s;
+    if (s->delta) {
+        s->f *= p;
+        s->pdfW *= p;
+    } else {
+        s->f = eval(wi, s->wo);
+        s->pdfW = pdf(wi, s->wo);
+        if (!(s->pdfW > 0)) return std::nullopt;
+    }
+    return s;
+}
+
+Rgb MaskMaterial::eval(const Vec3f& wi, const Vec3f& wo) const { return eval_at(*inner, uv, wi, wo) * opacity; }
+float MaskMaterial::pdf(const Vec3f& wi, const Vec3f& wo) const { return opacity * pdf_at(*inner, uv, wi, wo); }
+std::optional<BsdfSample> MaskMaterial::sample(const Vec3f& wi, Vec2f u) const {
+    if (u.x >= opacity) {
+        const float c = std::abs(wi.z);
+        if (!(c > 0)) return std::nullopt;
+        return BsdfSample{-wi, Rgb((1 - opacity) / c), 1 - opacity, true, kLobeSpecular | kLobeTransmission};
+    }
+    u.x = std::min(u.x / opacity, 0.99999994f);
+    std::optional<BsdfSample> s = sample_at(*inner, uv, wi, u);
+    if (!s) return s;
+    s->f *= opacity;
+    s->pdfW *= opacity;
+    return s;
+}
+
 
 std::optional<BsdfSample> Material::sample_adjusted(const BsdfContext& ctx, const Vec3f& wi, const Vec2f& u) const {
     const auto adjust = [&](const MaterialModel& m) -> std::optional<BsdfSample> {

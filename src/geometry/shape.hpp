@@ -39,4 +39,16 @@ struct SphereDesc {
     std::array<Vec3f, 3> axes{{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
 };
 
+// A shapegroup: meshes that instances place, each instance by its own transform (Embree
+// instancing: the group's triangles are stored once).
+struct ShapeGroupDesc {
+    std::string name;
+    std::vector<MeshDesc> meshes;  // in the group's space; their materials are the scene's
+};
+
+struct InstanceDesc {
+    uint32_t group = 0;
+    Transform to_world;
+};
+
 }  // namespace pathlab

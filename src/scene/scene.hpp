@@ -26,6 +26,7 @@ struct Intersection {
     Vec2f uv{0.0f, 0.0f};  // a mesh's interpolated texture coordinates; (0, 0) where it has none
     float t = 0;
     uint32_t geom_id, prim_id;  // the shape and triangle hit, for surface_coordinates() (set by intersect())
+    static constexpr uint32_t kInstanceHit = 0xffffffffu;  // geom_id of a hit on an instance's mesh
     uint32_t material = 0;
     int32_t light = -1;  // index into Scene::lights() of the area light here, or -1
 };
@@ -64,8 +65,9 @@ public:
 
     // Radiance along a ray that escapes the scene in direction w (the environment, if any).
     Rgb escaped_radiance(const Vec3f& w = {}) const {
-        return environment_ >= 0 ? std::get<EnvironmentLight>(lights_[size_t(environment_)]).Le(w) : Rgb(0.0f);
+        return environment_ >= 0 ? environment_radiance(lights_[size_t(environment_)], w) : Rgb(0.0f);
     }
+    // The environment light (constant or envmap), or -1.
     int environment_light() const { return environment_; }
 
     // Chooses a light with probability proportional to its power (uniformly if all are 0).
@@ -89,7 +91,13 @@ private:
         int32_t first_light = -1;  // area light of triangle k is first_light + k
         const MeshDesc* mesh = nullptr;       // triangles: the mesh, and its unit face normals
         const Vec3f* face_normals = nullptr;  // (computed once, not per hit)
+        int32_t instance = -1;                // an instance: its index in desc_.instances
     };
+
+    // A hit on an instance: the group's mesh placed by the instance's transform, computed as
+    // transform_mesh would have placed its vertices (so a shapegroup renders like the same
+    // meshes written out, bit for bit wherever Embree's object-space hit is exact).
+    void instance_hit(const RawHit& raw, Intersection& hit) const;
 
     SceneDescription desc_;
     std::string name_;

@@ -16,7 +16,8 @@ std::shared_ptr<const Texture> read_texture(XmlSource& xml, const pugi::xml_node
     if (!xml.plugin_children(n).empty())
         xml.fail(xml.plugin_children(n).front(), fmt::format("<texture type=\"{}\"> has no nested plugins (its colours are constants)", type));
     Properties p = xml.properties(n, plugin->info());
-    const TextureContext ctx{b.shapes.base_dir, b.shapes.allow_files};
+    TextureContext ctx{b.shapes.base_dir, b.shapes.allow_files};
+    if (ctx.allow_files) ctx.search_dirs = xml.search_dirs();
     return reading([&] {
         auto t = std::make_shared<const Texture>(plugin->read(p, ctx));
         p.check_all_used();
@@ -28,8 +29,8 @@ void read_named_texture(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b
     if (!n.attribute("id")) xml.fail(n, "a top-level <texture> needs an id (BSDFs refer to it with <ref name=\"PARAMETER\" id=\"...\"/>)");
     const std::string id = xml.attr(n, "id");
     if (n.attribute("name")) xml.fail(n, "a top-level <texture> has no name (the BSDF's <ref> names the parameter it gives)");
-    b.check_new_id(xml, n, id);
-    b.named_textures[id] = read_texture(xml, n, b);
+    if (b.named.count(id)) b.name(xml, n, id, "texture", 0);  // names the earlier declaration
+    b.name(xml, n, id, "texture", read_texture(xml, n, b));
 }
 
 }  // namespace pathlab

@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include "core/file_search.hpp"
 #include "image/image_io.hpp"
 
 namespace pathlab {
@@ -39,10 +40,10 @@ Texture read_bitmap(Properties& p, const TextureContext& ctx) {
     const bool raw = p.get_bool("raw");
     const UvTransform to_uv = read_to_uv(p);
     if (!ctx.allow_files) p.fail("this loader does not read files (bitmap textures are disabled)");
-    std::filesystem::path path(p.get_string("filename"));
-    if (path.is_relative()) path = std::filesystem::path(ctx.base_dir) / path;
+    const std::string path =
+        find_in_dirs(p.get_string("filename"), ctx.search_dirs.empty() ? std::vector<std::string>{ctx.base_dir} : ctx.search_dirs);
     try {
-        return Texture(load_bitmap_texture(path.string(), raw, f, w, to_uv));
+        return Texture(load_bitmap_texture(path, raw, f, w, to_uv));
     } catch (const ImageIoError& e) {
         p.fail("filename", fmt::format("cannot read the texture: {}", e.what()));
     }

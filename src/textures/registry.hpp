@@ -15,6 +15,9 @@ namespace pathlab {
 struct TextureContext {
     std::string base_dir = ".";  // relative file names are resolved against it
     bool allow_files = true;     // false: textures that read files are an error (the fuzzer)
+    // Where relative file names are searched, in order (the scene file's folder and its <path>
+    // folders); base_dir when empty.
+    std::vector<std::string> search_dirs = {};
 };
 
 struct TexturePlugin {

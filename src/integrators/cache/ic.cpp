@@ -125,8 +125,8 @@ void IrradianceCaching::prepare(const RenderContext& ctx, const PassProgress& pr
 
 Rgb IrradianceCaching::radiance(const Scene& scene, const Ray& ray, Sampler& sampler) const {
     Intersection hit;
-    if (!scene.intersect(ray, hit)) return scene.escaped_radiance(ray.d);
-    Rgb L = emitted_radiance(scene, hit, -ray.d);
+    if (!scene.intersect(ray, hit)) return options_.hide_emitters ? Rgb(0.0f) : scene.escaped_radiance(ray.d);
+    Rgb L = options_.hide_emitters ? Rgb(0.0f) : emitted_radiance(scene, hit, -ray.d);
     const ShadingPoint sp = make_shading_point(scene, hit, ray.d);
     const std::optional<PhongMaterial> phong = sp.material->is_black() ? std::nullopt : cached_diffuse(sp);
     if (!phong) return pt_mis_from_hit(scene, hit, ray.d, 0, sampler, rules_, false, -1, L);
@@ -173,10 +173,10 @@ std::vector<IntegratorStatistic> IrradianceCaching::statistics() const {
 }
 
 const IntegratorInfo& ic_integrator() {
-    static const IntegratorInfo info{"ic", {}, "irradiance caching with gradients (Ward): cached indirect diffuse light at first hits, pt-mis elsewhere",
+    static const IntegratorInfo info{"ic", {"irrcache"}, "irradiance caching with gradients (Ward): cached indirect diffuse light at first hits, pt-mis elsewhere",
                                      false, true, path_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
                                          return std::make_unique<IrradianceCaching>(o);
-                                     }};
+                                     }, false, true};
     return info;
 }
 

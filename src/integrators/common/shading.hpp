@@ -44,6 +44,7 @@ inline ShadingPoint make_shading_point(const Scene& scene, const Intersection& h
     if (back) {
         sp.ng = -sp.ng;
         ns = -ns;
+        if (sp.material->back >= 0) sp.material = &scene.material(uint32_t(sp.material->back));
     }
     if (sp.material->surface_coordinates) [[unlikely]]
         set_surface_coordinates(scene, hit, back, sp);

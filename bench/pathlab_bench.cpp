@@ -11,6 +11,7 @@
 //   pathlab_bench volumes  volpath: samples/s, equal-time RMSE with and without MIS, optical thickness
 //   pathlab_bench distributed  2 MPI ranks against 1 process, film reduction, checkpoints
 //   pathlab_bench lights   an environment map's cost per sample against the constant environment; spot and IES
+//   pathlab_bench textures textured against constant materials per sample; texture lookups
 #include <CLI/CLI.hpp>
 
 #include "bidirectional.hpp"
@@ -22,6 +23,7 @@
 #include "photon_mapping.hpp"
 #include "performance.hpp"
 #include "volumes.hpp"
+#include "textures.hpp"
 
 int main(int argc, char** argv) {
     using namespace pathlab::bench;
@@ -106,6 +108,13 @@ int main(int argc, char** argv) {
     worker->group("");
     worker->add_option("--film-sizes", dopt.film_sizes)->delimiter(',');
     worker->add_option("--repeats", dopt.repeats);
+    TexturesOptions tx;
+    CLI::App* txc = app.add_subcommand("textures", "Textured against constant materials per sample; texture lookups");
+    txc->add_option("--size", tx.size, "Image width and height")->capture_default_str();
+    txc->add_option("--seconds", tx.seconds, "Seconds per timed render")->capture_default_str();
+    txc->add_option("--repeats", tx.repeats, "Interleaved rounds (medians reported)")->capture_default_str();
+    txc->add_option("--lookups", tx.lookups, "Texture lookups per timing")->capture_default_str();
+    txc->add_option("--scene", tx.scene_file, "The textured scene file (default: scenes/textures.xml)");
     // Under mpirun this program is one rank of the reduction benchmark.
     std::vector<std::string> args(argv, argv + argc);
     CLI11_PARSE(app, argc, argv);
@@ -116,6 +125,7 @@ int main(int argc, char** argv) {
     if (*dist) distributed_suite(dopt, args[0]);
     if (*lic) lights_suite(lo);
     if (*vol) volumes_suite(vo);
+    if (*txc) textures_suite(tx);
     if (*icc) irradiance_caching_suite(icopt);
     if (*pmc) photon_mapping_suite(pm);
     if (*bd) bidirectional_suite(b);

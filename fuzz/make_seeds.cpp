@@ -1,7 +1,7 @@
 // Writes the seed corpora of the reader fuzz targets, from files pathlab (and the libraries it
 // links) can make itself: small images in every format and variant the readers know, and OBJ
 // meshes, voxel grids. Usage: fuzz_make_seeds DIR  (creates DIR/exr, DIR/hdr, DIR/pfm, DIR/png,
-// DIR/obj, DIR/vol).
+// DIR/jpeg, DIR/obj, DIR/vol).
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
@@ -9,6 +9,7 @@
 #include <ImfTiledOutputFile.h>
 #include <stb_image_write.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -75,7 +76,7 @@ int main(int argc, char** argv) {
         return 2;
     }
     const fs::path dir = argv[1];
-    for (const char* sub : {"exr", "hdr", "pfm", "png", "obj", "vol"}) fs::create_directories(dir / sub);
+    for (const char* sub : {"exr", "hdr", "pfm", "png", "jpeg", "obj", "vol"}) fs::create_directories(dir / sub);
 
     // pathlab's own writers, at sizes around the readers' special cases (HDR run-length
     // encoding needs widths of 8 or more).
@@ -83,6 +84,22 @@ int main(int argc, char** argv) {
         const Image img = pattern(w, h);
         const std::string stem = std::to_string(w) + "x" + std::to_string(h);
         for (const char* ext : {"exr", "hdr", "pfm", "png"}) pathlab::write_image(img, (dir / ext / (stem + "." + ext)).string());
+    }
+
+    // JPEG (stb_image_write): grey and colour, two qualities (4:2:0 subsampling below 91), sizes
+    // that are and are not whole 8x8 and 16x16 blocks.
+    for (const auto& [w, h] : {std::pair{1, 1}, std::pair{8, 8}, std::pair{17, 9}, std::pair{33, 20}}) {
+        const Image img = pattern(w, h);
+        std::vector<uint8_t> rgb(size_t(w) * size_t(h) * 3), grey(size_t(w) * size_t(h));
+        for (size_t i = 0; i < img.pixel_count(); ++i) {
+            for (int k = 0; k < 3; ++k) rgb[i * 3 + size_t(k)] = uint8_t(std::min(255.0f, img[i][k] * 255.0f));
+            grey[i] = rgb[i * 3];
+        }
+        const std::string stem = (dir / "jpeg" / (std::to_string(w) + "x" + std::to_string(h))).string();
+        for (const int q : {50, 95}) {
+            stbi_write_jpg((stem + "-q" + std::to_string(q) + ".jpg").c_str(), w, h, 3, rgb.data(), q);
+            stbi_write_jpg((stem + "-grey-q" + std::to_string(q) + ".jpg").c_str(), w, h, 1, grey.data(), q);
+        }
     }
 
     // EXR: every compression; tiled with mipmaps; half and grey channels.

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Fuzzes pathlab's readers of untrusted files with libFuzzer (clang, AddressSanitizer, UBSan).
-#   scripts/fuzz.sh TARGET [SECONDS]   TARGET: scene_xml, exr, hdr, pfm, png, obj, vol, ies, or all
+#   scripts/fuzz.sh TARGET [SECONDS]   TARGET: scene_xml, exr, hdr, pfm, png, jpeg, obj, vol, ies, or all
 #                                      (all: each target in turn for SECONDS); default 660 s
 #   scripts/fuzz.sh [SECONDS]          the scene-file loader, as before (scene_xml)
 # Seeds: the shipped scenes, meshes and IES files, images and meshes written by fuzz_make_seeds
@@ -14,14 +14,14 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-all_targets=(scene_xml exr hdr pfm png obj vol ies)
+all_targets=(scene_xml exr hdr pfm png jpeg obj vol ies)
 if [[ $# -eq 0 || $1 =~ ^[0-9]+$ ]]; then
     targets=(scene_xml)
     seconds=${1:-660}
 else
     case $1 in
         all) targets=("${all_targets[@]}") ;;
-        scene_xml | exr | hdr | pfm | png | obj | vol | ies) targets=("$1") ;;
+        scene_xml | exr | hdr | pfm | png | jpeg | obj | vol | ies) targets=("$1") ;;
         *) echo "fuzz.sh: unknown target '$1' (valid: ${all_targets[*]}, all)" >&2; exit 2 ;;
     esac
     seconds=${2:-660}
@@ -93,6 +93,7 @@ for t in "${targets[@]}"; do
             make_seeds
             cp -n build-fuzz/seeds/"$t"/* "$corpus"/ 2>/dev/null || true
             cp -n tests/data/image_regressions/*."$t" "$corpus"/ 2>/dev/null || true
+            if [[ $t == jpeg ]]; then cp -n tests/data/image_regressions/*.jpg "$corpus"/ 2>/dev/null || true; fi
             ;;
     esac
     dict=fuzz/$t.dict

@@ -11,6 +11,7 @@
 #include <ImfHeader.h>
 #include <ImfOutputFile.h>
 #include <fcntl.h>
+#include <stb_image_write.h>
 #include <sys/stat.h>
 
 #include <csignal>
@@ -59,10 +60,15 @@ protected:
             for (int x = 0; x < w; ++x) img.at(x, y) = Rgb(float(x + 1) / float(w), float(y) / float(h), float((x * 7 + y) % 5));
         return img;
     }
-    // The bytes of a valid file of `ext`, written by pathlab.
+    // The bytes of a valid file of `ext`, written by pathlab (a JPEG by stb_image_write).
     std::string valid_file(const std::string& ext, int w = 37, int h = 9) const {
         const std::string file = path("valid." + ext);
-        write_image(pattern(w, h), file);
+        if (ext == "jpg") {
+            const Image8 img = to_srgb8(pattern(w, h), 0.0f);
+            if (!stbi_write_jpg(file.c_str(), w, h, 3, img.rgb.data(), 90)) throw std::runtime_error("cannot write a JPEG");
+        } else {
+            write_image(pattern(w, h), file);
+        }
         return read_file(file);
     }
     // Names of the temporaries in the directory.
@@ -79,6 +85,8 @@ protected:
 void read_bytes_as(const std::string& ext, const std::string& bytes, const std::string& name) {
     if (ext == "png") {
         (void)read_png8_from_memory(bytes.data(), bytes.size(), name);
+    } else if (ext == "jpg") {
+        (void)read_jpeg8_from_memory(bytes.data(), bytes.size(), name);
     } else {
         (void)read_image_from_memory(image_format_for("x." + ext), bytes.data(), bytes.size(), name);
     }
@@ -87,6 +95,8 @@ void read_bytes_as(const std::string& ext, const std::string& bytes, const std::
 void read_file_as_its_kind(const std::string& file) {
     if (fs::path(file).extension() == ".png") {
         (void)read_png8(file);
+    } else if (fs::path(file).extension() == ".jpg") {
+        (void)read_jpeg8(file);
     } else if (fs::path(file).extension() == ".obj") {
         (void)load_obj_mesh(file);
     } else {
@@ -125,6 +135,11 @@ TEST_F(Hostile, RegressionCorporaFailCleanlyInBoundedTimeAndMemory) {
         {"many-channels.exr", "more than 1024 channels"},
         {"multipart.exr", "multi-part and deep OpenEXR files are not supported"},
         {"chunk-length-4g.png", "cannot read PNG: "},
+        {"huge-frame-tiny-file.jpg", "cannot read JPEG: truncated: 27 bytes cannot hold 16384x16384 pixels"},
+        {"arithmetic-coding.jpg", "cannot read JPEG: unsupported JPEG coding: arithmetic-coded"},
+        {"twelve-bit.jpg", "cannot read JPEG: unsupported JPEG: 12 bits per sample"},
+        {"no-end-of-image.jpg", "cannot read JPEG: truncated: the file ends before its end-of-image marker"},
+        {"segment-past-end.jpg", "cannot read JPEG: truncated: the file ends inside a segment of 65535 bytes"},
         {"exponent-int-overflow.obj", "a number with an exponent of 10 digits"},
         {"index-out-of-range.obj", "refers to a vertex that does not exist"},
     };
@@ -153,7 +168,7 @@ TEST_F(Hostile, RegressionCorporaFailCleanlyInBoundedTimeAndMemory) {
 
 // Every prefix of a valid file (stb_image hung on many of the .hdr ones), in one child.
 TEST_F(Hostile, EveryTruncationOfAValidFileFailsCleanly) {
-    for (const char* ext : {"hdr", "pfm", "exr", "png"}) {
+    for (const char* ext : {"hdr", "pfm", "exr", "png", "jpg"}) {
         const std::string bytes = valid_file(ext);
         const BoundedResult r = run_bounded(
             [&] {
@@ -175,7 +190,7 @@ TEST_F(Hostile, EveryTruncationOfAValidFileFailsCleanly) {
 
 // Random byte changes of valid files: each must load or fail with an ImageIoError.
 TEST_F(Hostile, RandomlyCorruptedFilesLoadOrFailCleanly) {
-    for (const char* ext : {"hdr", "pfm", "exr", "png"}) {
+    for (const char* ext : {"hdr", "pfm", "exr", "png", "jpg"}) {
         const std::string bytes = valid_file(ext, 19, 7);
         const BoundedResult r = run_bounded(
             [&] {

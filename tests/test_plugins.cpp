@@ -48,10 +48,12 @@ TEST(Plugins, EveryDeclaredDefaultReadsAsItsType) {
 TEST(Plugins, EveryBsdfBuildsFromItsDefaults) {
     for (const BsdfPlugin& b : bsdf_plugins()) {
         const std::string type = b.info().type;
-        // The wrappers need their nested BSDFs.
+        // The wrappers need their nested BSDFs (normalmap and bumpmap also a texture).
         const std::string nested = type == "twosided" || type == "mask" ? R"(<bsdf type="diffuse"/>)"
                                    : type == "blendbsdf"                 ? R"(<bsdf type="diffuse"/><bsdf type="conductor"/>)"
-                                                                         : "";
+                                   : type == "normalmap" || type == "bumpmap"
+                                       ? R"(<bsdf type="diffuse"/><texture type="checkerboard" name="normalmap"/>)"
+                                       : "";
         const std::string bsdf = "<bsdf type=\"" + type + "\">" + nested + "</bsdf>";
         EXPECT_NO_THROW(load_scene_text("<scene version=\"3\"><shape type=\"sphere\">" + bsdf + "</shape></scene>", "t.xml", "."))
             << type;

@@ -178,11 +178,6 @@ TEST(SceneFileStructure, RefusalsNameTheMissingFeature) {
         std::string body, message;
     };
     const std::vector<Case> cases = {
-        {"<texture type=\"bitmap\" id=\"t\"/>", "needs textures"},
-        {"<shape type=\"cube\"><bsdf type=\"blendbsdf\"><texture name=\"weight\" type=\"bitmap\"/><bsdf type=\"diffuse\"/><bsdf type=\"diffuse\"/></bsdf></shape>",
-         "needs textures"},
-        {"<shape type=\"cube\"><bsdf type=\"mask\"><texture name=\"opacity\" type=\"bitmap\"/><bsdf type=\"diffuse\"/></bsdf></shape>",
-         "needs textures"},
         {"<shape type=\"cube\"><bsdf type=\"principled\"/></shape>", "metallic, specular, roughness"},
         {"<integrator type=\"volpath_simple\"/>", "unsupported integrator type 'volpath_simple'"},
         {"<sensor type=\"perspective\"><film type=\"hdrfilm\"><rfilter type=\"sinc\"/></film></sensor>",

@@ -33,12 +33,16 @@ struct ConductorMaterial {
         const Vec3f wo(-wi.x, -wi.y, wi.z);
         return BsdfSample{wo, fresnel(wi.z) / wo.z, 1.0f, true, kLobeSpecular | kLobeReflection};
     }
+
+    static constexpr int kSlotSpecularReflectance = 0;  // the parameter a texture may give
+    void set_texel(int, const Rgb& v) { specular_reflectance = v; }
 };
 
 inline const PluginInfo& conductor_plugin() {
     static const PluginInfo info{"bsdf", "conductor", "a smooth metal: a perfect specular reflector with the conductor's Fresnel reflectance",
                                  {kConductorMaterialParam, kConductorEtaParam, kConductorKParam,
-                                  {"specular_reflectance", ParamType::Rgb, "1", "scales the reflectance (not physical)", "specularReflectance"}}};
+                                  {"specular_reflectance", ParamType::Rgb, "1", "scales the reflectance (not physical)", "specularReflectance",
+                                   ConductorMaterial::kSlotSpecularReflectance}}};
     return info;
 }
 inline ConductorMaterial read_conductor(Properties& p) {

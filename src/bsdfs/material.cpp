@@ -1,21 +1,138 @@
 #include "bsdfs/material.hpp"
 
 namespace pathlab {
+namespace {
+
+// Radiance-mode values of a model (std::visit: the hot loop's inlined dispatch is visit_model).
+Rgb eval_of(const MaterialModel& m, const Vec3f& wi, const Vec3f& wo) {
+    return std::visit([&](const auto& x) { return x.eval(wi, wo); }, m);
+}
+float pdf_of(const MaterialModel& m, const Vec3f& wi, const Vec3f& wo) {
+    return std::visit([&](const auto& x) { return x.pdf(wi, wo); }, m);
+}
+Rgb eval_and_pdf_of(const MaterialModel& m, const Vec3f& wi, const Vec3f& wo, float& pdf) {
+    return std::visit(
+        [&](const auto& x) {
+            if constexpr (requires { x.eval_and_pdf(wi, wo, pdf); }) {
+                return x.eval_and_pdf(wi, wo, pdf);
+            } else {
+                pdf = x.pdf(wi, wo);
+                return x.eval(wi, wo);
+            }
+        },
+        m);
+}
+
+// Both directions on the same side of the geometric surface as of the shading one.
+bool sides_agree(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo) {
+    const Vec3f ng = ctx.frame.to_local(ctx.ng);
+    return dot(wi, ng) * wi.z > 0 && dot(wo, ng) * wo.z > 0;
+}
+
+}  // namespace
+
+void Material::prepare() {
+    varies = textures != nullptr;
+    // Anisotropic microfacets (alpha_u != alpha_v, or either given by a texture) act along dp/du.
+    const MicrofacetDistribution* d = nullptr;
+    if (const auto* r = std::get_if<RoughConductorMaterial>(&model)) d = &r->distribution;
+    if (const auto* r = std::get_if<RoughDielectricMaterial>(&model)) d = &r->distribution;
+    bool anisotropic = d && d->is_anisotropic();
+    if (d && textures)
+        for (const TextureBinding& b : textures->bindings)
+            anisotropic = anisotropic || b.slot == MicrofacetDistribution::kSlotAlphaU || b.slot == MicrofacetDistribution::kSlotAlphaV;
+    tangent_frame = anisotropic || perturbed();
+    // blendbsdf and mask vary where their nested materials do, and take their tangent frames.
+    const auto nested = [&](const Material& inner) {
+        Material c = inner;
+        c.prepare();
+        varies = varies || c.varies;
+        tangent_frame = tangent_frame || c.tangent_frame;
+    };
+    if (const auto* b = std::get_if<BlendMaterial>(&model)) nested(*b->first), nested(*b->second);
+    if (const auto* m = std::get_if<MaskMaterial>(&model)) nested(*m->inner);
+    surface_coordinates = varies || tangent_frame;
+}
+
+MaterialModel Material::model_at(const Vec2f& uv) const {
+    MaterialModel m = model;
+    std::visit(
+        [&](auto& x) {
+            if constexpr (requires { x.set_uv(uv); }) x.set_uv(uv);  // blendbsdf, mask: for their nested materials
+        },
+        m);
+    if (!textures || textures->bindings.empty()) return m;
+    for (const TextureBinding& b : textures->bindings) {
+        const Rgb v = b.scalar ? Rgb(b.texture->eval_1(uv)) : b.texture->eval(uv);
+        std::visit(
+            [&](auto& x) {
+                if constexpr (requires { x.set_texel(b.slot, v); }) x.set_texel(b.slot, v);
+            },
+            m);
+    }
+    std::visit(
+        [](auto& x) {
+            if constexpr (requires { x.texels_changed(); }) x.texels_changed();
+        },
+        m);
+    return m;
+}
+
+Frame Material::shading_frame(const Vec3f& n, const Vec3f& ng, bool back, const Vec3f& dpdu, const Vec3f& dpdv, const Vec2f& uv) const {
+    const Frame f = perturbed() ? perturbed_frame(*textures, n, ng, dpdu, dpdv, uv) : pathlab::tangent_frame(n, dpdu);
+    if (!back) return f;
+    Frame r;
+    r.n = -f.n;
+    r.s = f.s;
+    r.t = cross(r.n, r.s);
+    return r;
+}
+
+float Material::context_factor(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo) const {
+    if (ctx.mode == TransportMode::Importance) return importance_factor(ctx, wi, wo);
+    if (perturbed() && !sides_agree(ctx, wi, wo)) return 0.0f;
+    return 1.0f;
+}
+
+Rgb Material::eval_varying(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo) const {
+    return eval_of(model_at(ctx.uv), wi, wo) * context_factor(ctx, wi, wo);
+}
+
+float Material::pdf_varying(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo) const { return pdf_of(model_at(ctx.uv), wi, wo); }
+
+Rgb Material::eval_and_pdf_varying(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo, float& pdf) const {
+    return eval_and_pdf_of(model_at(ctx.uv), wi, wo, pdf) * context_factor(ctx, wi, wo);
+}
 
 // The composite models (blendbsdf, mask) out of line: they call Material back, and inlined
-// into the dispatch they would make every caller of it larger (pt-mis's hot loop).
+// into the dispatch they would make every caller of it larger (pt-mis's hot loop). A nested
+// material that varies is evaluated at the composite's uv (its radiance-mode model there: the
+// transport mode is applied once, by the composite's Material).
+namespace {
+Rgb eval_at(const Material& m, const Vec2f& uv, const Vec3f& wi, const Vec3f& wo) {
+    return m.varies ? eval_of(m.model_at(uv), wi, wo) : m.eval(wi, wo);
+}
+float pdf_at(const Material& m, const Vec2f& uv, const Vec3f& wi, const Vec3f& wo) {
+    return m.varies ? pdf_of(m.model_at(uv), wi, wo) : m.pdf(wi, wo);
+}
+std::optional<BsdfSample> sample_at(const Material& m, const Vec2f& uv, const Vec3f& wi, const Vec2f& u) {
+    if (!m.varies) return m.sample(wi, u);
+    return std::visit([&](const auto& x) { return x.sample(wi, u); }, m.model_at(uv));
+}
+}  // namespace
+
 Rgb BlendMaterial::eval(const Vec3f& wi, const Vec3f& wo) const {
-    return first->eval(wi, wo) * (1 - weight) + second->eval(wi, wo) * weight;
+    return eval_at(*first, uv, wi, wo) * (1 - weight) + eval_at(*second, uv, wi, wo) * weight;
 }
 float BlendMaterial::pdf(const Vec3f& wi, const Vec3f& wo) const {
-    return (1 - weight) * first->pdf(wi, wo) + weight * second->pdf(wi, wo);
+    return (1 - weight) * pdf_at(*first, uv, wi, wo) + weight * pdf_at(*second, uv, wi, wo);
 }
 std::optional<BsdfSample> BlendMaterial::sample(const Vec3f& wi, Vec2f u) const {
     const bool pick_second = u.x < weight;
     const float p = pick_second ? weight : 1 - weight;
     u.x = pick_second ? u.x / weight : (u.x - weight) / (1 - weight);
     u.x = std::min(u.x, 0.99999994f);
-    std::optional<BsdfSample> s = (pick_second ? second : first)->sample(wi, u);
+    std::optional<BsdfSample> s = sample_at(pick_second ? *second : *first, uv, wi, u);
     if (!s) return s;
     if (s->delta) {
         s->f *= p;
@@ -28,8 +145,8 @@ std::optional<BsdfSample> BlendMaterial::sample(const Vec3f& wi, Vec2f u) const 
     return s;
 }
 
-Rgb MaskMaterial::eval(const Vec3f& wi, const Vec3f& wo) const { return inner->eval(wi, wo) * opacity; }
-float MaskMaterial::pdf(const Vec3f& wi, const Vec3f& wo) const { return opacity * inner->pdf(wi, wo); }
+Rgb MaskMaterial::eval(const Vec3f& wi, const Vec3f& wo) const { return eval_at(*inner, uv, wi, wo) * opacity; }
+float MaskMaterial::pdf(const Vec3f& wi, const Vec3f& wo) const { return opacity * pdf_at(*inner, uv, wi, wo); }
 std::optional<BsdfSample> MaskMaterial::sample(const Vec3f& wi, Vec2f u) const {
     if (u.x >= opacity) {
         const float c = std::abs(wi.z);
@@ -37,7 +154,7 @@ std::optional<BsdfSample> MaskMaterial::sample(const Vec3f& wi, Vec2f u) const {
         return BsdfSample{-wi, Rgb((1 - opacity) / c), 1 - opacity, true, kLobeSpecular | kLobeTransmission};
     }
     u.x = std::min(u.x / opacity, 0.99999994f);
-    std::optional<BsdfSample> s = inner->sample(wi, u);
+    std::optional<BsdfSample> s = sample_at(*inner, uv, wi, u);
     if (!s) return s;
     s->f *= opacity;
     s->pdfW *= opacity;
@@ -46,15 +163,21 @@ std::optional<BsdfSample> MaskMaterial::sample(const Vec3f& wi, Vec2f u) const {
 
 
 std::optional<BsdfSample> Material::sample_adjusted(const BsdfContext& ctx, const Vec3f& wi, const Vec2f& u) const {
-    std::optional<BsdfSample> s = sample(wi, u);
-    if (!s) return s;
-    if (ctx.mode == TransportMode::Importance) {
-        const float k = importance_factor(ctx, wi, s->wo);
-        if (!(k > 0)) return std::nullopt;
-        s->f *= k;
-    }
-    if (ctx.reverse_pdf) s->pdf_rev = s->delta ? s->pdfW : pdf(s->wo, wi);
-    return s;
+    const auto adjust = [&](const MaterialModel& m) -> std::optional<BsdfSample> {
+        std::optional<BsdfSample> s = visit_model(m, [&](const auto& x) { return x.sample(wi, u); });
+        if (!s) return s;
+        if (ctx.mode == TransportMode::Importance) {
+            const float k = importance_factor(ctx, wi, s->wo);
+            if (!(k > 0)) return std::nullopt;
+            s->f *= k;
+        } else if (perturbed() && !sides_agree(ctx, wi, s->wo)) {
+            return std::nullopt;
+        }
+        if (ctx.reverse_pdf) s->pdf_rev = s->delta ? s->pdfW : pdf_of(m, s->wo, wi);
+        return s;
+    };
+    if (!varies) return adjust(model);
+    return adjust(model_at(ctx.uv));
 }
 
 float Material::importance_factor(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo) const {

@@ -9,8 +9,16 @@
 //  - pdf(wi, wo) and BsdfSample::pdfW are densities per unit solid angle of wo.
 //  - sample(wi, u) draws wo given two uniform numbers in [0,1).
 // The models (one header each) compute radiance-mode values. Material's functions that take a
-// BsdfContext apply the transport mode (bsdf_context.hpp) and fill the reverse pdf; the ones
-// without a context are the plain radiance-mode models.
+// BsdfContext apply the transport mode (bsdf_context.hpp), fill the reverse pdf and evaluate
+// the material's textures at the context's uv (material_textures.hpp); the ones without a
+// context are the plain radiance-mode models (of a textured material: the model of its
+// textures' largest values, which only its lobe flags and is_black() use).
+//
+// Normal and bump maps tilt the shading frame (make_shading_point builds it with
+// shading_frame()); it is then a shading normal like an interpolated vertex normal, with one
+// addition: directions on different sides of the geometric and the perturbed shading surface
+// are refused in radiance mode too (importance mode refuses them for every shading normal), so
+// that both modes see the same BSDF and bidirectional methods agree with path tracing.
 #pragma once
 
 #include <memory>
@@ -21,6 +29,7 @@
 #include "bsdfs/conductor.hpp"
 #include "bsdfs/ior.hpp"
 #include "bsdfs/dielectric.hpp"
+#include "bsdfs/material_textures.hpp"
 #include "bsdfs/phong.hpp"
 #include "bsdfs/plastic.hpp"
 #include "bsdfs/roughconductor.hpp"
@@ -32,13 +41,20 @@ namespace pathlab {
 
 struct Material;
 
-// blendbsdf: (1 - weight) * first + weight * second (Mitsuba's blendbsdf with a constant
-// weight; a texture weight needs textures). Sampling picks a BSDF with probability 1 - weight
-// or weight; eval and pdf mix both (their non-delta lobes), a delta sample keeps its own
-// coefficient times the choice's probability (bsdf_sample.hpp).
+// blendbsdf: (1 - weight) * first + weight * second (Mitsuba's blendbsdf; the weight may be a
+// texture). Sampling picks a BSDF with probability 1 - weight or weight; eval and pdf mix both
+// (their non-delta lobes), a delta sample keeps its own coefficient times the choice's
+// probability (bsdf_sample.hpp). Textured nested BSDFs are evaluated at `uv`, which
+// Material::model_at sets (normal and bump maps inside a blend are refused: the blend has one
+// shading frame; wrap the blend instead).
 struct BlendMaterial {
     std::shared_ptr<const Material> first, second;
     float weight = 0.5f;  // of `second`
+    Vec2f uv = Vec2f(0, 0);  // where the nested BSDFs are evaluated (textured ones only)
+
+    static constexpr int kSlotWeight = 0;
+    void set_texel(int, const Rgb& v) { weight = v.x; }
+    void set_uv(const Vec2f& at) { uv = at; }
 
     Rgb eval(const Vec3f& wi, const Vec3f& wo) const;
     float pdf(const Vec3f& wi, const Vec3f& wo) const;
@@ -46,11 +62,16 @@ struct BlendMaterial {
 };
 
 // mask: opacity * the nested BSDF, and with probability 1 - opacity the path goes straight
-// through (a Dirac delta along -wi of coefficient 1 - opacity, on either side). A constant
-// opacity (a texture needs textures).
+// through (a Dirac delta along -wi of coefficient 1 - opacity, on either side). The opacity may
+// be a texture (cut-outs); a textured nested BSDF is evaluated at `uv`, as in BlendMaterial.
 struct MaskMaterial {
     std::shared_ptr<const Material> inner;
     float opacity = 0.5f;
+    Vec2f uv = Vec2f(0, 0);
+
+    static constexpr int kSlotOpacity = 0;
+    void set_texel(int, const Rgb& v) { opacity = v.x; }
+    void set_uv(const Vec2f& at) { uv = at; }
 
     Rgb eval(const Vec3f& wi, const Vec3f& wo) const;
     float pdf(const Vec3f& wi, const Vec3f& wo) const;
@@ -90,6 +111,28 @@ struct Material {
     // twosided with two BSDFs: the index (in the scene's materials) of the one for the back,
     // used with the frame flipped as for the front; -1: the same material on both sides.
     int32_t back = -1;
+    // Set by set_textures() and prepare() (Scene::build calls it), read at every hit:
+    bool varies = false;               // it has textures, a normal or a bump map
+    bool tangent_frame = false;        // its shading frame follows dp/du (anisotropic, normal or bump mapped)
+    bool surface_coordinates = false;  // either: it uses uv, dp/du and dp/dv
+    std::shared_ptr<const MaterialTextures> textures = nullptr;  // null: the same everywhere
+
+    // Binds textures (and a normal or bump map) to the material.
+    void set_textures(MaterialTextures t) {
+        textures = std::make_shared<const MaterialTextures>(std::move(t));
+        prepare();
+    }
+    // Computes the three flags above from the model, the textures and, for blendbsdf and mask,
+    // the nested materials.
+    void prepare();
+    bool perturbed() const { return textures && textures->perturbation != FramePerturbation::None; }
+    // The model at surface coordinates uv: the textured parameters set to their values there.
+    MaterialModel model_at(const Vec2f& uv) const;
+    // The shading frame at a hit whose front-side unit shading and geometric normals are n, ng
+    // (for tangent_frame materials; the others use Frame(n)): tangent_frame() or
+    // perturbed_frame() of material_textures.hpp, reversed (n -> -n) for the back of a
+    // two-sided material, which is the same tilted surface seen from behind.
+    Frame shading_frame(const Vec3f& n, const Vec3f& ng, bool back, const Vec3f& dpdu, const Vec3f& dpdv, const Vec2f& uv) const;
 
     Rgb eval(const Vec3f& wi, const Vec3f& wo) const {
         return visit_model(model, [&](const auto& m) { return m.eval(wi, wo); });
@@ -111,22 +154,33 @@ struct Material {
     [[gnu::always_inline]] std::optional<BsdfSample> sample(const Vec3f& wi, const Vec2f& u) const {
         return visit_model(model, [&](const auto& m) { return m.sample(wi, u); });
     }
-    // ---- with a shading context (transport mode, reverse pdf) ----------------------------
-    // Radiance mode without a reverse pdf is the plain model and stays inline (the path
-    // tracers' hot loop); the rest takes the out-of-line adjusted path.
+    // ---- with a shading context (transport mode, reverse pdf, uv) ------------------------
+    // Radiance mode without a reverse pdf, of a material that does not vary, is the plain
+    // model and stays inline (the path tracers' hot loop); the rest takes the out-of-line
+    // adjusted path.
     Rgb eval(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo) const {
-        if (ctx.mode == TransportMode::Radiance) [[likely]]
-            return eval(wi, wo);
-        return eval(wi, wo) * importance_factor(ctx, wi, wo);
+        if (!varies) [[likely]] {
+            if (ctx.mode == TransportMode::Radiance) [[likely]]
+                return eval(wi, wo);
+            return eval(wi, wo) * importance_factor(ctx, wi, wo);
+        }
+        return eval_varying(ctx, wi, wo);
     }
-    float pdf(const BsdfContext&, const Vec3f& wi, const Vec3f& wo) const { return pdf(wi, wo); }
+    float pdf(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo) const {
+        if (!varies) [[likely]]
+            return pdf(wi, wo);
+        return pdf_varying(ctx, wi, wo);
+    }
     Rgb eval_and_pdf(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo, float& pdf) const {
-        if (ctx.mode == TransportMode::Radiance) [[likely]]
-            return eval_and_pdf(wi, wo, pdf);
-        return eval_and_pdf(wi, wo, pdf) * importance_factor(ctx, wi, wo);
+        if (!varies) [[likely]] {
+            if (ctx.mode == TransportMode::Radiance) [[likely]]
+                return eval_and_pdf(wi, wo, pdf);
+            return eval_and_pdf(wi, wo, pdf) * importance_factor(ctx, wi, wo);
+        }
+        return eval_and_pdf_varying(ctx, wi, wo, pdf);
     }
     [[gnu::always_inline]] std::optional<BsdfSample> sample(const BsdfContext& ctx, const Vec3f& wi, const Vec2f& u) const {
-        if (ctx.mode == TransportMode::Radiance && !ctx.reverse_pdf) [[likely]]
+        if (ctx.mode == TransportMode::Radiance && !ctx.reverse_pdf && !varies) [[likely]]
             return sample(wi, u);
         return sample_adjusted(ctx, wi, u);
     }
@@ -157,6 +211,9 @@ struct Material {
     // The context's adjustments (material.cpp: out of line, so that the hot path's visit of the
     // model stays the only one in the integrators' code and is inlined there).
     std::optional<BsdfSample> sample_adjusted(const BsdfContext& ctx, const Vec3f& wi, const Vec2f& u) const;
+    Rgb eval_varying(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo) const;
+    float pdf_varying(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo) const;
+    Rgb eval_and_pdf_varying(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo, float& pdf) const;
 
     // What importance transport multiplies the radiance-mode BSDF by (bsdf_context.hpp): the
     // refraction factor (eta_wo / eta_wi)^2 and the shading-normal correction; 0 for directions
@@ -164,6 +221,11 @@ struct Material {
     float importance_factor(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo) const;
 
 private:
+    // What the context multiplies a varying material's radiance-mode BSDF by: importance mode's
+    // factor, or for a perturbed frame in radiance mode 0 where wi or wo lie on different sides
+    // of the geometric and the shading surface (1 elsewhere).
+    float context_factor(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo) const;
+
     static uint32_t lobes_of(const PhongMaterial& m) {
         return kLobeReflection | (pathlab::is_black(m.diffuse) ? 0u : kLobeDiffuse) | (pathlab::is_black(m.specular) ? 0u : kLobeGlossy);
     }

@@ -104,6 +104,16 @@ struct MicrofacetDistribution {
 
     bool is_anisotropic() const { return alpha_u != alpha_v; }
 
+    // The roughness parameters a texture may give (ParamInfo::texture_slot; slot 0 is the
+    // reflectance of the BSDFs that have one), and setting one to its value at a hit (clamped
+    // as the constructor does).
+    static constexpr int kSlotAlpha = 1, kSlotAlphaU = 2, kSlotAlphaV = 3;
+    void set_texel(int slot, float a) {
+        const float v = std::max(a, kMinAlpha);
+        if (slot != kSlotAlphaV) alpha_u = v;
+        if (slot != kSlotAlphaU) alpha_v = v;
+    }
+
 private:
     // Solves f(x) = 0 for increasing f on [lo, hi] (f(lo) <= 0 <= f(hi)) by Newton steps,
     // bisecting whenever a step would leave the bracket. f returns {value, derivative}.
@@ -153,17 +163,19 @@ private:
 };
 
 // The parameters of a rough BSDF's microfacet distribution (isotropic ones have no alpha_u,
-// alpha_v), and how they are read.
-inline std::vector<ParamInfo> microfacet_params(bool anisotropic) {
+// alpha_v), and how they are read. `textured`: textures may give the roughness.
+inline std::vector<ParamInfo> microfacet_params(bool anisotropic, bool textured) {
+    const auto slot = [textured](int s) { return textured ? s : -1; };
     std::vector<ParamInfo> p = {
         {"distribution", ParamType::String, "beckmann", "microfacet distribution: beckmann or ggx"},
-        {"alpha", ParamType::Float, "0.1", "roughness (0.01 is nearly a mirror, 1 very rough)"},
+        {"alpha", ParamType::Float, "0.1", "roughness (0.01 is nearly a mirror, 1 very rough)", "",
+         slot(MicrofacetDistribution::kSlotAlpha)},
     };
     if (anisotropic) {
         p.push_back({"alpha_u", ParamType::Float, "",
-                     "roughness along the shading frame's tangent (with alpha_v, instead of alpha; without uv the tangent follows from the normal alone)",
-                     "alphaU"});
-        p.push_back({"alpha_v", ParamType::Float, "", "roughness along the bitangent", "alphaV"});
+                     "roughness along the shading frame's tangent, dp/du (with alpha_v, instead of alpha; without uv the tangent follows from the normal alone)",
+                     "alphaU", slot(MicrofacetDistribution::kSlotAlphaU)});
+        p.push_back({"alpha_v", ParamType::Float, "", "roughness along the bitangent", "alphaV", slot(MicrofacetDistribution::kSlotAlphaV)});
     }
     return p;
 }

@@ -81,13 +81,22 @@ struct PhongMaterial {
     }
 
     static Vec3f mirror(const Vec3f& w) { return {-w.x, -w.y, w.z}; }
+
+    // The parameters a texture may give (ParamInfo::texture_slot), and setting one to its
+    // value at a hit.
+    static constexpr int kSlotDiffuse = 0, kSlotSpecular = 1, kSlotExponent = 2;
+    void set_texel(int slot, const Rgb& v) {
+        if (slot == kSlotDiffuse) diffuse = v;
+        else if (slot == kSlotSpecular) specular = v;
+        else exponent = v.x;
+    }
 };
 
 // The scene-file plugins: diffuse (Lambert, Mitsuba 3) and phong (Mitsuba 0.6, the course's
 // normalised Phong).
 inline const PluginInfo& diffuse_plugin() {
     static const PluginInfo info{"bsdf", "diffuse", "Lambertian reflection rho / pi",
-                                 {{"reflectance", ParamType::Rgb, "0.5", "albedo rho"}}};
+                                 {{"reflectance", ParamType::Rgb, "0.5", "albedo rho", "", PhongMaterial::kSlotDiffuse}}};
     return info;
 }
 inline PhongMaterial read_diffuse(Properties& p) { return PhongMaterial{p.get_rgb("reflectance"), Rgb(0.0f), 1}; }
@@ -95,9 +104,9 @@ inline PhongMaterial read_diffuse(Properties& p) { return PhongMaterial{p.get_rg
 inline const PluginInfo& phong_plugin() {
     static const PluginInfo info{
         "bsdf", "phong", "the course's normalised Phong: rho_d / pi + rho_s (n + 2) / (2 pi) cos^n of the angle to the mirror direction",
-        {{"diffuse_reflectance", ParamType::Rgb, "0.5", "rho_d", "diffuseReflectance"},
-         {"specular_reflectance", ParamType::Rgb, "0.2", "rho_s", "specularReflectance"},
-         {"exponent", ParamType::Float, "30", "n"}}};
+        {{"diffuse_reflectance", ParamType::Rgb, "0.5", "rho_d", "diffuseReflectance", PhongMaterial::kSlotDiffuse},
+         {"specular_reflectance", ParamType::Rgb, "0.2", "rho_s", "specularReflectance", PhongMaterial::kSlotSpecular},
+         {"exponent", ParamType::Float, "30", "n", "", PhongMaterial::kSlotExponent}}};
     return info;
 }
 inline PhongMaterial read_phong(Properties& p) {

@@ -39,18 +39,27 @@ struct CoatedDiffuse {
     Rgb specular_reflectance{1.0f};
     float eta = 1.49f / 1.000277f;  // int_ior / ext_ior
     bool nonlinear = false;
+    float fdr = 0;                  // the coating's internal diffuse reflectance Fdr
     Rgb base{0.0f};                 // rho' / (pi eta^2), precomputed
     float specular_weight = 0.5f;   // w
 
     CoatedDiffuse() = default;
     CoatedDiffuse(const Rgb& diffuse, const Rgb& specular, float int_ior, float ext_ior, bool nonlinear_)
-        : diffuse_reflectance(diffuse), specular_reflectance(specular), eta(int_ior / ext_ior), nonlinear(nonlinear_) {
-        const float fdr = fresnel_diffuse_reflectance(1 / eta);
-        const Rgb denom = nonlinear ? Rgb(1.0f) - diffuse * fdr : Rgb(1.0f - fdr);
-        base = diffuse / denom * (kInvPi / (eta * eta));
-        const float s = mean(specular), d = mean(diffuse);
+        : diffuse_reflectance(diffuse), specular_reflectance(specular), eta(int_ior / ext_ior), nonlinear(nonlinear_),
+          fdr(fresnel_diffuse_reflectance(1 / eta)) {
+        update();
+    }
+    // Recomputes what depends on the reflectances and Fdr (after a texture set them).
+    void update() {
+        const Rgb denom = nonlinear ? Rgb(1.0f) - diffuse_reflectance * fdr : Rgb(1.0f - fdr);
+        base = diffuse_reflectance / denom * (kInvPi / (eta * eta));
+        const float s = mean(specular_reflectance), d = mean(diffuse_reflectance);
         specular_weight = s + d > 0 ? s / (s + d) : 0.0f;
     }
+
+    // The parameters a texture may give, and setting one to its value at a hit (update() after).
+    static constexpr int kSlotDiffuse = 0, kSlotSpecular = 1;
+    void set_texel(int slot, const Rgb& v) { (slot == kSlotDiffuse ? diffuse_reflectance : specular_reflectance) = v; }
 
     float fresnel(float cos) const { return fresnel_dielectric(cos, eta); }
     Rgb diffuse(float F_i, float cos_o) const { return base * ((1 - F_i) * (1 - fresnel(cos_o))); }
@@ -85,11 +94,16 @@ struct PlasticMaterial {
         if (!(p > 0)) return std::nullopt;
         return BsdfSample{wo, coat.diffuse(F, wo.z), p, false, kLobeDiffuse | kLobeReflection};
     }
+
+    void set_texel(int slot, const Rgb& v) { coat.set_texel(slot, v); }
+    void texels_changed() { coat.update(); }
 };
 
 inline std::vector<ParamInfo> coated_diffuse_params() {
-    return {{"diffuse_reflectance", ParamType::Rgb, "0.5", "rho, the albedo of the diffuse base", "diffuseReflectance"},
-            {"specular_reflectance", ParamType::Rgb, "1", "scales the coating's reflection", "specularReflectance"},
+    return {{"diffuse_reflectance", ParamType::Rgb, "0.5", "rho, the albedo of the diffuse base", "diffuseReflectance",
+             CoatedDiffuse::kSlotDiffuse},
+            {"specular_reflectance", ParamType::Rgb, "1", "scales the coating's reflection", "specularReflectance",
+             CoatedDiffuse::kSlotSpecular},
             {"int_ior", ParamType::FloatOrString, "polypropylene", "index of the coating, a number or a name", "intIOR"},
             {"ext_ior", ParamType::FloatOrString, "air", "index of the outside", "extIOR"},
             {"nonlinear", ParamType::Boolean, "false",

@@ -2,6 +2,9 @@
 
 #include <fmt/format.h>
 
+#include "bsdfs/bumpmap.hpp"
+#include "bsdfs/normalmap.hpp"
+
 namespace pathlab {
 namespace {
 
@@ -24,14 +27,14 @@ const PluginInfo& twosided_plugin() {
 const PluginInfo& blendbsdf_plugin() {
     static const PluginInfo info{"bsdf", "blendbsdf",
                                  "(1 - weight) first + weight second: wraps exactly two nested BSDFs (<bsdf> or <ref>, not dielectrics)",
-                                 {{"weight", ParamType::Float, "0.5", "the second BSDF's share, 0 to 1 (a <texture> needs textures: refused)"}}};
+                                 {{"weight", ParamType::Float, "0.5", "the second BSDF's share, 0 to 1", "", BlendMaterial::kSlotWeight}}};
     return info;
 }
 
 const PluginInfo& mask_plugin() {
     static const PluginInfo info{"bsdf", "mask",
                                  "opacity * the nested BSDF; the rest passes straight through (cut-outs such as leaves): wraps one BSDF",
-                                 {{"opacity", ParamType::Float, "0.5", "0 (invisible) to 1 (opaque) (a <texture> needs textures: refused)"}}};
+                                 {{"opacity", ParamType::Float, "0.5", "0 (invisible) to 1 (opaque)", "", MaskMaterial::kSlotOpacity}}};
     return info;
 }
 
@@ -49,6 +52,8 @@ const std::vector<BsdfPlugin>& bsdf_plugins() {
         {twosided_plugin, nullptr},
         {blendbsdf_plugin, nullptr},
         {mask_plugin, nullptr},
+        {normalmap_plugin, nullptr},
+        {bumpmap_plugin, nullptr},
     };
     return table;
 }

@@ -14,8 +14,8 @@ namespace pathlab {
 
 struct BsdfPlugin {
     const PluginInfo& (*info)();
-    // Builds the material from its parameters; null for twosided, a wrapper of another BSDF
-    // that the scene-file reader applies.
+    // Builds the material from its parameters; null for the wrappers of another BSDF that the
+    // scene-file reader applies: twosided, normalmap, bumpmap.
     Material (*read)(Properties&);
 };
 

@@ -65,14 +65,22 @@ struct RoughConductorMaterial {
         if (!(p > 0)) return std::nullopt;
         return BsdfSample{wo, f, p, false, kLobeGlossy | kLobeReflection};
     }
+
+    // The parameters a texture may give: the reflectance, or the roughness (microfacet.hpp).
+    static constexpr int kSlotSpecularReflectance = 0;
+    void set_texel(int slot, const Rgb& v) {
+        if (slot == kSlotSpecularReflectance) specular_reflectance = v;
+        else distribution.set_texel(slot, v.x);
+    }
 };
 
 inline const PluginInfo& roughconductor_plugin() {
     static const PluginInfo info = [] {
-        PluginInfo i{"bsdf", "roughconductor", "a rough metal: Cook-Torrance / Walter et al. microfacet reflection", microfacet_params(true)};
+        PluginInfo i{"bsdf", "roughconductor", "a rough metal: Cook-Torrance / Walter et al. microfacet reflection",
+                     microfacet_params(true, true)};
         i.params.insert(i.params.end(), {kConductorMaterialParam, kConductorEtaParam, kConductorKParam,
                                          {"specular_reflectance", ParamType::Rgb, "1", "scales the reflectance (not physical)",
-                                          "specularReflectance"},
+                                          "specularReflectance", RoughConductorMaterial::kSlotSpecularReflectance},
                                          kSampleVisibleParam});
         return i;
     }();

@@ -123,12 +123,15 @@ struct RoughDielectricMaterial {
         if (!(p > 0)) return std::nullopt;
         return BsdfSample{wo, f, p, false, kLobeGlossy | (reflect_lobe ? kLobeReflection : kLobeTransmission)};
     }
+
+    // A texture may give the roughness (microfacet.hpp's slots).
+    void set_texel(int slot, const Rgb& v) { distribution.set_texel(slot, v.x); }
 };
 
 inline const PluginInfo& roughdielectric_plugin() {
     static const PluginInfo info = [] {
         PluginInfo i{"bsdf", "roughdielectric", "a rough interface between two dielectrics (frosted glass): Walter et al. 2007",
-                     microfacet_params(true)};
+                     microfacet_params(true, true)};
         i.params.insert(i.params.end(), {kIntIorParam, kExtIorParam, kSampleVisibleParam});
         return i;
     }();

@@ -55,10 +55,8 @@ struct RoughPlasticMaterial {
             const double m0 = double(k) / (kTableSize - 1), m1 = double(k + 1) / (kTableSize - 1);
             integral += 0.5 * (transmittance[size_t(k)] * m0 + transmittance[size_t(k + 1)] * m1) * (m1 - m0);
         }
-        const float fdr = float(1 - 2 * integral / (double(coat.eta) * coat.eta));
-        const Rgb& rho = coat.diffuse_reflectance;
-        const Rgb denom = coat.nonlinear ? Rgb(1.0f) - rho * fdr : Rgb(1.0f - fdr);
-        coat.base = rho / denom * (kInvPi / (coat.eta * coat.eta));
+        coat.fdr = float(1 - 2 * integral / (double(coat.eta) * coat.eta));
+        coat.update();
     }
 
     // T(mu), linearly interpolated.
@@ -112,6 +110,10 @@ struct RoughPlasticMaterial {
         return BsdfSample{wo, f, p, false, lobe};
     }
 
+    // Textures may give the reflectances, not the roughness (the transmittance table depends on it).
+    void set_texel(int slot, const Rgb& v) { coat.set_texel(slot, v); }
+    void texels_changed() { coat.update(); }
+
 private:
     // E(mu): albedo of the coating's reflection (R_s = 1) for light arriving at cosine mu, by
     // the midpoint rule over microfacet normals with theta_h = atan(a tan(pi t / 2)), t
@@ -141,7 +143,7 @@ private:
 
 inline const PluginInfo& roughplastic_plugin() {
     static const PluginInfo info = [] {
-        PluginInfo i{"bsdf", "roughplastic", "a diffuse base under a rough dielectric coating", microfacet_params(false)};
+        PluginInfo i{"bsdf", "roughplastic", "a diffuse base under a rough dielectric coating", microfacet_params(false, false)};
         for (const ParamInfo& c : coated_diffuse_params()) i.params.push_back(c);
         i.params.push_back(kSampleVisibleParam);
         return i;

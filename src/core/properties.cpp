@@ -124,7 +124,8 @@ Properties::Value* Properties::lookup(const std::string& name) {
     const auto it = values_.find(p.name);
     if (it == values_.end()) return nullptr;
     Value& v = it->second;
-    const std::vector<const char*> tags = allowed_tags(p.type);
+    std::vector<const char*> tags = allowed_tags(p.type);
+    if (p.texture_slot >= 0) tags.push_back("texture");
     if (std::find_if(tags.begin(), tags.end(), [&](const char* t) { return v.tag == t; }) == tags.end())
         throw PropertyError(v.where, fmt::format("parameter '{}' must be given as <{}>, not <{}>", spelled_.at(p.name),
                                                  fmt::join(tags, "> or <"), v.tag));

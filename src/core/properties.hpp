@@ -52,6 +52,9 @@ struct ParamInfo {
     std::string default_value;  // as it would be written in a file; empty: none (optional)
     std::string doc;            // one line
     std::string old_name = {};  // Mitsuba 0.6's camelCase spelling, accepted too
+    // 0 or more: a texture may give this parameter (a <texture> or <ref> child of the plugin's
+    // element); the number says which of the model's parameters it sets (bsdfs/material.hpp).
+    int texture_slot = -1;
 };
 
 struct PluginInfo {
@@ -68,7 +71,8 @@ struct PluginInfo {
 class Properties {
 public:
     struct Value {
-        std::string tag;    // the element that gave it: float, integer, boolean, string, rgb, spectrum, point, vector, transform
+        std::string tag;    // the element that gave it: float, integer, boolean, string, rgb, spectrum, point, vector,
+                            // transform, or texture (text: the texture's largest value, read as a constant)
         std::string text;   // its value attribute, after $name substitution
         Vec3f xyz{0.0f};    // point/vector given as x, y, z attributes (xyz_given)
         bool xyz_given = false;

@@ -101,6 +101,21 @@ struct Transform {
                 if (!std::isfinite(v)) return false;
         return true;
     }
+    // The inverse of an affine, invertible transform (is_affine_invertible()).
+    Transform inverse_affine() const {
+        const double det = determinant();
+        Transform r;
+        // The linear part's inverse is its adjugate over the determinant; then the translation.
+        const auto& a = m;
+        r.m[0] = {a[1][1] * a[2][2] - a[1][2] * a[2][1], a[0][2] * a[2][1] - a[0][1] * a[2][2], a[0][1] * a[1][2] - a[0][2] * a[1][1], 0};
+        r.m[1] = {a[1][2] * a[2][0] - a[1][0] * a[2][2], a[0][0] * a[2][2] - a[0][2] * a[2][0], a[0][2] * a[1][0] - a[0][0] * a[1][2], 0};
+        r.m[2] = {a[1][0] * a[2][1] - a[1][1] * a[2][0], a[0][1] * a[2][0] - a[0][0] * a[2][1], a[0][0] * a[1][1] - a[0][1] * a[1][0], 0};
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) r.m[size_t(i)][size_t(j)] /= det;
+        for (int i = 0; i < 3; ++i)
+            r.m[size_t(i)][3] = -(r.m[size_t(i)][0] * a[0][3] + r.m[size_t(i)][1] * a[1][3] + r.m[size_t(i)][2] * a[2][3]);
+        return r;
+    }
     // Affine (last row 0 0 0 1) and invertible.
     bool is_affine_invertible() const {
         return m[3][0] == 0 && m[3][1] == 0 && m[3][2] == 0 && m[3][3] == 1 && std::abs(determinant()) > 1e-300;

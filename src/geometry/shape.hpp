@@ -26,6 +26,10 @@ struct MediumInterface {
     int32_t medium_towards(const Vec3f& w, const Vec3f& ng) const { return dot(w, ng) > 0 ? exterior : interior; }
 };
 
+// How a mesh's surface coordinates uv are found at a hit: interpolated from its per-vertex
+// `uvs`, or (a disk's triangle fan) computed from the hit point as Mitsuba 3's disk does.
+enum class UvMap : unsigned char { Vertices, Disk };
+
 struct MeshDesc {
     std::string name;
     std::vector<Vec3f> positions;
@@ -35,6 +39,8 @@ struct MeshDesc {
     uint32_t material = 0;
     Rgb emission{0.0f};  // radiance of a one-sided area emitter on the winding-normal side
     MediumInterface media{};
+    UvMap uv_map = UvMap::Vertices;
+    Transform to_world, to_object;  // UvMap::Disk: the unit disk's placement and its inverse
 };
 
 struct SphereDesc {
@@ -44,6 +50,9 @@ struct SphereDesc {
     bool flip_normals = false;  // normals point inwards
     Rgb emission{0.0f};         // radiance of a one-sided area emitter on the normal side
     MediumInterface media{};
+    // The world directions of the sphere's own x, y, z axes (its to_world's rotation), which
+    // its uv parameterisation (the poles on z, u = 0 towards x) follows.
+    std::array<Vec3f, 3> axes{{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
 };
 
 // A shapegroup: meshes that instances place, each instance by its own transform (Embree

@@ -6,6 +6,7 @@
 
 #include <tiny_obj_loader.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <tuple>
@@ -17,20 +18,56 @@ namespace pathlab {
 MeshDesc rectangle_mesh() {
     MeshDesc m;
     m.positions = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
+    m.uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};  // Mitsuba 3: uv = ((x + 1) / 2, (y + 1) / 2)
     m.triangles = {{0, 1, 2}, {2, 3, 0}};
     return m;
 }
 
 MeshDesc cube_mesh() {
+    // The corners (bit 0: x, bit 1: y, bit 2: z), and two counter-clockwise (seen from
+    // outside) triangles of them per face.
+    Vec3f corner[8];
+    for (int i = 0; i < 8; ++i) corner[i] = {i & 1 ? 1.0f : -1.0f, i & 2 ? 1.0f : -1.0f, i & 4 ? 1.0f : -1.0f};
+    const uint32_t faces[6][6] = {{0, 2, 3, 3, 1, 0},   // z = -1
+                                  {4, 5, 7, 7, 6, 4},   // z = +1
+                                  {0, 1, 5, 5, 4, 0},   // y = -1
+                                  {2, 6, 7, 7, 3, 2},   // y = +1
+                                  {0, 4, 6, 6, 2, 0},   // x = -1
+                                  {1, 3, 7, 7, 5, 1}};  // x = +1
+    // Each face mapped onto [0, 1]^2 as Mitsuba 3's cube maps it (its vertex table), u and v
+    // as functions of the corner's coordinates on that face.
+    const auto face_uv = [](int face, const Vec3f& p) -> Vec2f {
+        const auto h = [](float c) { return (c + 1) * 0.5f; };   // -1 -> 0, 1 -> 1
+        const auto r = [](float c) { return (1 - c) * 0.5f; };   // -1 -> 1, 1 -> 0
+        switch (face) {
+            case 0: return {r(p.y), h(p.x)};  // z = -1
+            case 1: return {h(p.y), h(p.x)};  // z = +1
+            case 2: return {h(p.z), h(p.x)};  // y = -1
+            case 3: return {r(p.x), r(p.z)};  // y = +1
+            case 4: return {h(p.y), h(p.z)};  // x = -1
+            default: return {h(p.y), r(p.z)};  // x = +1
+        }
+    };
+    // Four vertices per face (so that each face has its own uv); the triangles keep their
+    // corners and their order, so the geometry is exactly what it was without uv.
     MeshDesc m;
-    for (int i = 0; i < 8; ++i) m.positions.push_back({i & 1 ? 1.0f : -1.0f, i & 2 ? 1.0f : -1.0f, i & 4 ? 1.0f : -1.0f});
-    // Two counter-clockwise (seen from outside) triangles per face.
-    m.triangles = {{0, 2, 3}, {3, 1, 0},   // z = -1
-                   {4, 5, 7}, {7, 6, 4},   // z = +1
-                   {0, 1, 5}, {5, 4, 0},   // y = -1
-                   {2, 6, 7}, {7, 3, 2},   // y = +1
-                   {0, 4, 6}, {6, 2, 0},   // x = -1
-                   {1, 3, 7}, {7, 5, 1}};  // x = +1
+    for (int f = 0; f < 6; ++f) {
+        uint32_t local[8];
+        std::fill(local, local + 8, UINT32_MAX);
+        for (int k = 0; k < 6; k += 3) {
+            std::array<uint32_t, 3> tri;
+            for (int j = 0; j < 3; ++j) {
+                const uint32_t c = faces[f][k + j];
+                if (local[c] == UINT32_MAX) {
+                    local[c] = uint32_t(m.positions.size());
+                    m.positions.push_back(corner[c]);
+                    m.uvs.push_back(face_uv(f, corner[c]));
+                }
+                tri[size_t(j)] = local[c];
+            }
+            m.triangles.push_back(tri);
+        }
+    }
     return m;
 }
 
@@ -42,6 +79,7 @@ MeshDesc disk_mesh(int segments) {
         m.positions.push_back({float(std::cos(phi)), float(std::sin(phi)), 0});
     }
     for (int i = 0; i < segments; ++i) m.triangles.push_back({0, uint32_t(1 + i), uint32_t(1 + (i + 1) % segments)});
+    m.uv_map = UvMap::Disk;
     return m;
 }
 
@@ -184,6 +222,8 @@ MeshDesc load_obj_mesh(const std::string& path) {
 
 void transform_mesh(MeshDesc& mesh, const Transform& t) {
     if (t.m == Transform().m) return;
+    mesh.to_world = t * mesh.to_world;
+    mesh.to_object = mesh.to_world.inverse_affine();
     for (Vec3f& p : mesh.positions) p = Vec3f(t.point(Vec3d(p)));
     for (Vec3f& n : mesh.normals) {
         const Vec3d tn = t.normal(Vec3d(n));

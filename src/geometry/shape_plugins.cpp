@@ -61,26 +61,30 @@ ShapeDesc read_obj(Properties& p, const ShapeContext& ctx) {
 }
 
 const PluginInfo& rectangle_plugin() {
-    static const PluginInfo info{"shape", "rectangle", "[-1, 1]^2 in the z = 0 plane, normal +z", {kToWorld, kFlipNormals, kFaceNormals}};
+    static const PluginInfo info{"shape", "rectangle", "[-1, 1]^2 in the z = 0 plane, normal +z; uv = ((x + 1) / 2, (y + 1) / 2)",
+                                 {kToWorld, kFlipNormals, kFaceNormals}};
     return info;
 }
 ShapeDesc read_rectangle(Properties& p, const ShapeContext&) { return finish_mesh(rectangle_mesh(), p); }
 
 const PluginInfo& cube_plugin() {
-    static const PluginInfo info{"shape", "cube", "[-1, 1]^3, outward normals", {kToWorld, kFlipNormals, kFaceNormals}};
+    static const PluginInfo info{"shape", "cube", "[-1, 1]^3, outward normals; each face mapped onto [0, 1]^2 in uv (as Mitsuba 3)",
+                                 {kToWorld, kFlipNormals, kFaceNormals}};
     return info;
 }
 ShapeDesc read_cube(Properties& p, const ShapeContext&) { return finish_mesh(cube_mesh(), p); }
 
 const PluginInfo& disk_plugin() {
-    static const PluginInfo info{"shape", "disk", "the unit disk in the z = 0 plane, normal +z (a fan of 128 triangles, 0.04% less area)",
+    static const PluginInfo info{"shape", "disk",
+                                 "the unit disk in the z = 0 plane, normal +z (a fan of 128 triangles, 0.04% less area); uv = (r, phi / 2 pi), exact",
                                  {kToWorld, kFlipNormals, kFaceNormals}};
     return info;
 }
 ShapeDesc read_disk(Properties& p, const ShapeContext&) { return finish_mesh(disk_mesh(), p); }
 
 const PluginInfo& sphere_plugin() {
-    static const PluginInfo info{"shape", "sphere", "an exact sphere (intersected in double precision, not tessellated)",
+    static const PluginInfo info{"shape", "sphere",
+                                 "an exact sphere (intersected in double precision, not tessellated); uv = (phi / 2 pi, theta / pi) about its z axis",
                                  {{"center", ParamType::Point, "0, 0, 0", "centre"},
                                   {"radius", ParamType::Float, "1", "radius"},
                                   {"to_world", ParamType::Transform, "", "may only translate, rotate and scale uniformly", "toWorld"},
@@ -108,6 +112,8 @@ ShapeDesc read_sphere(Properties& p, const ShapeContext&) {
     s.center = Vec3f(center);
     s.radius = float(radius);
     s.flip_normals = flip;
+    if (to_world)
+        for (int i = 0; i < 3; ++i) s.axes[size_t(i)] = Vec3f(normalize(to_world->vector(Vec3d(i == 0, i == 1, i == 2))));
     return s;
 }
 

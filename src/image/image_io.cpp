@@ -27,6 +27,7 @@
 
 #include "image/file_io.hpp"
 #include "image/rgbe.hpp"
+#include "image/stb_jpeg.hpp"
 #include "image/stb_png.hpp"
 
 namespace pathlab {
@@ -559,6 +560,81 @@ Image8 read_png(const io::ByteSource& src, const ImageReadLimits& limits) {
     return img;
 }
 
+// ---- JPEG through stb ----------------------------------------------------------------------
+
+uint32_t be16(const uint8_t* p) { return uint32_t(p[0]) << 8 | uint32_t(p[1]); }
+
+// The markers up to the first scan are read here (stb_image reads them again): the frame's
+// size is checked before stb allocates anything, the codings stb does not decode are named,
+// and a file without its end-of-image marker is refused as truncated (stb would fill the
+// missing part of the image with grey and succeed).
+Image8 read_jpeg(const io::ByteSource& src, const ImageReadLimits& limits) {
+    const std::string& name = src.name();
+    if (src.size() < 4) throw ImageIoError(fmt::format("{}: not a JPEG file (it is {} bytes long)", name, src.size()));
+    uint8_t head[2];
+    src.read(0, head, 2);
+    if (head[0] != 0xff || head[1] != 0xd8) throw ImageIoError(fmt::format("{}: not a JPEG file (no start-of-image marker)", name));
+    if (src.size() > uint64_t(INT32_MAX)) throw ImageIoError(fmt::format("{}: files over 2 GiB are not read", name));
+    const io::Bytes bytes(src, src.size());
+    const uint8_t* b = bytes.data();
+    const size_t n = bytes.size();
+    const auto truncated = [&](const char* where) { return ImageIoError(fmt::format("{}: truncated: the file ends {}", name, where)); };
+    uint64_t w = 0, h = 0;
+    size_t pos = 2, scan = 0;
+    while (scan == 0) {
+        if (pos >= n) throw truncated("before its image data");
+        if (b[pos] != 0xff) throw ImageIoError(fmt::format("{}: corrupt: no marker at byte {} (0x{:02x})", name, pos, b[pos]));
+        while (pos < n && b[pos] == 0xff) ++pos;  // fill bytes
+        if (pos >= n) throw truncated("in a marker");
+        const unsigned m = b[pos++];
+        if (m == 0xd8 || m == 0x01 || (m >= 0xd0 && m <= 0xd7)) continue;  // markers without a segment
+        if (m == 0xd9) throw ImageIoError(fmt::format("{}: the image ends before any image data", name));
+        if (n - pos < 2) throw truncated("in a segment's length");
+        const size_t len = be16(b + pos);
+        if (len < 2) throw ImageIoError(fmt::format("{}: corrupt: a segment of length {}", name, len));
+        if (len > n - pos) throw truncated(fmt::format("inside a segment of {} bytes", len).c_str());
+        const bool frame = m >= 0xc0 && m <= 0xcf && m != 0xc4 && m != 0xc8 && m != 0xcc;
+        if (frame) {
+            if (len < 8) throw ImageIoError(fmt::format("{}: corrupt: a frame header of {} bytes", name, len));
+            if (m != 0xc0 && m != 0xc1 && m != 0xc2) {
+                const char* kind = m == 0xc3 ? "lossless" : (m >= 0xc9 ? "arithmetic-coded" : "hierarchical");
+                throw ImageIoError(fmt::format("{}: unsupported JPEG coding: {} (baseline and progressive JPEGs are read)", name, kind));
+            }
+            const unsigned precision = b[pos + 2], components = b[pos + 7];
+            h = be16(b + pos + 3), w = be16(b + pos + 5);
+            if (precision != 8) throw ImageIoError(fmt::format("{}: unsupported JPEG: {} bits per sample (8 are read)", name, precision));
+            if (h == 0) throw ImageIoError(fmt::format("{}: unsupported JPEG: its height is given after the image data (DNL)", name));
+            if (components != 1 && components != 3 && components != 4)
+                throw ImageIoError(fmt::format("{}: unsupported JPEG: {} components (1, 3 or 4 are read)", name, components));
+            io::check_image_size(name, w, h, limits.max_pixels, 3);
+        }
+        if (m == 0xda) {
+            if (w == 0) throw ImageIoError(fmt::format("{}: corrupt: image data before the frame header", name));
+            scan = pos + len;
+        }
+        pos += len;
+    }
+    // Every 8x8 block of the first scan takes at least one bit, so a complete file holds at
+    // least one byte per 512 pixels.
+    if (double(n) * 512 + 4096 < double(w) * double(h))
+        throw ImageIoError(fmt::format("{}: truncated: {} bytes cannot hold {}x{} pixels", name, n, w, h));
+    bool end = false;
+    for (size_t i = n - 1; i > scan && !end; --i) end = b[i - 1] == 0xff && b[i] == 0xd9;
+    if (!end) throw truncated("before its end-of-image marker");
+    // Everything stb needs: the file, per component the decoded samples and (progressive) the
+    // coefficients, at most four components padded to whole 32x32 blocks, and the RGB image.
+    const size_t budget = n + size_t(40 * (w + 32) * (h + 32)) + (size_t(4) << 20);
+    Image8 img;
+    const io::JpegDecodeResult r = io::decode_jpeg_rgb8(b, n, budget, img);
+    if (!r.ok) {
+        if (r.over_budget) throw ImageIoError(fmt::format("{}: decoding it would take more memory than a {}x{} image needs (corrupt?)", name, w, h));
+        throw ImageIoError(fmt::format("{}: {}", name, r.error));
+    }
+    if (uint64_t(img.width) != w || uint64_t(img.height) != h)
+        throw ImageIoError(fmt::format("{}: corrupt: decoded {}x{} pixels for a {}x{} frame", name, img.width, img.height, w, h));
+    return img;
+}
+
 // Runs a reader, giving each of its errors as "NAME: cannot read FORMAT: reason".
 template <typename Read>
 auto reading(const io::ByteSource& src, const char* format, Read&& read) -> decltype(read()) {
@@ -583,6 +659,10 @@ Image read_from(ImageFormat format, const io::ByteSource& src, const ImageReadLi
 
 Image8 read_png8_from(const io::ByteSource& src, const ImageReadLimits& limits) {
     return reading(src, "PNG", [&] { return read_png(src, limits); });
+}
+
+Image8 read_jpeg8_from(const io::ByteSource& src, const ImageReadLimits& limits) {
+    return reading(src, "JPEG", [&] { return read_jpeg(src, limits); });
 }
 
 void write_encoded(const Image& img, ImageFormat format, io::FdWriter& out, const std::string& name, float png_exposure) {
@@ -673,6 +753,12 @@ Image read_image_from_memory(ImageFormat format, const void* data, size_t size, 
 
 Image8 read_png8_from_memory(const void* data, size_t size, const std::string& name, const ImageReadLimits& limits) {
     return read_png8_from(io::MemorySource(data, size, name), limits);
+}
+
+Image8 read_jpeg8(const std::string& path, const ImageReadLimits& limits) { return read_jpeg8_from(io::FileSource(path), limits); }
+
+Image8 read_jpeg8_from_memory(const void* data, size_t size, const std::string& name, const ImageReadLimits& limits) {
+    return read_jpeg8_from(io::MemorySource(data, size, name), limits);
 }
 
 }  // namespace pathlab

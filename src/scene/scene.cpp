@@ -1,6 +1,7 @@
 #include "scene/scene.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include <fmt/format.h>
 
@@ -92,6 +93,7 @@ std::unique_ptr<Scene> Scene::build(const SceneDescription& desc) {
     s->width_ = desc.width;
     s->height_ = desc.height;
     s->materials_ = desc.materials;
+    for (Material& m : s->materials_) m.prepare();
 
     for (const FreeLight& l : desc.lights) {
         std::visit([&](const auto& light) { s->lights_.emplace_back(light); }, l);
@@ -171,6 +173,8 @@ bool Scene::has_hittable_emitters() const {
 [[gnu::always_inline]] inline void Scene::fill(const Ray& ray, const RawHit& raw, Intersection& hit) const {
     hit.t = raw.t;
     hit.uv = Vec2f(0.0f, 0.0f);
+    hit.geom_id = raw.geom_id;
+    hit.prim_id = raw.prim_id;
     if (raw.inst_id != RawHit::kNoInstance) [[unlikely]] {
         instance_hit(raw, hit);
         return;
@@ -221,6 +225,66 @@ bool Scene::intersect(const Ray& ray, Intersection& hit, uint32_t mask, const Me
     return true;
 }
 
+Scene::SurfaceCoordinates Scene::surface_coordinates(const Intersection& hit) const {
+    SurfaceCoordinates c{hit.uv, Vec3f(0.0f), Vec3f(0.0f)};
+    if (hit.geom_id == Intersection::kInstanceHit) {
+        // An instance's mesh: its interpolated uv, and two tangents of the geometric normal
+        // (dp/du of instanced meshes is not computed yet: the hit does not keep the instance).
+        const Frame f(hit.ng);
+        c.dpdu = f.s;
+        c.dpdv = f.t;
+        return c;
+    }
+    const GeometryRecord& rec = geometry_[hit.geom_id];
+    if (rec.is_sphere) {
+        // Mitsuba 3's sphere: the hit in the sphere's own unit space, theta from its z axis, phi
+        // about it from its x axis; uv = (phi / 2 pi, theta / pi).
+        const SphereDesc& s = desc_.spheres[rec.index];
+        const Vec3d q = (Vec3d(hit.p) - Vec3d(s.center)) / double(s.radius);
+        const Vec3d e[3] = {Vec3d(s.axes[0]), Vec3d(s.axes[1]), Vec3d(s.axes[2])};
+        const double x = dot(q, e[0]), y = dot(q, e[1]), z = std::clamp(dot(q, e[2]), -1.0, 1.0);
+        double phi = std::atan2(y, x);
+        if (phi < 0) phi += 2 * M_PI;
+        const double theta = std::acos(z), rd = std::hypot(x, y), r = s.radius;
+        c.uv = Vec2f(float(phi / (2 * M_PI)), float(theta / M_PI));
+        // dp/du = 2 pi r (-y, x, 0), dp/dv = pi r (z cos phi, z sin phi, -rd) in the sphere's axes.
+        c.dpdu = Vec3f((e[0] * -y + e[1] * x) * (2 * M_PI * r));
+        c.dpdv = rd > 0 ? Vec3f((e[0] * (z * x / rd) + e[1] * (z * y / rd) - e[2] * rd) * (M_PI * r)) : Vec3f(e[0] * (M_PI * r));
+        return c;
+    }
+    const MeshDesc& m = *rec.mesh;
+    const auto& tri = m.triangles[hit.prim_id];
+    if (m.uv_map == UvMap::Disk) {
+        // Mitsuba 3's disk: the hit in the unit disk's space in polar coordinates, uv = (r, phi / 2 pi).
+        const Vec3d local = m.to_object.point(Vec3d(hit.p));
+        const double r = std::hypot(local.x, local.y);
+        double phi = std::atan2(local.y, local.x);
+        if (phi < 0) phi += 2 * M_PI;
+        c.uv = Vec2f(float(r), float(phi / (2 * M_PI)));
+        const double cs = r > 0 ? local.x / r : 1, sn = r > 0 ? local.y / r : 0;
+        c.dpdu = Vec3f(m.to_world.vector({cs, sn, 0}));
+        c.dpdv = Vec3f(m.to_world.vector(Vec3d(-sn, cs, 0) * (2 * M_PI * r)));
+        return c;
+    }
+    if (!m.uvs.empty()) {  // (uv itself was interpolated by intersect())
+        // p = p0 + dp/du (u - u0) + dp/dv (v - v0) across the triangle.
+        const Vec3f dp0 = m.positions[tri[1]] - m.positions[tri[0]], dp1 = m.positions[tri[2]] - m.positions[tri[0]];
+        const Vec2f uv0 = m.uvs[tri[0]];
+        const Vec2f d0(m.uvs[tri[1]].x - uv0.x, m.uvs[tri[1]].y - uv0.y), d1(m.uvs[tri[2]].x - uv0.x, m.uvs[tri[2]].y - uv0.y);
+        const float det = d0.x * d1.y - d0.y * d1.x;
+        if (det != 0 && std::isfinite(1 / det)) {
+            const float inv = 1 / det;
+            c.dpdu = (dp0 * d1.y - dp1 * d0.y) * inv;
+            c.dpdv = (dp1 * d0.x - dp0 * d1.x) * inv;
+            if (is_finite(c.dpdu) && is_finite(c.dpdv)) return c;
+        }
+    }
+    const Frame f(hit.ng);
+    c.dpdu = f.s;
+    c.dpdv = f.t;
+    return c;
+}
+
 void Scene::instance_hit(const RawHit& raw, Intersection& hit) const {
     const InstanceDesc& inst = desc_.instances[size_t(geometry_[raw.inst_id].instance)];
     const MeshDesc& m = desc_.groups[inst.group].meshes[raw.geom_id];
@@ -250,6 +314,7 @@ void Scene::instance_hit(const RawHit& raw, Intersection& hit) const {
     if (!m.uvs.empty()) hit.uv = m.uvs[tri[0]] * b0 + m.uvs[tri[1]] * b1 + m.uvs[tri[2]] * b2;
     hit.material = m.material;
     hit.light = -1;
+    hit.geom_id = Intersection::kInstanceHit;
 }
 
 bool Scene::occluded(const Ray& ray) const {

@@ -23,8 +23,10 @@ struct Intersection {
     Vec3f p;             // hit point, recomputed from the primitive (not o + t d) for accuracy
     Vec3f ng;            // unit geometric normal as the shape defines it (winding / outward)
     Vec3f ns;            // unit shading normal (ng unless the mesh has vertex normals)
-    Vec2f uv{0.0f, 0.0f};  // surface coordinates (mesh texture coordinates); (0, 0) where there are none
+    Vec2f uv{0.0f, 0.0f};  // a mesh's interpolated texture coordinates; (0, 0) where it has none
     float t = 0;
+    uint32_t geom_id, prim_id;  // the shape and triangle hit, for surface_coordinates() (set by intersect())
+    static constexpr uint32_t kInstanceHit = 0xffffffffu;  // geom_id of a hit on an instance's mesh
     uint32_t material = 0;
     int32_t light = -1;  // index into Scene::lights() of the area light here, or -1
 };
@@ -54,6 +56,17 @@ public:
     int32_t camera_medium() const { return desc_.camera_medium; }
     // True when some shape changes the medium or the camera sits in one.
     bool has_media() const { return has_media_; }
+
+    // The surface's coordinates at a hit, for materials that use them (textures, normal and bump
+    // maps, anisotropic roughness), computed on demand so that other hits pay nothing: uv (a
+    // mesh's interpolated texture coordinates, or the analytic parameterisations of spheres
+    // and disks, Mitsuba 3's) and the derivatives dp/du, dp/dv (on a mesh from its triangle's
+    // texture coordinates; without them, two unit tangents from the geometric normal).
+    struct SurfaceCoordinates {
+        Vec2f uv;
+        Vec3f dpdu, dpdv;
+    };
+    SurfaceCoordinates surface_coordinates(const Intersection& hit) const;
     const std::vector<Light>& lights() const { return lights_; }
     bool has_delta_lights() const;
     // True when a sampled direction can find emission (an area light or the environment).

@@ -11,6 +11,7 @@
 #include "media/medium.hpp"
 #include "render/film.hpp"
 #include "samplers/sampler.hpp"
+#include "textures/registry.hpp"
 #include "scenefile/readers.hpp"
 
 namespace pathlab {
@@ -40,6 +41,7 @@ std::vector<PluginInfo> all_plugins() {
     for (const PluginInfo& s : group_shape_plugins()) out.push_back(s);
     for (const BsdfPlugin& b : bsdf_plugins()) out.push_back(b.info());
     out.push_back(null_bsdf_plugin());
+    for (const TexturePlugin& t : texture_plugins()) out.push_back(t.info());
     for (const EmitterPlugin& e : emitter_plugins()) out.push_back(e.info());
     for (const PluginInfo& (*media)() : {homogeneous_plugin, heterogeneous_plugin, isotropic_phase_plugin, hg_phase_plugin,
                                          gridvolume_plugin, constvolume_plugin})
@@ -63,7 +65,8 @@ std::string plugin_reference_markdown() {
         md += fmt::format("| {} | | | | {} |\n", type, cell(p.summary));
         for (const ParamInfo& q : p.params) {
             const std::string name = q.old_name.empty() ? fmt::format("`{}`", q.name) : fmt::format("`{}` (`{}`)", q.name, q.old_name);
-            md += fmt::format("| | {} | {} | {} | {} |\n", name, param_type_name(q.type), cell(q.default_value), cell(q.doc));
+            const std::string type = std::string(param_type_name(q.type)) + (q.texture_slot >= 0 ? " or texture" : "");
+            md += fmt::format("| | {} | {} | {} | {} |\n", name, type, cell(q.default_value), cell(q.doc));
         }
     }
     return md;

@@ -5,6 +5,7 @@
 
 #include <any>
 #include <map>
+#include <memory>
 #include <optional>
 #include <set>
 #include <string>
@@ -58,6 +59,8 @@ void use_default_sensor(SceneBuilder& b);
 // A <bsdf> element, or a <ref> to one (nested BSDFs of twosided, blendbsdf, mask may be refs).
 Material read_bsdf(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b);   // read_bsdf.cpp
 void read_named_bsdf(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b);
+std::shared_ptr<const Texture> read_texture(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b);  // read_texture.cpp
+void read_named_texture(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b);
 void read_shape(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b);       // read_shape.cpp
 std::vector<PluginInfo> group_shape_plugins();  // shapegroup, instance
 void read_free_emitter(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b);  // read_emitter.cpp

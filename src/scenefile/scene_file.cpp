@@ -107,15 +107,14 @@ void Loader::read_children(XmlSource& xml, const pugi::xml_node& scene) {
         } else if (tag == "integrator") read_integrator(xml, n, b);
         else if (tag == "sensor") read_sensor(xml, n, b);
         else if (tag == "bsdf") read_named_bsdf(xml, n, b);
+        else if (tag == "texture") read_named_texture(xml, n, b);
         else if (tag == "shape") read_shape(xml, n, b);
         else if (tag == "emitter") read_free_emitter(xml, n, b);
-        else if (tag == "texture")
-            xml.fail(n, "<texture> needs textures, which pathlab does not have yet; use constant values (<rgb>, <float>)");
         else if (tag == "medium")
             read_named_medium(xml, n, b);
         else
             xml.fail(n, fmt::format("unsupported element <{}> in <scene>; supported: <default>, <path>, <include>, <alias>, "
-                                    "<integrator>, <sensor>, <bsdf>, <shape>, <emitter>, <medium>", tag));
+                                    "<integrator>, <sensor>, <bsdf>, <texture>, <shape>, <emitter>, <medium>", tag));
     }
 }
 

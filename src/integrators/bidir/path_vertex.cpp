@@ -37,7 +37,7 @@ float pdf_next(const Scene& scene, const PerspectiveCamera& camera, const PathVe
     } else {
         if (!prev) return 0.0f;
         const Vec3f wp = direction(cur, *prev);
-        pdfW = cur.sp.material->pdf(cur.sp.frame.to_local(wp), cur.sp.frame.to_local(wn));
+        pdfW = cur.sp.material->pdf(cur.sp, cur.sp.frame.to_local(wp), cur.sp.frame.to_local(wn));
     }
     return to_area_density(pdfW, cur, next);
 }

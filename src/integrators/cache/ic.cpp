@@ -16,10 +16,14 @@
 namespace pathlab {
 namespace {
 
-// The Phong material of sp, if it has a diffuse part the cache can serve.
-const PhongMaterial* cached_diffuse(const ShadingPoint& sp) {
-    const auto* phong = std::get_if<PhongMaterial>(&sp.material->model);
-    return phong && !is_black(phong->diffuse) ? phong : nullptr;
+// The Phong material of sp (at its uv, for a textured one), if it has a diffuse part the cache
+// can serve.
+std::optional<PhongMaterial> cached_diffuse(const ShadingPoint& sp) {
+    if (!std::holds_alternative<PhongMaterial>(sp.material->model)) return std::nullopt;
+    const PhongMaterial phong = sp.material->varies ? std::get<PhongMaterial>(sp.material->model_at(sp.uv))
+                                                    : std::get<PhongMaterial>(sp.material->model);
+    if (is_black(phong.diffuse)) return std::nullopt;
+    return phong;
 }
 
 // Random-number streams: the records' gathers, apart from every pixel's own.
@@ -124,7 +128,7 @@ Rgb IrradianceCaching::radiance(const Scene& scene, const Ray& ray, Sampler& sam
     if (!scene.intersect(ray, hit)) return options_.hide_emitters ? Rgb(0.0f) : scene.escaped_radiance(ray.d);
     Rgb L = options_.hide_emitters ? Rgb(0.0f) : emitted_radiance(scene, hit, -ray.d);
     const ShadingPoint sp = make_shading_point(scene, hit, ray.d);
-    const PhongMaterial* phong = sp.material->is_black() ? nullptr : cached_diffuse(sp);
+    const std::optional<PhongMaterial> phong = sp.material->is_black() ? std::nullopt : cached_diffuse(sp);
     if (!phong) return pt_mis_from_hit(scene, hit, ray.d, 0, sampler, rules_, false, -1, L);
     if (!rules_.may_bounce(0)) return L;
     // Direct light: pt-mis's MIS pair.
@@ -155,7 +159,7 @@ void IrradianceCaching::finish(const RenderContext& ctx) {
             Intersection hit;
             if (!ctx.scene.intersect(ray, hit)) continue;
             const ShadingPoint sp = make_shading_point(ctx.scene, hit, ray.d);
-            const PhongMaterial* phong = sp.material->is_black() ? nullptr : cached_diffuse(sp);
+            const std::optional<PhongMaterial> phong = sp.material->is_black() ? std::nullopt : cached_diffuse(sp);
             Rgb E;
             if (phong && cache_.interpolate(sp.p, sp.frame.n, E)) img.at(x, y) = phong->diffuse * (2 * kInvPi) * E;
         }

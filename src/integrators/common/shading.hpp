@@ -16,8 +16,21 @@ struct ShadingPoint : BsdfContext {
     Ray spawn(const Vec3f& w_local) const { return spawn_ray(p, ng, frame.to_world(w_local)); }
 };
 
+// The surface coordinates and the shading frame at a hit on a material that uses them (out of
+// the hot path): uv for its textures, and the frame along dp/du for tangent_frame materials.
+[[gnu::noinline]] inline void set_surface_coordinates(const Scene& scene, const Intersection& hit, bool back, ShadingPoint& sp) {
+    const Scene::SurfaceCoordinates c = scene.surface_coordinates(hit);
+    sp.uv = c.uv;
+    sp.frame = sp.material->tangent_frame ? sp.material->shading_frame(hit.ns, hit.ng, back, c.dpdu, c.dpdv, c.uv)
+                                          : Frame(back ? -hit.ns : hit.ns);
+}
+
 // Two-sided materials see the front of every surface: their normals are flipped to face the
-// arriving ray. One-sided ones keep the shape's orientation (black from behind).
+// arriving ray. One-sided ones keep the shape's orientation (black from behind). The shading
+// frame is Frame(ns), or for materials whose frame follows the surface's tangent dp/du
+// (anisotropic, normal or bump mapped) the material's shading_frame(). A ShadingPoint holds
+// only values and a pointer to the scene's material (a textured material is evaluated at
+// sp.uv when it is used), so it may be copied freely (bdpt's and vcm's path vertices).
 inline ShadingPoint make_shading_point(const Scene& scene, const Intersection& hit, const Vec3f& ray_dir,
                                        TransportMode mode = TransportMode::Radiance) {
     ShadingPoint sp;
@@ -27,12 +40,16 @@ inline ShadingPoint make_shading_point(const Scene& scene, const Intersection& h
     sp.mode = mode;
     sp.ng = hit.ng;
     Vec3f ns = hit.ns;
-    if (sp.material->two_sided && dot(ray_dir, hit.ng) > 0) {
+    const bool back = sp.material->two_sided && dot(ray_dir, hit.ng) > 0;
+    if (back) {
         sp.ng = -sp.ng;
         ns = -ns;
         if (sp.material->back >= 0) sp.material = &scene.material(uint32_t(sp.material->back));
     }
-    sp.frame = Frame(ns);
+    if (sp.material->surface_coordinates) [[unlikely]]
+        set_surface_coordinates(scene, hit, back, sp);
+    else
+        sp.frame = Frame(ns);
     sp.wi = sp.frame.to_local(-ray_dir);
     return sp;
 }

@@ -78,8 +78,8 @@ float Vcm::merge_weight(const PathVertex* y, int s, const std::vector<PathVertex
     const PathVertex& z = camera[size_t(t - 1)];
     const PathVertex& photon = y[s - 1];
     const Vec3f wp = z.sp.frame.to_local(photon.sp.frame.to_world(photon.sp.wi));
-    const float pdf_to_light = z.sp.material->pdf(z.sp.wi, wp);     // z sampling the photon's direction
-    const float pdf_to_camera = z.sp.material->pdf(wp, z.sp.wi);    // ... and the camera's, from the photon's
+    const float pdf_to_light = z.sp.material->pdf(z.sp, z.sp.wi, wp);   // z sampling the photon's direction
+    const float pdf_to_camera = z.sp.material->pdf(z.sp, wp, z.sp.wi);  // ... and the camera's, from the photon's
     const float light_prev_rev = to_area_density(pdf_to_light, photon, y[s - 2]);
     const float camera_prev_rev = to_area_density(pdf_to_camera, z, camera[size_t(t - 2)]);
     const MisVertex zm{z.pdf_fwd, photon.pdf_fwd, false, false, true};

@@ -1,0 +1,68 @@
+#include "image/stb_jpeg.hpp"
+
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+
+#include "image/stb_budget.hpp"
+
+#define STBI_MALLOC(sz) budget_malloc(sz)
+#define STBI_REALLOC(p, newsz) budget_realloc(p, newsz)
+#define STBI_FREE(p) budget_free(p)
+#define STB_IMAGE_STATIC
+#define STB_IMAGE_IMPLEMENTATION
+#define STBI_ONLY_JPEG
+#define STBI_NO_STDIO
+#define STBI_NO_LINEAR
+#define STBI_NO_HDR
+#if defined(__clang__)
+#pragma clang diagnostic push
+#pragma clang diagnostic ignored "-Wunused-function"
+#pragma clang diagnostic ignored "-Wsign-compare"
+#pragma clang diagnostic ignored "-Wimplicit-fallthrough"
+#else
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wunused-function"
+#pragma GCC diagnostic ignored "-Wsign-compare"
+#pragma GCC diagnostic ignored "-Wimplicit-fallthrough"
+#pragma GCC diagnostic ignored "-Wmisleading-indentation"
+#endif
+#include <stb_image.h>
+#if defined(__clang__)
+#pragma clang diagnostic pop
+#else
+#pragma GCC diagnostic pop
+#endif
+
+namespace pathlab::io {
+
+JpegDecodeResult decode_jpeg_rgb8(const uint8_t* data, size_t size, size_t budget, Image8& out) {
+    JpegDecodeResult result;
+    Budget b;
+    b.limit = budget;
+    t_budget = &b;
+    int w = 0, h = 0, n = 0;
+    stbi_uc* pixels = stbi_load_from_memory(data, int(size), &w, &h, &n, 3);
+    if (!pixels) {
+        t_budget = nullptr;
+        result.over_budget = b.exceeded;
+        const char* why = stbi_failure_reason();
+        result.error = why ? why : "unknown error";
+        return result;
+    }
+    const size_t bytes = size_t(w) * size_t(h) * 3;
+    try {
+        out.width = w, out.height = h;
+        out.rgb.assign(pixels, pixels + bytes);
+    } catch (...) {
+        stbi_image_free(pixels);
+        t_budget = nullptr;
+        throw;
+    }
+    stbi_image_free(pixels);
+    t_budget = nullptr;
+    result.ok = true;
+    return result;
+}
+
+}  // namespace pathlab::io

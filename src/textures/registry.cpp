@@ -1,0 +1,89 @@
+#include "textures/registry.hpp"
+
+#include <filesystem>
+
+#include <fmt/format.h>
+
+#include "core/file_search.hpp"
+#include "image/image_io.hpp"
+
+namespace pathlab {
+namespace {
+
+const ParamInfo kToUv{"to_uv", ParamType::Transform, "", "applied to the surface's uv before the lookup (scale, rotate, translate)"};
+
+UvTransform read_to_uv(Properties& p) {
+    const std::optional<Transform> t = p.get_transform("to_uv");
+    return t ? UvTransform::from(*t) : UvTransform();
+}
+
+const PluginInfo& bitmap_plugin() {
+    static const PluginInfo info{
+        "texture", "bitmap", "an image looked up at uv: PNG and JPEG (sRGB) or EXR, HDR, PFM (linear)",
+        {{"filename", ParamType::String, "", "the image, relative to the scene file: .png, .jpg, .jpeg, .exr, .hdr or .pfm"},
+         {"filter_type", ParamType::String, "bilinear", "bilinear (the four nearest texels) or nearest"},
+         {"wrap_mode", ParamType::String, "repeat", "uv outside [0, 1]: repeat, mirror or clamp"},
+         {"raw", ParamType::Boolean, "false", "keep 8-bit values as stored instead of decoding sRGB (normal and bump maps)"},
+         kToUv}};
+    return info;
+}
+Texture read_bitmap(Properties& p, const TextureContext& ctx) {
+    if (!p.has("filename")) p.fail("<texture type=\"bitmap\"> needs <string name=\"filename\" value=\"...\"/>");
+    const std::string filter = p.get_string("filter_type"), wrap = p.get_string("wrap_mode");
+    FilterType f = FilterType::Bilinear;
+    if (filter == "nearest") f = FilterType::Nearest;
+    else if (filter != "bilinear") p.fail("filter_type", fmt::format("unsupported filter_type '{}'; supported: bilinear, nearest", filter));
+    WrapMode w = WrapMode::Repeat;
+    if (wrap == "mirror") w = WrapMode::Mirror;
+    else if (wrap == "clamp") w = WrapMode::Clamp;
+    else if (wrap != "repeat") p.fail("wrap_mode", fmt::format("unsupported wrap_mode '{}'; supported: repeat, mirror, clamp", wrap));
+    const bool raw = p.get_bool("raw");
+    const UvTransform to_uv = read_to_uv(p);
+    if (!ctx.allow_files) p.fail("this loader does not read files (bitmap textures are disabled)");
+    const std::string path =
+        find_in_dirs(p.get_string("filename"), ctx.search_dirs.empty() ? std::vector<std::string>{ctx.base_dir} : ctx.search_dirs);
+    try {
+        return Texture(load_bitmap_texture(path, raw, f, w, to_uv));
+    } catch (const ImageIoError& e) {
+        p.fail("filename", fmt::format("cannot read the texture: {}", e.what()));
+    }
+}
+
+const PluginInfo& checkerboard_plugin() {
+    static const PluginInfo info{"texture", "checkerboard", "two colours in a checker pattern, 2 x 2 squares per unit of uv",
+                                 {{"color0", ParamType::Rgb, "0.4", "the squares at [0, 1/2]^2 and [1/2, 1]^2"},
+                                  {"color1", ParamType::Rgb, "0.2", "the other squares"},
+                                  kToUv}};
+    return info;
+}
+Texture read_checkerboard(Properties& p, const TextureContext&) {
+    CheckerboardTexture c;
+    c.color0 = p.get_rgb("color0");
+    c.color1 = p.get_rgb("color1");
+    c.to_uv = read_to_uv(p);
+    return Texture(c);
+}
+
+}  // namespace
+
+const std::vector<TexturePlugin>& texture_plugins() {
+    static const std::vector<TexturePlugin> table = {
+        {bitmap_plugin, read_bitmap},
+        {checkerboard_plugin, read_checkerboard},
+    };
+    return table;
+}
+
+const TexturePlugin* find_texture_plugin(const std::string& type) {
+    for (const TexturePlugin& t : texture_plugins())
+        if (t.info().type == type) return &t;
+    return nullptr;
+}
+
+std::string texture_type_names() {
+    std::vector<std::string> names;
+    for (const TexturePlugin& t : texture_plugins()) names.push_back(t.info().type);
+    return fmt::format("{}", fmt::join(names, ", "));
+}
+
+}  // namespace pathlab

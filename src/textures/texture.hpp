@@ -1,0 +1,67 @@
+// Textures: a colour or a scalar that varies over a surface, evaluated at a hit's surface
+// coordinates uv. A closed set dispatched with std::visit, as the materials are: constant (a
+// plain value), bitmap (bitmap.hpp) and checkerboard (checkerboard.hpp). Conventions (the uv
+// transform, the scalar value of a colour, texel footprints) in texture_common.hpp.
+//
+// A material refers to its textures (bsdfs/material.hpp); they are immutable once loaded and
+// shared by every thread. Texel values are kept as loaded (linear RGB, per texture), so that a
+// later stage may expose them by name or upsample them to spectra.
+#pragma once
+
+#include <variant>
+
+#include "textures/bitmap.hpp"
+#include "textures/checkerboard.hpp"
+
+namespace pathlab {
+
+struct ConstantTexture {
+    Rgb value{0.0f};
+
+    Rgb eval(const Vec2f&) const { return value; }
+    float eval_1(const Vec2f&) const { return scalar_value(value); }
+    Vec2f eval_1_grad(const Vec2f&) const { return {0.0f, 0.0f}; }
+};
+
+class Texture {
+public:
+    using Model = std::variant<ConstantTexture, BitmapTexture, CheckerboardTexture>;
+
+    Texture(Model m) : model_(std::move(m)) {}
+
+    Rgb eval(const Vec2f& uv) const {
+        return std::visit([&](const auto& t) { return t.eval(uv); }, model_);
+    }
+    float eval_1(const Vec2f& uv) const {
+        return std::visit([&](const auto& t) { return t.eval_1(uv); }, model_);
+    }
+    Vec2f eval_1_grad(const Vec2f& uv) const {
+        return std::visit([&](const auto& t) { return t.eval_1_grad(uv); }, model_);
+    }
+    // The texels a lookup reads (bitmaps; none for the others).
+    TexelFootprint footprint(const Vec2f& uv) const {
+        if (const auto* b = std::get_if<BitmapTexture>(&model_)) return b->footprint(uv);
+        return {};
+    }
+    // The smallest and largest value of each channel anywhere on the surface.
+    Rgb min_value() const;
+    Rgb max_value() const;
+
+    const Model& model() const { return model_; }
+
+private:
+    Model model_;
+};
+
+inline Rgb Texture::min_value() const {
+    if (const auto* b = std::get_if<BitmapTexture>(&model_)) return b->min_value();
+    if (const auto* c = std::get_if<CheckerboardTexture>(&model_)) return min(c->color0, c->color1);
+    return std::get<ConstantTexture>(model_).value;
+}
+inline Rgb Texture::max_value() const {
+    if (const auto* b = std::get_if<BitmapTexture>(&model_)) return b->max_value();
+    if (const auto* c = std::get_if<CheckerboardTexture>(&model_)) return max(c->color0, c->color1);
+    return std::get<ConstantTexture>(model_).value;
+}
+
+}  // namespace pathlab

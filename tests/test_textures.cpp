@@ -1,0 +1,405 @@
+// Textures on their own: the sRGB decode, bilinear weights and values, the wrap modes against
+// an independent statement of each, nearest lookups, the uv transform, the checkerboard, the
+// gradient bump maps use; and reading them from files (PNG, JPEG, EXR) and scene files,
+// including every refusal (a clear message naming the file and line, never a crash).
+#include <gtest/gtest.h>
+
+#include <stb_image_write.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include <unistd.h>
+
+#include "cli_runner.hpp"
+#include "image/image_io.hpp"
+#include "scenefile/scene_file.hpp"
+#include "textures/registry.hpp"
+#include "textures/srgb.hpp"
+
+namespace pathlab {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A texture of w x h texels whose values are their indices (distinct, grey).
+BitmapTexture indexed(int w, int h, FilterType f = FilterType::Bilinear, WrapMode m = WrapMode::Repeat, UvTransform t = {}) {
+    std::vector<Rgb> texels;
+    for (int i = 0; i < w * h; ++i) texels.push_back(Rgb(float(i)));
+    return BitmapTexture(w, h, std::move(texels), f, m, t);
+}
+
+TEST(Textures, SrgbDecodeIsTheStandardCurveAndInvertsTheEncoder) {
+    const auto& t = srgb8_to_linear_table();
+    EXPECT_EQ(t[0], 0.0f);
+    EXPECT_EQ(t[255], 1.0f);
+    EXPECT_FLOAT_EQ(t[10], float(10 / 255.0 / 12.92));                            // the linear segment
+    EXPECT_FLOAT_EQ(t[128], float(std::pow((128 / 255.0 + 0.055) / 1.055, 2.4)));  // 0.2158605
+    EXPECT_NEAR(t[128], 0.2158605f, 1e-6f);
+    for (int v = 0; v < 256; ++v) {
+        EXPECT_EQ(encode_srgb8(t[size_t(v)]), v) << v;  // pathlab's PNG writer's curve, inverted
+        if (v > 0) EXPECT_GT(t[size_t(v)], t[size_t(v - 1)]);
+    }
+}
+
+TEST(Textures, BilinearWeightsAndValues) {
+    // 4 x 3 texels: texel (i, j) holds i + 4 j.
+    const BitmapTexture tex = indexed(4, 3);
+    // At a texel's centre: that texel, with weight 1 (up to the rounding of (j + 1/2) / 3).
+    for (int j = 0; j < 3; ++j)
+        for (int i = 0; i < 4; ++i) {
+            const Vec2f uv((i + 0.5f) / 4, (j + 0.5f) / 3);
+            EXPECT_NEAR(tex.eval(uv).x, float(i + 4 * j), 1e-5f);
+            const TexelFootprint f = tex.footprint(uv);
+            const int k = int(std::max_element(f.weight.begin(), f.weight.end()) - f.weight.begin());
+            EXPECT_EQ(f.index[size_t(k)], uint32_t(i + 4 * j));
+            EXPECT_NEAR(f.weight[size_t(k)], 1.0f, 1e-6f);
+        }
+    EXPECT_EQ(tex.eval({0.625f, 0.5f}).x, 6.0f);  // (2.5 / 4, 1.5 / 3) exactly: texel (2, 1) alone
+    // A quarter of the way from texel (1, 0) to (2, 0) and a half from row 0 to row 1:
+    // x = u 4 - 1/2 = 1.25, y = v 3 - 1/2 = 0.5.
+    const Vec2f uv(1.75f / 4, 1.0f / 3);
+    const TexelFootprint f = tex.footprint(uv);
+    ASSERT_EQ(f.count, 4);
+    const uint32_t want_index[4] = {1, 2, 5, 6};
+    const float want_weight[4] = {0.75f * 0.5f, 0.25f * 0.5f, 0.75f * 0.5f, 0.25f * 0.5f};
+    float sum = 0, value = 0;
+    for (int k = 0; k < 4; ++k) {
+        EXPECT_EQ(f.index[size_t(k)], want_index[k]);
+        EXPECT_NEAR(f.weight[size_t(k)], want_weight[k], 1e-6f);
+        sum += f.weight[size_t(k)];
+        value += f.weight[size_t(k)] * float(f.index[size_t(k)]);
+    }
+    EXPECT_NEAR(sum, 1.0f, 1e-6f);
+    EXPECT_NEAR(tex.eval(uv).x, 0.375f * 1 + 0.125f * 2 + 0.375f * 5 + 0.125f * 6, 1e-5f);  // 3.25
+    EXPECT_NEAR(tex.eval(uv).x, value, 1e-5f);
+    // Equal texels give exactly their value at every position (0.1f is not a sum of halves).
+    const BitmapTexture flat(3, 2, std::vector<Rgb>(6, Rgb(0.1f, 0.7f, 0.3f)));
+    for (float u = -1.3f; u < 2; u += 0.0731f)
+        for (float v = -0.7f; v < 2; v += 0.1173f) EXPECT_EQ(flat.eval({u, v}), Rgb(0.1f, 0.7f, 0.3f));
+}
+
+// Each wrap mode against its plain statement on a row of n = 4 texels.
+TEST(Textures, WrapModes) {
+    const int n = 4;
+    for (int i = -13; i <= 13; ++i) {
+        const int repeat = ((i % n) + n) % n;
+        const int period = ((i % (2 * n)) + 2 * n) % (2 * n);  // 0 1 2 3 3 2 1 0, repeated
+        const int mirror = period < n ? period : 2 * n - 1 - period;
+        const int clamp = std::clamp(i, 0, n - 1);
+        EXPECT_EQ(indexed(n, 1, FilterType::Nearest, WrapMode::Repeat).wrap(i, n), repeat) << i;
+        EXPECT_EQ(indexed(n, 1, FilterType::Nearest, WrapMode::Mirror).wrap(i, n), mirror) << i;
+        EXPECT_EQ(indexed(n, 1, FilterType::Nearest, WrapMode::Clamp).wrap(i, n), clamp) << i;
+    }
+    // Lookups outside [0, 1]: texel i holds i.
+    struct Case {
+        float u;
+        float repeat, mirror, clamp;
+    };
+    for (const Case& c : {Case{-0.1f, 3, 0, 0}, Case{1.1f, 0, 3, 3}, Case{1.9f, 3, 0, 3}, Case{2.1f, 0, 0, 3}, Case{-1.1f, 3, 3, 0}}) {
+        EXPECT_EQ(indexed(n, 1, FilterType::Nearest, WrapMode::Repeat).eval({c.u, 0.5f}).x, c.repeat) << c.u;
+        EXPECT_EQ(indexed(n, 1, FilterType::Nearest, WrapMode::Mirror).eval({c.u, 0.5f}).x, c.mirror) << c.u;
+        EXPECT_EQ(indexed(n, 1, FilterType::Nearest, WrapMode::Clamp).eval({c.u, 0.5f}).x, c.clamp) << c.u;
+    }
+    // Bilinear at u = 0: halfway between texel -1 and texel 0.
+    EXPECT_FLOAT_EQ(indexed(n, 1, FilterType::Bilinear, WrapMode::Repeat).eval({0.0f, 0.5f}).x, 1.5f);  // (3 + 0) / 2
+    EXPECT_FLOAT_EQ(indexed(n, 1, FilterType::Bilinear, WrapMode::Mirror).eval({0.0f, 0.5f}).x, 0.0f);  // (0 + 0) / 2
+    EXPECT_FLOAT_EQ(indexed(n, 1, FilterType::Bilinear, WrapMode::Clamp).eval({0.0f, 0.5f}).x, 0.0f);
+    // Non-finite and enormous coordinates stay inside the image.
+    for (const WrapMode m : {WrapMode::Repeat, WrapMode::Mirror, WrapMode::Clamp})
+        for (const float u : {kInf, -kInf, std::nanf(""), 3e38f, -3e38f}) {
+            const Rgb v = indexed(n, 1, FilterType::Bilinear, m).eval({u, u});
+            EXPECT_TRUE(v.x >= 0 && v.x <= n - 1) << u;
+        }
+}
+
+TEST(Textures, NearestLookupAndTheUvTransform) {
+    // Nearest: texel (floor(u w), floor(v h)); row 0 is the top of the image, at small v.
+    const BitmapTexture tex = indexed(4, 2, FilterType::Nearest);
+    EXPECT_EQ(tex.eval({0.01f, 0.01f}).x, 0.0f);
+    EXPECT_EQ(tex.eval({0.99f, 0.01f}).x, 3.0f);
+    EXPECT_EQ(tex.eval({0.26f, 0.51f}).x, 5.0f);
+    EXPECT_EQ(tex.footprint({0.26f, 0.51f}).count, 1);
+    // to_uv from a <transform>: scale by 2 in u, then translate by 0.25 (a 4x4 matrix: its
+    // upper-left 2x2 block and its translation column are kept).
+    const Transform t = Transform::translate({0.25, 0, 7}) * Transform::scale({2, 1, 5});
+    const UvTransform to_uv = UvTransform::from(t);
+    EXPECT_EQ(to_uv.apply({0.1f, 0.3f}), Vec2f(0.45f, 0.3f));
+    const BitmapTexture moved = indexed(4, 2, FilterType::Nearest, WrapMode::Repeat, to_uv);
+    EXPECT_EQ(moved.eval({0.1f, 0.3f}).x, 1.0f);  // u' = 0.45: texel 1
+}
+
+TEST(Textures, CheckerboardSquares) {
+    CheckerboardTexture c;
+    c.color0 = Rgb(1, 0, 0), c.color1 = Rgb(0, 0, 1);
+    EXPECT_EQ(c.eval({0.25f, 0.25f}), c.color0);
+    EXPECT_EQ(c.eval({0.75f, 0.75f}), c.color0);
+    EXPECT_EQ(c.eval({0.75f, 0.25f}), c.color1);
+    EXPECT_EQ(c.eval({0.25f, 0.75f}), c.color1);
+    EXPECT_EQ(c.eval({-0.25f, 0.25f}), c.color1);  // the pattern repeats
+    c.to_uv = UvTransform::from(Transform::scale({4, 4, 1}));  // 8 x 8 squares
+    EXPECT_EQ(c.eval({0.1f, 0.1f}), c.color0);
+    EXPECT_EQ(c.eval({0.2f, 0.1f}), c.color1);
+    // Scalars: a grey colour's value, else its luminance.
+    CheckerboardTexture g;
+    g.color0 = Rgb(0.3f), g.color1 = Rgb(0.2f, 0.4f, 0.6f);
+    EXPECT_EQ(g.eval_1({0.25f, 0.25f}), 0.3f);
+    EXPECT_EQ(g.eval_1({0.75f, 0.25f}), luminance(g.color1));
+}
+
+// bumpmap's gradient: that of the bilinear interpolant, through the uv transform (against
+// central differences inside one cell, where the interpolant is smooth).
+TEST(Textures, ScalarGradientIsTheInterpolantsDerivative) {
+    std::vector<Rgb> texels;
+    for (int i = 0; i < 16; ++i) texels.push_back(Rgb(float((i * 7) % 5), float(i % 3), float(i % 4)));  // colours: luminance
+    const UvTransform to_uv = UvTransform::from(Transform::rotate({0, 0, 1}, 30) * Transform::scale({1.5, 0.7, 1}));
+    const BitmapTexture tex(4, 4, texels, FilterType::Bilinear, WrapMode::Repeat, to_uv);
+    EXPECT_FALSE(tex.monochrome());
+    for (const Vec2f uv : {Vec2f(0.31f, 0.42f), Vec2f(0.77f, 0.13f), Vec2f(0.52f, 0.61f)}) {
+        const Vec2f g = tex.eval_1_grad(uv);
+        const float h = 1e-3f;
+        const float du = (tex.eval_1({uv.x + h, uv.y}) - tex.eval_1({uv.x - h, uv.y})) / (2 * h);
+        const float dv = (tex.eval_1({uv.x, uv.y + h}) - tex.eval_1({uv.x, uv.y - h})) / (2 * h);
+        EXPECT_NEAR(g.x, du, 2e-2f * (1 + std::abs(du))) << uv.x << " " << uv.y;
+        EXPECT_NEAR(g.y, dv, 2e-2f * (1 + std::abs(dv))) << uv.x << " " << uv.y;
+    }
+    EXPECT_EQ(indexed(4, 4, FilterType::Nearest).eval_1_grad({0.3f, 0.3f}), Vec2f(0.0f, 0.0f));
+}
+
+// ---- files and scene files ---------------------------------------------------------------
+
+class TextureFiles : public ::testing::Test {
+protected:
+    void SetUp() override {
+        dir_ = fs::temp_directory_path() / ("pathlab-textures-" + std::to_string(::getpid()));
+        fs::create_directories(dir_);
+    }
+    void TearDown() override { fs::remove_all(dir_); }
+    std::string path(const std::string& name) const { return (dir_ / name).string(); }
+    void write(const std::string& name, const std::string& bytes) const { std::ofstream(path(name), std::ios::binary) << bytes; }
+    // An 8-bit image whose texel (x, y) holds (x * sx, y * sy, 200).
+    static Image8 pattern8(int w, int h, int sx = 40, int sy = 60) {
+        Image8 img{w, h, std::vector<uint8_t>(size_t(w * h * 3))};
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                uint8_t* p = &img.rgb[size_t(y * w + x) * 3];
+                p[0] = uint8_t(x * sx), p[1] = uint8_t(y * sy), p[2] = 200;
+            }
+        return img;
+    }
+    void write_jpeg(const std::string& name, const Image8& img, int quality = 100) const {
+        ASSERT_TRUE(stbi_write_jpg(path(name).c_str(), img.width, img.height, 3, img.rgb.data(), quality));
+    }
+    // A scene with one sphere whose BSDF is `bsdf`, after the top-level elements `before`.
+    SceneDescription load(const std::string& bsdf, const std::string& before = "") const {
+        return load_scene_text("<scene version=\"3.0.0\">" + before + "<shape type=\"sphere\">" + bsdf + "</shape></scene>",
+                               path("scene.xml"), dir_.string());
+    }
+    // The message of the SceneFileError the scene raises (empty if it loads).
+    std::string error_of(const std::string& bsdf, const std::string& before = "") const {
+        try {
+            load(bsdf, before);
+        } catch (const SceneFileError& e) {
+            return e.what();
+        }
+        return "";
+    }
+    fs::path dir_;
+};
+
+TEST_F(TextureFiles, PngIsDecodedFromSrgbUnlessRaw) {
+    write_png8(pattern8(4, 3), path("p.png"));
+    const BitmapTexture srgb = load_bitmap_texture(path("p.png"), false, FilterType::Nearest);
+    const BitmapTexture raw = load_bitmap_texture(path("p.png"), true, FilterType::Nearest);
+    ASSERT_EQ(srgb.width(), 4);
+    ASSERT_EQ(srgb.height(), 3);
+    const auto& table = srgb8_to_linear_table();
+    // Texel (2, 1): (80, 60, 200).
+    EXPECT_EQ(srgb.texels()[6], Rgb(table[80], table[60], table[200]));
+    EXPECT_EQ(raw.texels()[6], Rgb(80 / 255.0f, 60 / 255.0f, 200 / 255.0f));
+    EXPECT_TRUE(srgb.colour());
+    EXPECT_FALSE(raw.colour());
+}
+
+TEST_F(TextureFiles, JpegAndExrAreRead) {
+    write_jpeg("p.jpg", pattern8(16, 8, 10, 20));
+    const BitmapTexture j = load_bitmap_texture(path("p.jpg"), true);
+    EXPECT_EQ(j.width(), 16);
+    EXPECT_EQ(j.height(), 8);
+    // Lossy, but close at quality 100 (smooth ramps): texel (5, 3) is (50, 60, 200).
+    EXPECT_NEAR(j.texels()[size_t(3 * 16 + 5)].x, 50 / 255.0f, 0.03f);
+    EXPECT_NEAR(j.texels()[size_t(3 * 16 + 5)].y, 60 / 255.0f, 0.03f);
+    EXPECT_NEAR(j.texels()[size_t(3 * 16 + 5)].z, 200 / 255.0f, 0.03f);
+    Image img(3, 2);
+    img.at(2, 1) = Rgb(7.5f, -0.25f, 0.125f);
+    write_image(img, path("e.exr"));
+    const BitmapTexture e = load_bitmap_texture(path("e.exr"), false);
+    EXPECT_EQ(e.texels()[5], Rgb(7.5f, -0.25f, 0.125f));  // float images: as stored, raw or not
+    EXPECT_EQ(e.min_value(), Rgb(0.0f, -0.25f, 0.0f));
+}
+
+TEST_F(TextureFiles, UnreadableTruncatedAndUnsupportedImagesNameTheFile) {
+    write_png8(pattern8(8, 8), path("good.png"));
+    std::ifstream in(path("good.png"), std::ios::binary);
+    const std::string png((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    write("cut.png", png.substr(0, png.size() / 2));
+    write_jpeg("good.jpg", pattern8(32, 32));
+    std::ifstream jin(path("good.jpg"), std::ios::binary);
+    const std::string jpg((std::istreambuf_iterator<char>(jin)), std::istreambuf_iterator<char>());
+    write("cut.jpg", jpg.substr(0, jpg.size() - 40));
+    write("fake.jpg", "not a jpeg at all");
+    write("image.bmp", "BM....");
+    const std::pair<const char*, const char*> cases[] = {
+        {"missing.png", "missing.png"},
+        {"cut.png", "cut.png: cannot read PNG"},
+        {"cut.jpg", "cut.jpg: cannot read JPEG: truncated"},
+        {"fake.jpg", "fake.jpg: cannot read JPEG: not a JPEG file"},
+        {"image.bmp", "unsupported texture image '.bmp' (supported: .png, .jpg, .jpeg, .exr, .hdr, .pfm)"},
+    };
+    for (const auto& [file, needle] : cases) {
+        const std::string e = error_of(std::string("<bsdf type=\"diffuse\"><texture type=\"bitmap\" name=\"reflectance\"><string name=\"filename\" value=\"") +
+                                       file + "\"/></texture></bsdf>");
+        EXPECT_NE(e.find("scene.xml:1:"), std::string::npos) << e;  // the file and line of the element
+        EXPECT_NE(e.find("cannot read the texture"), std::string::npos) << e;
+        EXPECT_NE(e.find(needle), std::string::npos) << file << ": " << e;
+    }
+    // The command line: exit code 2 and the message.
+    std::ofstream(path("cli.xml")) << "<scene version=\"3.0.0\"><shape type=\"sphere\"><bsdf type=\"diffuse\"><texture type=\"bitmap\" "
+                                      "name=\"reflectance\"><string name=\"filename\" value=\"cut.jpg\"/></texture></bsdf></shape></scene>";
+    const test::CliResult r = test::run({"--scene", path("cli.xml"), "--spp", "1", "-q", "-o", path("out.exr")});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_TRUE(test::contains(r.err, "cut.jpg: cannot read JPEG: truncated")) << r.err;
+}
+
+TEST_F(TextureFiles, TexturesAreBoundToBsdfParameters) {
+    write_png8(pattern8(4, 4), path("wall.png"));
+    const SceneDescription d = load(
+        R"(<bsdf type="roughconductor"><ref name="specular_reflectance" id="wall"/>
+             <texture type="checkerboard" name="alpha_u"><float name="color0" value="0.05"/><float name="color1" value="0.4"/></texture>
+             <float name="alpha_v" value="0.2"/></bsdf>)",
+        R"(<texture type="bitmap" id="wall"><string name="filename" value="wall.png"/><string name="filter_type" value="nearest"/>
+             <string name="wrap_mode" value="clamp"/><boolean name="raw" value="true"/>
+             <transform name="to_uv"><scale x="2" y="3"/></transform></texture>)");
+    ASSERT_EQ(d.materials.size(), 1u);
+    const Material& m = d.materials[0];
+    ASSERT_TRUE(m.textures);
+    EXPECT_TRUE(m.varies);
+    EXPECT_TRUE(m.tangent_frame);  // alpha_u textured: anisotropic
+    ASSERT_EQ(m.textures->bindings.size(), 2u);
+    EXPECT_EQ(m.textures->bindings[0].param, "specular_reflectance");
+    EXPECT_FALSE(m.textures->bindings[0].scalar);
+    EXPECT_EQ(m.textures->bindings[1].param, "alpha_u");
+    EXPECT_TRUE(m.textures->bindings[1].scalar);
+    const auto& bitmap = std::get<BitmapTexture>(m.textures->bindings[0].texture->model());
+    EXPECT_EQ(bitmap.filter(), FilterType::Nearest);
+    EXPECT_EQ(bitmap.wrap_mode(), WrapMode::Clamp);
+    EXPECT_FALSE(bitmap.colour());
+    EXPECT_EQ(bitmap.to_uv().apply({0.5f, 0.5f}), Vec2f(1.0f, 1.5f));
+    // The constant model holds the textures' largest values (its lobe flags follow them).
+    const auto& rc = std::get<RoughConductorMaterial>(m.model);
+    EXPECT_EQ(rc.distribution.alpha_u, 0.4f);
+    EXPECT_EQ(rc.distribution.alpha_v, 0.2f);
+    // At a hit: the values there (uv (0.3, 0.1): checker square of color0).
+    const auto at = std::get<RoughConductorMaterial>(m.model_at({0.3f, 0.1f}));
+    EXPECT_EQ(at.distribution.alpha_u, 0.05f);
+    EXPECT_EQ(at.distribution.alpha_v, 0.2f);
+    // uv' = (0.6, 0.3) -> clamped nearest texel (2, 1) of the raw image: (80, 60, 200) / 255.
+    EXPECT_EQ(at.specular_reflectance, Rgb(80 / 255.0f, 60 / 255.0f, 200 / 255.0f));
+
+    // normalmap and bumpmap wrap a BSDF (in either order with twosided) and give it a frame.
+    const SceneDescription n = load(
+        R"(<bsdf type="twosided"><bsdf type="normalmap"><texture type="bitmap" name="normalmap"><string name="filename" value="wall.png"/>
+             <boolean name="raw" value="true"/></texture><bsdf type="diffuse"><ref name="reflectance" id="wall"/></bsdf></bsdf></bsdf>)",
+        R"(<texture type="bitmap" id="wall"><string name="filename" value="wall.png"/></texture>)");
+    const Material& nm = n.materials[0];
+    EXPECT_TRUE(nm.two_sided);
+    EXPECT_TRUE(nm.perturbed());
+    EXPECT_TRUE(nm.tangent_frame);
+    EXPECT_EQ(nm.textures->perturbation, FramePerturbation::NormalMap);
+    EXPECT_EQ(nm.textures->bindings.size(), 1u);
+    // Models with derived values recompute them: a rough plastic textured at 0.2 where the
+    // texture is 0.2 is the rough plastic of 0.2 (its base rho' / (pi eta^2) and lobe weight).
+    const SceneDescription rp = load(R"(<bsdf type="roughplastic"><texture type="checkerboard" name="diffuse_reflectance">
+             <rgb name="color0" value="0.2, 0.3, 0.4"/><rgb name="color1" value="0.8"/></texture></bsdf>)");
+    const SceneDescription rp_constant = load(R"(<bsdf type="roughplastic"><rgb name="diffuse_reflectance" value="0.2, 0.3, 0.4"/></bsdf>)");
+    const auto rp_at = std::get<RoughPlasticMaterial>(rp.materials[0].model_at({0.25f, 0.25f}));
+    const auto& rp_want = std::get<RoughPlasticMaterial>(rp_constant.materials[0].model);
+    EXPECT_EQ(rp_at.coat.base, rp_want.coat.base);
+    EXPECT_EQ(rp_at.coat.specular_weight, rp_want.coat.specular_weight);
+    EXPECT_NE(std::get<RoughPlasticMaterial>(rp.materials[0].model).coat.base, rp_want.coat.base);  // the 0.8 placeholder's
+    const SceneDescription bm = load(
+        R"(<bsdf type="bumpmap"><float name="scale" value="0.25"/><bsdf type="twosided"><bsdf type="roughplastic"/></bsdf>
+             <texture type="checkerboard" name="whatever"/></bsdf>)");
+    EXPECT_EQ(bm.materials[0].textures->perturbation, FramePerturbation::BumpMap);
+    EXPECT_EQ(bm.materials[0].textures->bump_scale, 0.25f);
+    EXPECT_TRUE(bm.materials[0].two_sided);
+}
+
+TEST_F(TextureFiles, RefusalsSayWhatIsWrongAndWhere) {
+    write_png8(pattern8(2, 2), path("t.png"));
+    Image negative(2, 2, Rgb(0.5f));
+    negative.at(1, 1) = Rgb(0.5f, -1.0f, 0.5f);
+    write_image(negative, path("neg.exr"));
+    const std::string bitmap = R"(<texture type="bitmap" name="reflectance"><string name="filename" value="t.png"/></texture>)";
+    const std::string checker = R"(<texture type="checkerboard" name="NAME"/>)";
+    const auto checker_as = [&](const std::string& name) { return std::string(checker).replace(checker.find("NAME"), 4, name); };
+    struct Case {
+        std::string bsdf, before, needle;
+    };
+    const std::vector<Case> cases = {
+        {"<bsdf type=\"dielectric\">" + checker_as("int_ior") + "</bsdf>", "",
+         "parameter 'int_ior' of <bsdf type=\"dielectric\"> cannot be a texture; those that can: none"},
+        {"<bsdf type=\"roughplastic\">" + checker_as("alpha") + "</bsdf>", "",
+         "parameter 'alpha' of <bsdf type=\"roughplastic\"> cannot be a texture; those that can: diffuse_reflectance, specular_reflectance"},
+        {"<bsdf type=\"diffuse\">" + checker_as("colour") + "</bsdf>", "", "parameter 'colour' of <bsdf type=\"diffuse\"> cannot be a texture"},
+        {"<bsdf type=\"diffuse\"><texture type=\"checkerboard\"/></bsdf>", "", "needs the name of the parameter it gives (reflectance)"},
+        {"<bsdf type=\"diffuse\"><texture type=\"noise\" name=\"reflectance\"/></bsdf>", "",
+         "unsupported texture type 'noise'; supported: bitmap, checkerboard"},
+        {"<bsdf type=\"diffuse\"><texture type=\"bitmap\" name=\"reflectance\"/></bsdf>", "", "needs <string name=\"filename\""},
+        {"<bsdf type=\"diffuse\"><texture type=\"bitmap\" name=\"reflectance\"><string name=\"filename\" value=\"t.png\"/>"
+         "<string name=\"filter_type\" value=\"trilinear\"/></texture></bsdf>",
+         "", "unsupported filter_type 'trilinear'; supported: bilinear, nearest"},
+        {"<bsdf type=\"diffuse\"><texture type=\"bitmap\" name=\"reflectance\"><string name=\"filename\" value=\"t.png\"/>"
+         "<string name=\"wrap_mode\" value=\"border\"/></texture></bsdf>",
+         "", "unsupported wrap_mode 'border'; supported: repeat, mirror, clamp"},
+        {"<bsdf type=\"diffuse\"><texture type=\"bitmap\" name=\"reflectance\"><string name=\"filename\" value=\"t.png\"/>"
+         "<float name=\"gamma\" value=\"2\"/></texture></bsdf>",
+         "", "unsupported parameter 'gamma' for <texture type=\"bitmap\">; supported: filename, filter_type, wrap_mode, raw, to_uv"},
+        {"<bsdf type=\"diffuse\"><texture type=\"bitmap\" name=\"reflectance\"><string name=\"filename\" value=\"neg.exr\"/></texture></bsdf>",
+         "", "the texture for 'reflectance' has negative values (down to -1); it must not be negative"},
+        {"<bsdf type=\"diffuse\">" + bitmap + "<rgb name=\"reflectance\" value=\"0.5\"/></bsdf>", "", "parameter 'reflectance' is given twice"},
+        {"<bsdf type=\"diffuse\"><ref name=\"reflectance\" id=\"nowhere\"/></bsdf>", "", "no <texture> with id 'nowhere' is declared"},
+        {"<bsdf type=\"diffuse\"><ref name=\"reflectance\" id=\"m\"/></bsdf>", "<bsdf type=\"diffuse\" id=\"m\"/>", "'m' is a <bsdf> (declared at"},
+        {"<ref id=\"t\"/>", "<texture type=\"checkerboard\" id=\"t\"/>", "'t' is a <texture>; a shape refers to a <bsdf>"},
+        {"<bsdf type=\"diffuse\"/>", "<texture type=\"checkerboard\"/>", "a top-level <texture> needs an id"},
+        {"<bsdf type=\"diffuse\"/>", "<texture type=\"checkerboard\" id=\"a\"/><bsdf type=\"diffuse\" id=\"a\"/>", "the id 'a' is already used"},
+        {"<bsdf type=\"diffuse\"><texture type=\"checkerboard\" name=\"reflectance\"><texture type=\"checkerboard\" name=\"color0\"/></texture></bsdf>",
+         "", "<texture type=\"checkerboard\"> has no nested plugins (its colours are constants)"},
+        {"<bsdf type=\"normalmap\"><bsdf type=\"diffuse\"/></bsdf>", "", "<bsdf type=\"normalmap\"> needs a texture"},
+        {"<bsdf type=\"normalmap\">" + checker_as("height") + "<bsdf type=\"diffuse\"/></bsdf>", "",
+         "the texture of a normalmap must be named \"normalmap\""},
+        {"<bsdf type=\"bumpmap\">" + checker_as("h") + "</bsdf>", "", "<bsdf type=\"bumpmap\"> wraps exactly one nested <bsdf>"},
+        {"<bsdf type=\"bumpmap\">" + checker_as("h") + "<bsdf type=\"diffuse\"/><bsdf type=\"diffuse\"/></bsdf>", "",
+         "<bsdf type=\"bumpmap\"> wraps exactly one nested <bsdf>"},
+        {"<bsdf type=\"bumpmap\">" + checker_as("h") + checker_as("g") + "<bsdf type=\"diffuse\"/></bsdf>", "",
+         "<bsdf type=\"bumpmap\"> takes exactly one texture"},
+        {"<bsdf type=\"bumpmap\">" + checker_as("h") + "<bsdf type=\"bumpmap\">" + checker_as("h") + "<bsdf type=\"diffuse\"/></bsdf></bsdf>",
+         "", "this BSDF already has a normal or bump map"},
+        {"<bsdf type=\"twosided\">" + checker_as("h") + "<bsdf type=\"diffuse\"/></bsdf>", "", "unsupported element <texture> in <bsdf type=\"twosided\">"},
+        {"<bsdf type=\"mask\"><ref id=\"d\"/></bsdf>", "<bsdf type=\"normalmap\" id=\"d\">" + checker_as("normalmap") + "<bsdf type=\"diffuse\"/></bsdf>",
+         "a normal or bump map inside mask is not supported"},
+        {"<bsdf type=\"diffuse\"><bsdf type=\"diffuse\"/></bsdf>", "", "<bsdf type=\"diffuse\"> has no nested <bsdf>; its parameters that may be textures: reflectance"},
+    };
+    for (const Case& c : cases) {
+        const std::string e = error_of(c.bsdf, c.before);
+        EXPECT_NE(e.find(c.needle), std::string::npos) << c.bsdf << "\n  gave: " << e << "\n  expected: " << c.needle;
+        EXPECT_NE(e.find("scene.xml:1:"), std::string::npos) << e;
+    }
+    // A twosided BSDF may wrap a declared one by reference, and a bumpmap a declared texture.
+    EXPECT_EQ(error_of("<bsdf type=\"bumpmap\"><ref id=\"h\"/><ref id=\"d\"/></bsdf>",
+                       "<bsdf type=\"diffuse\" id=\"d\"/><texture type=\"checkerboard\" id=\"h\"/>"),
+              "");
+}
+
+}  // namespace
+}  // namespace pathlab

@@ -1,5 +1,5 @@
 #!/bin/sh
-# Renders the material rows shown in README's Materials section (scenes/materials/*.xml, each
+# Renders the material rows shown in docs/materials.md (scenes/materials/*.xml, each
 # a row of five spheres) into docs/images/materials/*.png, at each file's own settings.
 # Usage: scripts/render-materials.sh [extra pathlab options, e.g. -D spp=64]
 set -e

@@ -1,4 +1,4 @@
-// Plugin declarations: README's tables are exactly what the plugins declare, every declared
+// Plugin declarations: the tables of docs/scene-files.md are exactly what the plugins declare, every declared
 // default can be read as its type, every plugin builds from its defaults alone, and the C++
 // defaults of shared structures agree with the declared ones.
 #include <gtest/gtest.h>
@@ -13,8 +13,8 @@
 namespace pathlab {
 namespace {
 
-TEST(Plugins, ReadmeTablesAreTheDeclarations) {
-    std::ifstream in(std::string(PATHLAB_SOURCE_DIR) + "/README.md");
+TEST(Plugins, DocumentedTablesAreTheDeclarations) {
+    std::ifstream in(std::string(PATHLAB_SOURCE_DIR) + "/docs/scene-files.md");
     std::stringstream ss;
     ss << in.rdbuf();
     const std::string readme = ss.str();
@@ -23,7 +23,7 @@ TEST(Plugins, ReadmeTablesAreTheDeclarations) {
     ASSERT_NE(b, std::string::npos);
     ASSERT_NE(e, std::string::npos);
     EXPECT_EQ(readme.substr(b + begin.size(), e - b - begin.size()), plugin_reference_markdown())
-        << "README's plugin tables are out of date: paste the output of `build/pathlab plugins` between the markers";
+        << "docs/scene-files.md's plugin tables are out of date: paste the output of `build/pathlab plugins` between the markers";
 }
 
 TEST(Plugins, EveryDeclaredDefaultReadsAsItsType) {

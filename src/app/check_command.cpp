@@ -49,7 +49,7 @@ CLI::App* add_check_command(CLI::App& app, CheckOptions& o) {
     cmd->add_option("--references,--reference", o.references,
                     "Directory of references: .exr/.pfm/.hdr (e.g. from `pathlab reference`, whose manifest.json is checked) or the "
                     "course's 8-bit .png (names: {index}-{scene}, {index}, {scene} or the course acronym; a scene file's: its "
-                    "stem; see README)")
+                    "stem; see docs/judging.md)")
         ->required();
     cmd->add_option("--mapping", o.mapping, "File of 'scene = file' lines when the references are named otherwise");
     add_scene_arguments(*cmd, o.scenes);

@@ -58,7 +58,7 @@ int run_cli(int argc, const char* const* argv, RankGroup* ranks) {
     CLI::App* scenes_cmd = app.add_subcommand("scenes", "List the built-in scenes, one per line");
     CLI::App* algorithms_cmd = app.add_subcommand("algorithms", "List the estimators (--algorithm values)");
     CLI::App* plugins_cmd =
-        app.add_subcommand("plugins", "The scene-file elements and their parameters (Markdown tables, as in README)");
+        app.add_subcommand("plugins", "The scene-file elements and their parameters (Markdown tables, as in docs/scene-files.md)");
     CompareOptions compare_opt;
     CLI::App* compare_cmd = add_compare_command(app, compare_opt);
     ReferenceOptions reference_opt;

@@ -1,7 +1,7 @@
 // <bsdf type>: a plugin of bsdfs/registry.hpp, or a wrapper of nested BSDFs (twosided with one
 // or two, blendbsdf with two, mask, normalmap and bumpmap with one), each nested one a <bsdf>
 // or a <ref id>. Declared at the top level with an id (referred to by <ref id>) or nested in a
-// shape or a wrapper. A BSDF's parameters that may be textures (README's tables: "or texture",
+// shape or a wrapper. A BSDF's parameters that may be textures (docs/scene-files.md's tables: "or texture",
 // also blendbsdf's weight and mask's opacity) take a nested <texture name="PARAMETER"> or a
 // <ref name="PARAMETER" id> to a top-level one.
 #include <fmt/format.h>

@@ -20,6 +20,7 @@ struct MeshDesc {
     std::vector<std::array<uint32_t, 3>> triangles;
     uint32_t material = 0;
     Rgb emission{0.0f};  // radiance of a one-sided area emitter on the winding-normal side
+    std::string id;      // the shape's id ("" for none): names its emitter's parameters (diff/)
 };
 
 struct SphereDesc {
@@ -28,6 +29,7 @@ struct SphereDesc {
     uint32_t material = 0;
     bool flip_normals = false;  // normals point inwards
     Rgb emission{0.0f};         // radiance of a one-sided area emitter on the normal side
+    std::string id;             // the shape's id ("" for none): names its emitter's parameters (diff/)
 };
 
 // A shapegroup: meshes that instances place, each instance by its own transform (Embree

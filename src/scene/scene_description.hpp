@@ -24,6 +24,11 @@ struct SceneDescription {
     std::vector<ShapeGroupDesc> groups;  // placed by instances
     std::vector<InstanceDesc> instances;
     std::vector<FreeLight> lights;
+    // Ids of the materials (by index in `materials`) and free lights (by index in `lights`), ""
+    // for unnamed ones (either vector may be shorter): the names of differentiable parameters
+    // (diff/parameters.hpp), as scene files' id attributes give them. Shapes carry their own id.
+    std::vector<std::string> material_ids;
+    std::vector<std::string> light_ids;
     // Render settings a scene file may suggest; command-line options override them.
     std::optional<std::string> algorithm;
     std::optional<int> spp, max_depth, rr_depth;  // depths in pathlab's bounces

@@ -104,7 +104,10 @@ void read_shape_into(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b, s
         } else if (tag == "bsdf") {
             if (material) xml.fail(c, "a shape can have only one BSDF");
             material = b.add_material(read_bsdf(xml, c, b));
-            if (const auto id = xml.optional_attr(c, "id")) b.name(xml, c, *id, "bsdf", *material);
+            if (const auto id = xml.optional_attr(c, "id")) {
+                b.name(xml, c, *id, "bsdf", *material);
+                b.name_material(*material, *id);
+            }
         } else if (tag == "emitter") {
             xml.check_attributes(c, {"type", "id", "name"});
             const std::string etype = xml.attr(c, "type");
@@ -147,12 +150,13 @@ void read_shape_into(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b, s
     if (auto* sphere = std::get_if<SphereDesc>(&shape)) {
         sphere->material = *material;
         sphere->emission = emission;
+        if (const auto id = xml.optional_attr(n, "id")) sphere->id = *id;
         b.desc.spheres.push_back(*sphere);
         return;
     }
     MeshDesc& m = std::get<MeshDesc>(shape);
     if (m.name.empty()) m.name = type;
-    if (const auto id = xml.optional_attr(n, "id")) m.name = *id;
+    if (const auto id = xml.optional_attr(n, "id")) m.name = m.id = *id;
     m.material = *material;
     m.emission = emission;
     (group ? *group : b.desc.meshes).push_back(std::move(m));

@@ -134,9 +134,8 @@ private:
     void vertex_term(const Material& m, const MaterialBinding& mb, const Vec3f& wi, const Vec3f& wo, bool delta, const Rgb& f,
                      const Rgb& Le, float k, int light, float scale, const Rgb& beta, const Rgb& dbeta, Carry& c) const {
         if constexpr (M == Mode::Reverse) {
-            const Rgb db = c.delta * beta;
-            if (mb.any()) add_bsdf_adjoint(m, mb, wi, wo, delta, db * Le * k, c);
-            emitter_term<M>(light, db * f * k, scale, c);
+            if (mb.any()) add_bsdf_adjoint(m, mb, wi, wo, delta, c.delta * beta * Le * k, c);
+            emitter_term<M>(light, beta * f * k, scale, c);
             c.Lr -= beta * (f * Le * k);
         } else if constexpr (M == Mode::Forward) {
             Rgb dLe(0.0f);
@@ -148,7 +147,8 @@ private:
         }
     }
 
-    // Emission reached with weight W (everything multiplying Le): its parameter's share.
+    // Emission reached with weight W (everything multiplying Le, the adjoint apart): its
+    // parameter's share.
     template <Mode M>
     void emitter_term(int light, const Rgb& W, float scale, Carry& c) const {
         const int off = light >= 0 && size_t(light) < set_.lights.size() ? set_.lights[size_t(light)] : -1;

@@ -5,8 +5,8 @@
 namespace pathlab::bench {
 
 struct DifferentiableOptions {
-    int size = 64;          // image width and height
-    int spp = 8;            // samples per pixel of every render
+    int size = 128;         // image width and height
+    int spp = 16;           // samples per pixel of every render
     int repeats = 5;        // interleaved rounds (medians reported)
     std::vector<int> scenes{2, 3, 5};
 };

@@ -147,11 +147,12 @@ Image signed_weights(const SceneDescription& d, const std::string& name, const D
     return w;
 }
 
-// Scene 2 with the right sphere rough metal and the left one plastic, with ids.
+// Scene 2 with the right sphere rough metal, the left one plastic and the left wall roughplastic.
 SceneDescription metals() {
     SceneDescription d = make_builtin_scene(2);
     d.materials[7] = make_rough_conductor(MicrofacetDistribution(MicrofacetType::GGX, 0.25f, 0.25f), {Rgb(0.2f), Rgb(3.0f)}, Rgb(0.9f));
     d.materials[6] = make_plastic(Rgb(0.6f, 0.5f, 0.2f), Rgb(0.8f));
+    d.materials[3] = make_rough_plastic(MicrofacetDistribution(MicrofacetType::Beckmann, 0.3f, 0.3f), Rgb(0.2f, 0.7f, 0.2f), Rgb(0.5f));
     return d;
 }
 
@@ -254,6 +255,7 @@ TEST(DiffGradients, RoughConductorAndPlasticAgreeWithFiniteDifferences) {
     expect_agreement(check_against_fd(metals(), "blue.specular_reflectance.value", tiny_settings(), 48, 1e-2), "roughconductor R");
     expect_agreement(check_against_fd(metals(), "yellow.diffuse_reflectance.value", tiny_settings(), 48, 1e-2), "plastic diffuse");
     expect_agreement(check_against_fd(metals(), "yellow.specular_reflectance.value", tiny_settings(), 48, 1e-2), "plastic coating");
+    expect_agreement(check_against_fd(metals(), "green.diffuse_reflectance.value", tiny_settings(), 48, 1e-2), "roughplastic base");
 }
 
 // Tests of the test: each fault makes the same comparison fail.

@@ -222,8 +222,12 @@ int run_optimize_command(const OptimizeOptions& o) {
     if (!o.region.empty()) {
         const std::vector<std::string> r = split_comma_list(o.region);
         int v[4];
-        for (size_t i = 0; i < 4 && r.size() == 4; ++i) v[i] = std::atoi(r[i].c_str());
-        if (r.size() != 4) throw UsageError(fmt::format("--region '{}': expected x0,y0,x1,y1", o.region));
+        for (size_t i = 0; i < 4 && r.size() == 4; ++i) {
+            char* end = nullptr;
+            v[i] = int(std::strtol(r[i].c_str(), &end, 10));
+            if (r[i].empty() || *end) throw UsageError(fmt::format("--region '{}': '{}' is not a whole number", o.region, r[i]));
+        }
+        if (r.size() != 4) throw UsageError(fmt::format("--region '{}': expected x0,y0,x1,y1 (pixels)", o.region));
         loss.x0 = v[0], loss.y0 = v[1], loss.x1 = v[2], loss.y1 = v[3];
         usage_on_invalid([&] { return loss_value(target, target, loss); });
     }

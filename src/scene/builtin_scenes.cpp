@@ -87,8 +87,8 @@ SceneDescription make_course_scene(const BuiltinSceneInfo& info, LightKind light
         d.meshes.back().id = "light";
     }
 
-    d.spheres.push_back(SphereDesc{{-0.5388500f, 0.0245301f, -0.7800200f}, 0.5f, kYellowBall, false, Rgb(0.0f), ""});
-    d.spheres.push_back(SphereDesc{{0.5583100f, 0.6645401f, -0.7800200f}, 0.5f, kBlueBall, false, Rgb(0.0f), ""});
+    d.spheres.push_back(SphereDesc{{-0.5388500f, 0.0245301f, -0.7800200f}, 0.5f, kYellowBall, false});
+    d.spheres.push_back(SphereDesc{{0.5583100f, 0.6645401f, -0.7800200f}, 0.5f, kBlueBall, false});
 
     if (light == LightKind::Point) d.lights.emplace_back(PointLight{{0.0f, -0.5f, 1.0f}, Rgb(50.0f / (4.0f * kPi))});
     if (light == LightKind::Environment)  // the course's raw colour, no sRGB decoding

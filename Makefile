@@ -27,8 +27,9 @@ test: build
 # memory, allocations and pt-mis efficiency; Markdown on stdout, JSON in out/bench/; then light tracing (lt paths/s
 # next to pt-mis, splat accumulation, 1 minute), bdpt against pt-mis (12 minutes), the photon methods (10 minutes), irradiance caching (13 minutes),
 # rendering across processes (2 MPI ranks against 1 process, film reduction, checkpoints: 3 minutes), the lights (an environment map's cost
-# per sample against the constant environment, spot and IES: 2 minutes), volpath (volumes: throughput, MIS at equal time, optical thickness)
-# and textures (textured against constant materials per sample, texture lookups: 2 minutes).
+# per sample against the constant environment, spot and IES: 2 minutes), volpath (volumes: throughput, MIS at equal time, optical thickness),
+# textures (textured against constant materials per sample, texture lookups: 2 minutes) and differentiable rendering (a gradient against a
+# primal render, memory vs spp and depth: 1 minute).
 bench: build
 	$(BUILD)/bench/pathlab_bench perf --json out/bench/performance.json
 	$(BUILD)/bench/pathlab_bench lt
@@ -39,6 +40,7 @@ bench: build
 	$(BUILD)/bench/pathlab_bench lights
 	$(BUILD)/bench/pathlab_bench volumes
 	$(BUILD)/bench/pathlab_bench textures
+	$(BUILD)/bench/pathlab_bench diff
 
 # Equal-spp and equal-time RMSE of the course's estimators on the 8 scenes (about 10 minutes).
 bench-estimators: build

@@ -12,9 +12,11 @@
 //   pathlab_bench distributed  2 MPI ranks against 1 process, film reduction, checkpoints
 //   pathlab_bench lights   an environment map's cost per sample against the constant environment; spot and IES
 //   pathlab_bench textures textured against constant materials per sample; texture lookups
+//   pathlab_bench diff     a gradient's cost (path replay) relative to a primal render, its memory vs spp and depth
 #include <CLI/CLI.hpp>
 
 #include "bidirectional.hpp"
+#include "differentiable.hpp"
 #include "distributed.hpp"
 #include "estimator_efficiency.hpp"
 #include "light_tracing.hpp"
@@ -115,6 +117,12 @@ int main(int argc, char** argv) {
     txc->add_option("--repeats", tx.repeats, "Interleaved rounds (medians reported)")->capture_default_str();
     txc->add_option("--lookups", tx.lookups, "Texture lookups per timing")->capture_default_str();
     txc->add_option("--scene", tx.scene_file, "The textured scene file (default: scenes/textures.xml)");
+    DifferentiableOptions dfo;
+    CLI::App* dfc = app.add_subcommand("diff", "A gradient's cost relative to a primal render at equal spp; its memory vs spp and depth");
+    dfc->add_option("--size", dfo.size, "Image width and height")->capture_default_str();
+    dfc->add_option("--spp", dfo.spp, "Samples per pixel")->capture_default_str();
+    dfc->add_option("--repeats", dfo.repeats, "Interleaved rounds (median reported)")->capture_default_str();
+    dfc->add_option("--scenes", dfo.scenes, "Course scene indices")->delimiter(',')->capture_default_str();
     // Under mpirun this program is one rank of the reduction benchmark.
     std::vector<std::string> args(argv, argv + argc);
     CLI11_PARSE(app, argc, argv);
@@ -123,6 +131,7 @@ int main(int argc, char** argv) {
         return 0;
     }
     if (*dist) distributed_suite(dopt, args[0]);
+    if (*dfc) differentiable_suite(dfo);
     if (*lic) lights_suite(lo);
     if (*vol) volumes_suite(vo);
     if (*txc) textures_suite(tx);

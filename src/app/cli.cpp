@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "app/command_arguments.hpp"
+#include "app/diff_commands.hpp"
 #include "app/render_command.hpp"
 #include "app/tool_commands.hpp"
 #include "job/rank_group.hpp"
@@ -73,6 +74,12 @@ int run_cli(int argc, const char* const* argv, RankGroup* ranks) {
     CLI::App* info_cmd = add_info_command(app, info_opt);
     MergeOptions merge_opt;
     CLI::App* merge_cmd = add_merge_command(app, merge_opt);
+    ParamsOptions params_opt;
+    CLI::App* params_cmd = add_params_command(app, params_opt);
+    GradientOptions gradient_opt;
+    CLI::App* gradient_cmd = add_gradient_command(app, gradient_opt);
+    OptimizeOptions optimize_opt;
+    CLI::App* optimize_cmd = add_optimize_command(app, optimize_opt);
 
     // No arguments: the usage, not a render of everything.
     if (argc <= 1) {
@@ -123,6 +130,9 @@ int run_cli(int argc, const char* const* argv, RankGroup* ranks) {
         if (*convert_cmd) return run_convert_command(convert_opt);
         if (*info_cmd) return run_info_command(info_opt);
         if (*merge_cmd) return run_merge_command(merge_opt);
+        if (*params_cmd) return run_params_command(params_opt);
+        if (*gradient_cmd) return run_gradient_command(gradient_opt);
+        if (*optimize_cmd) return run_optimize_command(optimize_opt);
         return run_render_command(render_opt, ranks);
     } catch (const UsageError& e) {
         fmt::print(stderr, "pathlab: {}\n", e.what());

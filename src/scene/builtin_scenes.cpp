@@ -64,21 +64,27 @@ SceneDescription make_course_scene(const BuiltinSceneInfo& info, LightKind light
     d.camera = Camera::look_at({-0.0439815f, -4.12529f, 0.222539f}, {-0.0370952487f, -3.1267848f, 0.168322891f},
                                {3.73896e-4f, 0.0542148f, 0.998529f}, 45.0f, FovAxis::EachAxis);
     d.materials = course_materials(glossy);
+    // The scene files' ids (scenes/N-*.xml), for differentiable parameters; the emitter's
+    // black BSDF has none (nothing to differentiate: paths end there).
+    d.material_ids = {"", "", "floor", "green", "red", "back", "yellow", "blue"};
 
     d.meshes.push_back(make_mesh("floor", kBox, {{0, 4, 5}, {5, 1, 0}}, kFloor));
     d.meshes.push_back(make_mesh("left wall", kBox, {{3, 7, 4}, {4, 0, 3}}, kGreen));
     d.meshes.push_back(make_mesh("right wall", kBox, {{1, 5, 6}, {6, 2, 1}}, kRed));
     d.meshes.push_back(make_mesh("back wall", kBox, {{0, 1, 2}, {2, 3, 0}}, kBackWall));
-    if (light == LightKind::Ceiling)  // radiance 1.21, hard-coded by the course (not from a power)
+    if (light == LightKind::Ceiling) {  // radiance 1.21, hard-coded by the course (not from a power)
         d.meshes.push_back(make_mesh("ceiling light", kBox, {{2, 6, 7}, {7, 3, 2}}, kEmitter, Rgb(1.21f)));
-    else
+        d.meshes.back().id = "light";
+    } else {
         d.meshes.push_back(make_mesh("ceiling", kBox, {{2, 6, 7}, {7, 3, 2}}, kFloor));
+    }
 
     if (light == LightKind::LightBox) {
         d.meshes.push_back(make_mesh("light box sides", kLightBox,
                                      {{0, 2, 1}, {2, 0, 3}, {3, 4, 7}, {4, 3, 0}, {1, 6, 5}, {6, 1, 2}, {4, 5, 6}, {6, 7, 4}},
                                      kBackWall));
         d.meshes.push_back(make_mesh("light box bottom", kLightBox, {{0, 5, 4}, {5, 0, 1}}, kEmitter, Rgb(31.831f)));
+        d.meshes.back().id = "light";
     }
 
     d.spheres.push_back(SphereDesc{{-0.5388500f, 0.0245301f, -0.7800200f}, 0.5f, kYellowBall, false});
@@ -87,6 +93,7 @@ SceneDescription make_course_scene(const BuiltinSceneInfo& info, LightKind light
     if (light == LightKind::Point) d.lights.emplace_back(PointLight{{0.0f, -0.5f, 1.0f}, Rgb(50.0f / (4.0f * kPi))});
     if (light == LightKind::Environment)  // the course's raw colour, no sRGB decoding
         d.lights.emplace_back(EnvironmentLight{Rgb(135.0f / 255.0f, 206.0f / 255.0f, 250.0f / 255.0f)});
+    if (!d.lights.empty()) d.light_ids = {"light"};
     return d;
 }
 

@@ -29,6 +29,11 @@ struct SceneDescription {
     // camera sits in (-1: none).
     std::vector<Medium> media;
     int32_t camera_medium = -1;
+    // Ids of the materials (by index in `materials`) and free lights (by index in `lights`), ""
+    // for unnamed ones (either vector may be shorter): the names of differentiable parameters
+    // (diff/parameters.hpp), as scene files' id attributes give them. Shapes carry their own id.
+    std::vector<std::string> material_ids;
+    std::vector<std::string> light_ids;
     // Render settings a scene file may suggest; command-line options override them.
     std::optional<std::string> algorithm;
     std::optional<int> spp, max_depth, rr_depth;  // depths in pathlab's bounces

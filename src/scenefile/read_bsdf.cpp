@@ -239,7 +239,10 @@ void read_named_bsdf(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b) {
     }
     if (id && b.named.count(*id)) b.name(xml, n, *id, "bsdf", uint32_t(0));  // names the earlier declaration
     const uint32_t index = b.add_material(read_bsdf(xml, n, b));
-    if (id) b.name(xml, n, *id, "bsdf", index);
+    if (id) {
+        b.name(xml, n, *id, "bsdf", index);
+        b.name_material(index, *id);
+    }
 }
 
 }  // namespace pathlab

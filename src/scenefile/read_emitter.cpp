@@ -36,6 +36,10 @@ void read_free_emitter(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b)
         for (const FreeLight& l : b.desc.lights)
             if (environment(l)) xml.fail(n, "a scene can have only one environment emitter (constant or envmap)");
     b.desc.lights.push_back(light);
+    if (const auto id = xml.optional_attr(n, "id")) {
+        b.desc.light_ids.resize(b.desc.lights.size());
+        b.desc.light_ids.back() = *id;
+    }
 }
 
 }  // namespace pathlab

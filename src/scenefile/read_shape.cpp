@@ -135,7 +135,10 @@ void read_shape_into(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b, s
                 if (const auto id = xml.optional_attr(c, "id")) b.name(xml, c, *id, "bsdf", NullBsdf{});
             } else {
                 material = b.add_material(read_bsdf(xml, c, b));
-                if (const auto id = xml.optional_attr(c, "id")) b.name(xml, c, *id, "bsdf", *material);
+                if (const auto id = xml.optional_attr(c, "id")) {
+                    b.name(xml, c, *id, "bsdf", *material);
+                    b.name_material(*material, *id);
+                }
             }
         } else if (tag == "emitter") {
             xml.check_attributes(c, {"type", "id", "name"});
@@ -183,12 +186,13 @@ void read_shape_into(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b, s
         sphere->material = *material;
         sphere->emission = emission;
         sphere->media = media;
+        if (const auto id = xml.optional_attr(n, "id")) sphere->id = *id;
         b.desc.spheres.push_back(*sphere);
         return;
     }
     MeshDesc& m = std::get<MeshDesc>(shape);
     if (m.name.empty()) m.name = type;
-    if (const auto id = xml.optional_attr(n, "id")) m.name = *id;
+    if (const auto id = xml.optional_attr(n, "id")) m.name = m.id = *id;
     m.material = *material;
     m.emission = emission;
     m.media = media;

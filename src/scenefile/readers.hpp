@@ -42,6 +42,11 @@ struct SceneBuilder {
         desc.materials.push_back(m);
         return uint32_t(desc.materials.size() - 1);
     }
+    // Records `id` as the name of material `index` (SceneDescription::material_ids).
+    void name_material(uint32_t index, const std::string& id) {
+        if (desc.material_ids.size() <= index) desc.material_ids.resize(index + 1);
+        desc.material_ids[index] = id;
+    }
     // Declares `id` (an error at n if it is taken).
     void name(const XmlSource& xml, const pugi::xml_node& n, const std::string& id, const std::string& kind, std::any value);
     // The object a <ref id> names, which must be of kind `expected` (the error lists what the id is).

@@ -53,6 +53,10 @@ public:
         return true;
     }
 
+    // Whether survive_roulette(bounces, ...) plays roulette at all (and draws a random number),
+    // for code that replays its decisions (diff/path_replay.cpp).
+    bool roulette_applies(int bounces) const { return !(rr_depth_ < 0 || bounces < rr_depth_); }
+
 private:
     int max_depth_;
     int rr_depth_;

@@ -1,0 +1,21 @@
+#pragma once
+
+#include <vector>
+
+namespace pathlab::bench {
+
+struct DifferentiableOptions {
+    int size = 128;         // image width and height
+    int spp = 16;           // samples per pixel of every render
+    int repeats = 5;        // interleaved rounds (medians reported)
+    std::vector<int> scenes{2, 3, 5};
+};
+
+// `pathlab_bench diff`: the CPU cost of one gradient evaluation (path replay: primal + replay per
+// sample) and of one optimisation iteration (the loss's image + the gradient) relative to one
+// primal render (pt-mis) at equal spp, with every parameter of the scene bound; and the memory of
+// a gradient evaluation against spp and path depth (heap allocations and their bytes: no
+// per-path tape).
+void differentiable_suite(const DifferentiableOptions& o);
+
+}  // namespace pathlab::bench

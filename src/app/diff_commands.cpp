@@ -1,0 +1,323 @@
+#include "app/diff_commands.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "app/command_arguments.hpp"
+#include "app/interrupt.hpp"
+#include "diff/loss.hpp"
+#include "diff/optimizer.hpp"
+#include "diff/path_replay.hpp"
+#include "diff/scene_file_update.hpp"
+#include "image/image_io.hpp"
+#include "job/scene_choice.hpp"
+#include "job/usage_error.hpp"
+#include "judge/false_colour.hpp"
+#include "judge/svg_plot.hpp"
+#include "scenefile/scene_file.hpp"
+
+namespace pathlab {
+namespace {
+
+SceneChoice one_scene(const std::string& spec) {
+    std::vector<SceneChoice> scenes = resolve_scenes(spec);
+    if (scenes.size() != 1) throw UsageError(fmt::format("give one scene, not '{}'", spec));
+    return std::move(scenes.front());
+}
+
+std::string value_text(const std::vector<float>& v) {
+    return v.size() == 1 ? fmt::format("{:.6g}", v[0]) : fmt::format("{:.6g}, {:.6g}, {:.6g}", v[0], v[1], v[2]);
+}
+
+template <typename F>
+auto usage_on_invalid(F&& f) {
+    try {
+        return f();
+    } catch (const std::invalid_argument& e) {
+        throw UsageError(e.what());
+    }
+}
+
+uint64_t parse_seed(const std::string& text) {
+    char* end = nullptr;
+    const uint64_t s = std::strtoull(text.c_str(), &end, 10);
+    if (text.empty() || *end) throw UsageError(fmt::format("--seed: '{}' is not a non-negative integer", text));
+    return s;
+}
+
+// The chosen parameters, with --set start values applied (and clamped) to the description.
+ParameterSet choose_parameters(SceneDescription& d, const DiffCommonOptions& o) {
+    const std::vector<std::string> names = split_comma_list(o.params);
+    if (o.params.empty()) throw UsageError("--params: give at least one parameter (`pathlab params SCENE` lists them)");
+    const ParameterSet set = usage_on_invalid([&] { return ParameterSet::choose(d, names); });
+    const std::vector<SceneParameter> all = scene_parameters(d);
+    for (const std::string& item : o.initial) {
+        const size_t eq = item.find('=');
+        if (eq == std::string::npos) throw UsageError(fmt::format("--set '{}': expected name=value or name=r,g,b", item));
+        const SceneParameter& p = usage_on_invalid([&]() -> const SceneParameter& { return find_parameter(all, item.substr(0, eq)); });
+        std::vector<float> v;
+        for (const std::string& x : split_comma_list(item.substr(eq + 1))) {
+            char* end = nullptr;
+            const float f = std::strtof(x.c_str(), &end);
+            if (x.empty() || *end || !std::isfinite(f)) throw UsageError(fmt::format("--set '{}': '{}' is not a number", item, x));
+            v.push_back(f);
+        }
+        if (v.size() == 1 && p.size == 3) v.assign(3, v[0]);
+        if (int(v.size()) != p.size) throw UsageError(fmt::format("--set '{}': {} takes {} values", item, p.name, p.size));
+        clamp_parameter_value(p, v);
+        set_parameter_value(d, p, v);
+    }
+    return set;
+}
+
+DiffSettings settings_of(const DiffCommonOptions& o, int width, int height) {
+    DiffSettings s;
+    s.width = width, s.height = height;
+    s.seed = parse_seed(o.seed);
+    if (o.spp < 1) throw UsageError("--spp must be at least 1");
+    s.spp = o.spp;
+    s.max_depth = o.max_depth;
+    s.rr_depth = o.rr_depth;
+    return s;
+}
+
+void add_common_options(CLI::App* cmd, DiffCommonOptions& o) {
+    cmd->add_option("--scene", o.scene, "Scene: a built-in course scene (index or name) or a scene file")->required();
+    cmd->add_option("--params", o.params, "Comma-separated parameter names (`pathlab params SCENE` lists them)")->required();
+    cmd->add_option("--set", o.initial, "Start value of a parameter: name=v or name=r,g,b (repeatable)");
+    cmd->add_option("--spp", o.spp, "Samples per pixel of each evaluation")->capture_default_str();
+    cmd->add_option("--seed", o.seed, "Random seed")->capture_default_str();
+    cmd->add_option("--max-depth", o.max_depth, "Longest path in bounces (-1: unlimited)")->capture_default_str();
+    cmd->add_option("--rr-depth", o.rr_depth, "Bounces before Russian roulette (-1: never)")->capture_default_str();
+    cmd->add_option("--resolution", o.resolution, "WIDTHxHEIGHT of the renders");
+}
+
+Image read_target(const std::string& path) {
+    try {
+        return read_image(path);
+    } catch (const ImageIoError& e) {
+        throw UsageError(e.what());
+    }
+}
+
+void write_json(const std::string& path, const nlohmann::json& j) { write_text_file(path, j.dump(2) + "\n"); }
+
+nlohmann::json parameters_json(const ParameterSet& set, const std::vector<float>& theta) {
+    nlohmann::json j = nlohmann::json::object();
+    for (size_t i = 0; i < set.params.size(); ++i)
+        j[set.params[i].name] = std::vector<float>(theta.begin() + set.offsets[i], theta.begin() + set.offsets[i] + set.params[i].size);
+    return j;
+}
+
+}  // namespace
+
+// ---- params ------------------------------------------------------------------------------
+
+CLI::App* add_params_command(CLI::App& app, ParamsOptions& o) {
+    CLI::App* cmd = app.add_subcommand("params", "List a scene's differentiable parameters: name, kind, value, size (docs/differentiable.md)");
+    cmd->add_option("SCENE", o.scene, "A built-in course scene (index or name) or a scene file")->required();
+    cmd->add_flag("--json", o.json, "Print them as JSON");
+    return cmd;
+}
+
+int run_params_command(const ParamsOptions& o) {
+    const SceneChoice scene = one_scene(o.scene);
+    const std::vector<SceneParameter> params = scene_parameters(scene.description);
+    if (o.json) {
+        nlohmann::json j = nlohmann::json::array();
+        for (const SceneParameter& p : params)
+            j.push_back({{"name", p.name}, {"kind", p.kind()}, {"value", parameter_value(scene.description, p)}, {"size", p.size},
+                         {"range", p.range()}});
+        fmt::print("{}\n", j.dump(2));
+        return 0;
+    }
+    size_t width = 4;
+    for (const SceneParameter& p : params) width = std::max(width, p.name.size());
+    fmt::print("{:<{}}  {:<7}  {:<34}  {:>4}  {}\n", "name", width, "kind", "value", "size", "range");
+    for (const SceneParameter& p : params)
+        fmt::print("{:<{}}  {:<7}  {:<34}  {:>4}  {}\n", p.name, width, p.kind(), value_text(parameter_value(scene.description, p)), p.size,
+                   p.range());
+    if (params.empty()) fmt::print("(none: differentiable parameters need ids on the scene's <bsdf>, <shape> and <emitter> elements)\n");
+    return 0;
+}
+
+// ---- gradient ----------------------------------------------------------------------------
+
+CLI::App* add_gradient_command(CLI::App& app, GradientOptions& o) {
+    CLI::App* cmd = app.add_subcommand(
+        "gradient", "Forward-mode images dI/dtheta (one per parameter) and the reverse-mode gradient of a loss (path replay)");
+    add_common_options(cmd, o.common);
+    cmd->add_option("--target", o.target, "Target image: the gradient is of the L2 loss against it (default: of the mean pixel value)");
+    cmd->add_option("--out", o.out_dir, "Folder for the images")->capture_default_str();
+    return cmd;
+}
+
+int run_gradient_command(const GradientOptions& o) {
+    SceneChoice scene = one_scene(o.common.scene);
+    const ParameterSet set = choose_parameters(scene.description, o.common);
+    int w = 64, h = 64;
+    Image target;
+    if (!o.target.empty()) {
+        target = read_target(o.target);
+        w = target.width(), h = target.height();
+    }
+    if (!o.common.resolution.empty()) parse_resolution_option(o.common.resolution, w, h);
+    const DiffSettings s = settings_of(o.common, w, h);
+    const std::unique_ptr<Scene> built = Scene::build(scene.description);
+    std::filesystem::create_directories(o.out_dir);
+    const Image primal = render_primal(*built, s);
+    write_image(primal, o.out_dir + "/primal.exr");
+    write_image(primal, o.out_dir + "/primal.png");
+    Image adjoint(w, h, Rgb(1.0f / (3.0f * float(w) * float(h))));  // the mean pixel value's
+    if (target.pixel_count() > 0) adjoint = loss_adjoint(primal, target, Loss{});
+    DiffSettings gs = s;
+    gs.seed = s.seed + 1;  // independent of the primal image that made the adjoint
+    const std::vector<double> g = gradient(*built, set, gs, adjoint);
+    for (size_t i = 0; i < set.params.size(); ++i) {
+        const Image d = forward_gradient(*built, set, s, parameter_tangent(set, i));
+        const std::string base = o.out_dir + "/d_" + set.params[i].name;
+        write_image(d, base + ".exr");
+        const Image zero(d.width(), d.height());
+        write_png8(false_colour_difference(d, zero, difference_scale(d, zero)), base + ".png");
+        std::vector<double> gi(g.begin() + set.offsets[i], g.begin() + set.offsets[i] + set.params[i].size);
+        fmt::print("{}: dLoss/dtheta = [{:.6g}]; forward image {}.exr\n", set.params[i].name, fmt::join(gi, ", "), base);
+    }
+    return 0;
+}
+
+// ---- optimize ----------------------------------------------------------------------------
+
+CLI::App* add_optimize_command(CLI::App& app, OptimizeOptions& o) {
+    CLI::App* cmd = app.add_subcommand("optimize", "Recover scene parameters from a target image by gradient descent (path replay gradients)");
+    add_common_options(cmd, o.common);
+    cmd->add_option("--target", o.target, "Target image (.exr, .hdr, .pfm): its size is the render's")->required();
+    cmd->add_option("--iterations", o.iterations, "Gradient steps")->capture_default_str();
+    cmd->add_option("--lr", o.lr, "Learning rate")->capture_default_str();
+    cmd->add_option("--optimizer", o.optimizer, "adam or gd (plain gradient descent)")->capture_default_str();
+    cmd->add_option("--loss", o.loss, "l2 or l1 (mean over pixels and channels)")->capture_default_str();
+    cmd->add_option("--region", o.region, "x0,y0,x1,y1: the loss over this pixel region only");
+    cmd->add_flag("--seed-per-iteration", o.seed_per_iteration, "New random numbers every iteration (default: the same ones)");
+    cmd->add_option("--save-every", o.save_every, "Write the image every this many iterations (0: never)")->capture_default_str();
+    cmd->add_option("--out", o.out_dir, "Folder for loss.json, loss.svg, images, params.json and scene.xml")->capture_default_str();
+    cmd->add_flag("-q,--quiet", o.quiet, "No line per iteration");
+    return cmd;
+}
+
+int run_optimize_command(const OptimizeOptions& o) {
+    SceneChoice scene = one_scene(o.common.scene);
+    const ParameterSet set = choose_parameters(scene.description, o.common);
+    const Image target = read_target(o.target);
+    int w = target.width(), h = target.height();
+    if (!o.common.resolution.empty()) parse_resolution_option(o.common.resolution, w, h);
+    if (w != target.width() || h != target.height())
+        throw UsageError(fmt::format("--resolution {}x{} differs from the target's {}x{}", w, h, target.width(), target.height()));
+    const DiffSettings base = settings_of(o.common, w, h);
+    Loss loss;
+    loss.kind = usage_on_invalid([&] { return parse_loss_kind(o.loss); });
+    if (!o.region.empty()) {
+        const std::vector<std::string> r = split_comma_list(o.region);
+        int v[4];
+        for (size_t i = 0; i < 4 && r.size() == 4; ++i) {
+            char* end = nullptr;
+            v[i] = int(std::strtol(r[i].c_str(), &end, 10));
+            if (r[i].empty() || *end) throw UsageError(fmt::format("--region '{}': '{}' is not a whole number", o.region, r[i]));
+        }
+        if (r.size() != 4) throw UsageError(fmt::format("--region '{}': expected x0,y0,x1,y1 (pixels)", o.region));
+        loss.x0 = v[0], loss.y0 = v[1], loss.x1 = v[2], loss.y1 = v[3];
+        usage_on_invalid([&] { return loss_value(target, target, loss); });
+    }
+    Optimizer opt(usage_on_invalid([&] { return parse_optimizer_kind(o.optimizer); }), o.lr, size_t(set.size));
+    if (o.iterations < 0) throw UsageError("--iterations must not be negative");
+    if (!(o.lr > 0)) throw UsageError("--lr must be positive");
+    std::filesystem::create_directories(o.out_dir);
+    check_writable_path(o.out_dir + "/loss.json");
+
+    SceneDescription desc = scene.description;
+    std::vector<float> theta = set.values(desc), best = theta;
+    double best_loss = std::numeric_limits<double>::infinity();
+    nlohmann::json history = nlohmann::json::array();
+    PlotSeries series{"loss", series_colour(0), {}};
+    InterruptGuard guard;
+    bool interrupted = false;
+    const auto start = std::chrono::steady_clock::now();
+    int it = 0;
+    for (; it < o.iterations; ++it) {
+        if (InterruptGuard::flag().load()) {
+            interrupted = true;
+            break;
+        }
+        set.set_values(desc, theta);
+        const std::unique_ptr<Scene> built = Scene::build(desc);
+        DiffSettings s = base;
+        // The image of the loss and the gradient's replay use independent samples, so that the
+        // gradient of the L2 loss is unbiased (seeds 2i and 2i + 1 past --seed per iteration).
+        s.seed = base.seed + (o.seed_per_iteration ? 2 * uint64_t(it) : 0);
+        const Image image = render_primal(*built, s);
+        const double L = loss_value(image, target, loss);
+        if (L < best_loss) best_loss = L, best = theta;
+        DiffSettings gs = s;
+        gs.seed = s.seed + 1;
+        const std::vector<double> g = gradient(*built, set, gs, loss_adjoint(image, target, loss));
+        history.push_back({{"iteration", it}, {"loss", L}, {"params", parameters_json(set, theta)}, {"gradient", g}});
+        series.points.push_back({double(it + 1), L});
+        if (o.save_every > 0 && it % o.save_every == 0) write_image(image, fmt::format("{}/iteration_{:04d}.png", o.out_dir, it));
+        if (!o.quiet) {
+            std::string values;
+            for (size_t i = 0; i < set.params.size(); ++i)
+                values += fmt::format("  {}=[{}]", set.params[i].name,
+                                      value_text(std::vector<float>(theta.begin() + set.offsets[i],
+                                                                    theta.begin() + set.offsets[i] + set.params[i].size)));
+            fmt::print("iteration {:4d}  loss {:.6g}{}\n", it, L, values);
+        }
+        opt.step(theta, g);
+        set.clamp(theta);
+    }
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    // Interrupted: the parameters of the lowest loss seen; otherwise the last step's.
+    const std::vector<float>& result = interrupted ? best : theta;
+    set.set_values(desc, result);
+    {
+        const std::unique_ptr<Scene> built = Scene::build(desc);
+        DiffSettings s = base;
+        s.seed = base.seed + 7777;  // an independent final image
+        const Image final_image = render_primal(*built, s);
+        write_image(final_image, o.out_dir + "/final.exr");
+        write_image(final_image, o.out_dir + "/final.png");
+        const double final_loss = loss_value(final_image, target, loss);
+        write_json(o.out_dir + "/params.json", {{"scene", scene.file.empty() ? scene.name : scene.file},
+                                                {"params", parameters_json(set, result)},
+                                                {"final_loss", final_loss},
+                                                {"interrupted", interrupted}});
+        write_json(o.out_dir + "/loss.json", {{"scene", scene.file.empty() ? scene.name : scene.file},
+                                              {"target", o.target},
+                                              {"optimizer", o.optimizer},
+                                              {"lr", o.lr},
+                                              {"spp", o.common.spp},
+                                              {"loss", o.loss},
+                                              {"iterations", history},
+                                              {"best", {{"loss", best_loss}, {"params", parameters_json(set, best)}}},
+                                              {"final", {{"loss", final_loss}, {"params", parameters_json(set, result)}}},
+                                              {"seconds", seconds}});
+        LogLogPlot plot{"pathlab optimize: loss per iteration", "iteration", fmt::format("{} loss", o.loss)};
+        plot.slope_guide = false;
+        write_text_file(o.out_dir + "/loss.svg", log_log_svg(plot, {series}));
+        if (!scene.file.empty()) {
+            try {
+                write_text_file(o.out_dir + "/scene.xml", scene_file_with_values(scene.file, set, result));
+            } catch (const std::runtime_error& e) {
+                fmt::print(stderr, "pathlab: {}\n", e.what());
+            }
+        }
+        fmt::print("{} iterations in {:.1f} s; final loss {:.6g}{}; written to {}/ (params.json, loss.json, loss.svg, final.exr{})\n", it,
+                   seconds, final_loss, interrupted ? " (interrupted: the best parameters so far)" : "", o.out_dir,
+                   scene.file.empty() ? "" : ", scene.xml");
+    }
+    return interrupted ? interrupted_exit_code() : 0;
+}
+
+}  // namespace pathlab

@@ -1,0 +1,162 @@
+// Derivatives of the BSDF value f(wi, wo) with respect to a material's differentiable
+// parameters (parameters.hpp): for each bound scalar parameter theta_j (one colour channel of a
+// reflectance, or the Phong exponent, or the roughness alpha), the Rgb df/dtheta_j. The path
+// replay (path_replay.cpp) weighs them with the adjoint radiance (reverse mode) or a tangent
+// (forward mode). Sampling is detached (as Mitsuba 3's prb): no derivative of a pdf, a lobe's
+// selection probability or a Russian roulette probability is taken.
+//
+// For a delta sample (conductor, plastic's coating) the derivative is that of the sample's
+// coefficient f (bsdf_sample.hpp), for other samples that of eval(wi, wo).
+//
+// Formulas (directions local, both above the surface):
+//   Phong:           df/drho_d = 1/pi,  df/drho_s = (n + 2) c^n / (2 pi),
+//                    df/dn = rho_s c^n (1 + (n + 2) ln c) / (2 pi)     (c = cos alpha > 0)
+//   roughconductor:  df/dR = F D G2 / (4 cos_i cos_o),  df/dalpha = R F (D' G2 + D G2') / (4 cos_i cos_o),
+//                    G2' = -G2^2 (Lambda'(wi) + Lambda'(wo)), with for GGX
+//                    D' = D (-2/alpha + 4 s / (alpha^3 t)), t = s / alpha^2 + hz^2, s = hx^2 + hy^2,
+//                    Lambda' = a2 / (2 alpha sqrt(1 + a2)), a2 = alpha^2 tan^2;
+//                    for Beckmann D' = D (2 s / (alpha^3 hz^2) - 2/alpha), Lambda' = exp(-c^2) / (2 sqrt(pi) c alpha), c = 1/sqrt(a2)
+//   conductor (delta), plastic's coating (delta): df/dR = F / cos
+//   plastic, roughplastic base: df/drho = T_i T_o / (pi eta^2) d(rho')/drho, rho' = rho / (1 - Fdr)
+//                    (or rho / (1 - rho Fdr): derivative 1 / (1 - rho Fdr)^2)
+#pragma once
+
+#include <cmath>
+
+#include "bsdfs/material.hpp"
+#include "diff/parameters.hpp"
+
+namespace pathlab {
+
+namespace bsdf_derivative_detail {
+
+inline Rgb channel(int c, float v) {
+    Rgb r(0.0f);
+    (&r.x)[c] = v;
+    return r;
+}
+
+// dLambda/dalpha of an isotropic distribution.
+inline float dlambda_dalpha(const MicrofacetDistribution& d, const Vec3f& w) {
+    const float z2 = w.z * w.z;
+    if (z2 == 0) return 0.0f;
+    const float alpha = d.alpha_u;
+    const float a2 = alpha * alpha * (w.x * w.x + w.y * w.y) / z2;
+    if (a2 == 0) return 0.0f;
+    if (d.type == MicrofacetType::GGX) return a2 / (2 * alpha * std::sqrt(1 + a2));
+    const double c = 1.0 / std::sqrt(double(a2));
+    return float(std::exp(-c * c) / (2 * std::sqrt(M_PI) * c * alpha));
+}
+
+// dD/dalpha of an isotropic distribution at the normal h.
+inline float dD_dalpha(const MicrofacetDistribution& d, const Vec3f& h) {
+    if (h.z <= 0) return 0.0f;
+    const float alpha = d.alpha_u, s = h.x * h.x + h.y * h.y, z2 = h.z * h.z;
+    const float D = d.D(h);
+    if (d.type == MicrofacetType::GGX) {
+        const float t = s / (alpha * alpha) + z2;
+        return D * (-2 / alpha + 4 * s / (alpha * alpha * alpha * t));
+    }
+    return D * (2 * s / (alpha * alpha * alpha * z2) - 2 / alpha);
+}
+
+// d(rho')/drho of a coated base, per channel (rho' = rho / (1 - Fdr) or rho / (1 - rho Fdr)).
+inline Rgb coated_base_derivative(const CoatedDiffuse& c, float fdr) {
+    if (!c.nonlinear) return Rgb(1 / (1 - fdr));
+    const Rgb d = Rgb(1.0f) - c.diffuse_reflectance * fdr;
+    return Rgb(1.0f) / (d * d);
+}
+
+// The coating's Fdr, recovered from the precomputed base rho' / (pi eta^2) of a channel with
+// rho > 0 (plastic's and roughplastic's constructors compute it by quadrature, too slow per
+// vertex); recomputed only for a black base (`compute`).
+template <typename Compute>
+float coating_fdr(const CoatedDiffuse& c, Compute&& compute) {
+    for (int ch = 0; ch < 3; ++ch) {
+        const float rho = (&c.diffuse_reflectance.x)[ch], base = (&c.base.x)[ch] * kPi * c.eta * c.eta;  // rho'
+        if (rho > 0 && base > 0) return c.nonlinear ? (1 - rho / base) / rho : 1 - rho / base;
+    }
+    return compute();
+}
+
+// The rough coating's Fdr as RoughPlasticMaterial's constructor computes it from its table.
+inline float rough_coating_fdr(const RoughPlasticMaterial& r) {
+    const int n = RoughPlasticMaterial::kTableSize;
+    double integral = 0;
+    for (int k = 0; k + 1 < n; ++k) {
+        const double m0 = double(k) / (n - 1), m1 = double(k + 1) / (n - 1);
+        integral += 0.5 * (r.transmittance[size_t(k)] * m0 + r.transmittance[size_t(k + 1)] * m1) * (m1 - m0);
+    }
+    return float(1 - 2 * integral / (double(r.coat.eta) * r.coat.eta));
+}
+
+}  // namespace bsdf_derivative_detail
+
+// Calls add(offset, df/dtheta) for every bound scalar parameter of `m` whose derivative at
+// (wi, wo) may be non-zero.
+template <typename Add>
+void bsdf_jacobian(const Material& m, const MaterialBinding& b, const Vec3f& wi, const Vec3f& wo, bool delta, Add&& add) {
+    using namespace bsdf_derivative_detail;
+    if (wi.z <= 0 || wo.z <= 0) return;
+    if (const auto* p = std::get_if<PhongMaterial>(&m.model)) {
+        if (delta) return;
+        if (b.diffuse >= 0)
+            for (int c = 0; c < 3; ++c) add(b.diffuse + c, channel(c, kInvPi));
+        if (b.specular < 0 && b.exponent < 0) return;
+        const float cos_alpha = dot(PhongMaterial::mirror(wi), wo);
+        if (!(cos_alpha > 0)) return;
+        const float n = p->exponent, lobe = std::pow(cos_alpha, n) * (1 / (2 * kPi));
+        if (b.specular >= 0)
+            for (int c = 0; c < 3; ++c) add(b.specular + c, channel(c, (n + 2) * lobe));
+        if (b.exponent >= 0) add(b.exponent, p->specular * (lobe * (1 + (n + 2) * std::log(cos_alpha))));
+        return;
+    }
+    if (const auto* k = std::get_if<ConductorMaterial>(&m.model)) {
+        if (!delta || b.specular < 0) return;
+        const Rgb F = fresnel_conductor(wi.z, k->eta, k->k) / wo.z;
+        for (int c = 0; c < 3; ++c) add(b.specular + c, channel(c, (&F.x)[c]));
+        return;
+    }
+    if (const auto* r = std::get_if<RoughConductorMaterial>(&m.model)) {
+        if (delta) return;
+        const Vec3f sum = wi + wo;
+        const float len = length(sum);
+        if (!(len > 0)) return;
+        const Vec3f h = sum / len;
+        const float cos_ih = dot(wi, h), D = r->distribution.D(h);
+        if (!(D > 0) || !(cos_ih > 0)) return;
+        const Rgb F = fresnel_conductor(cos_ih, r->eta, r->k) * (1 / (4 * wi.z * wo.z));
+        const float G = r->distribution.G2(wi, wo);
+        if (b.specular >= 0) {
+            const Rgb base = F * (D * G);
+            for (int c = 0; c < 3; ++c) add(b.specular + c, channel(c, (&base.x)[c]));
+        }
+        if (b.alpha >= 0) {
+            const float dG = -G * G * (dlambda_dalpha(r->distribution, wi) + dlambda_dalpha(r->distribution, wo));
+            add(b.alpha, r->specular_reflectance * F * (dD_dalpha(r->distribution, h) * G + D * dG));
+        }
+        return;
+    }
+    if (const auto* p = std::get_if<PlasticMaterial>(&m.model)) {
+        const CoatedDiffuse& c = p->coat;
+        const float Fi = c.fresnel(wi.z);
+        if (delta) {
+            if (b.specular >= 0)
+                for (int ch = 0; ch < 3; ++ch) add(b.specular + ch, channel(ch, Fi / wo.z));
+            return;
+        }
+        if (b.diffuse < 0) return;
+        const Rgb d = coated_base_derivative(c, coating_fdr(c, [&] { return fresnel_diffuse_reflectance(1 / c.eta); })) *
+                      ((1 - Fi) * (1 - c.fresnel(wo.z)) * kInvPi / (c.eta * c.eta));
+        for (int ch = 0; ch < 3; ++ch) add(b.diffuse + ch, channel(ch, (&d.x)[ch]));
+        return;
+    }
+    if (const auto* r = std::get_if<RoughPlasticMaterial>(&m.model)) {
+        if (delta || b.diffuse < 0) return;
+        const Rgb d = coated_base_derivative(r->coat, coating_fdr(r->coat, [&] { return rough_coating_fdr(*r); })) *
+                      (r->T(wi.z) * r->T(wo.z) * kInvPi / (r->coat.eta * r->coat.eta));
+        for (int ch = 0; ch < 3; ++ch) add(b.diffuse + ch, channel(ch, (&d.x)[ch]));
+    }
+}
+
+}  // namespace pathlab

@@ -1,0 +1,233 @@
+#include "diff/parameters.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+namespace pathlab {
+namespace {
+
+std::vector<float> rgb(const Rgb& c) { return {c.x, c.y, c.z}; }
+Rgb rgb(const std::vector<float>& v) { return Rgb(v.at(0), v.at(1), v.at(2)); }
+
+const std::string& id_at(const std::vector<std::string>& ids, size_t i) {
+    static const std::string none;
+    return i < ids.size() ? ids[i] : none;
+}
+
+}  // namespace
+
+std::string SceneParameter::range() const {
+    switch (field) {
+        case ParamField::PhongExponent: return "[0, 10000]";
+        case ParamField::RoughConductorAlpha: return "[0.001, 10]";
+        case ParamField::MeshRadiance:
+        case ParamField::SphereRadiance:
+        case ParamField::PointIntensity:
+        case ParamField::ConstantRadiance: return ">= 1e-6";
+        default: return "[0, 1]";
+    }
+}
+
+std::vector<SceneParameter> scene_parameters(const SceneDescription& d) {
+    std::vector<SceneParameter> out;
+    for (size_t i = 0; i < d.materials.size(); ++i) {
+        const std::string& id = id_at(d.material_ids, i);
+        const Material& m = d.materials[i];
+        if (id.empty() || m.is_black()) continue;
+        const uint32_t k = uint32_t(i);
+        const auto add = [&](const std::string& what, ParamField f, int size) { out.push_back({id + "." + what, f, k, size}); };
+        if (const auto* p = std::get_if<PhongMaterial>(&m.model)) {
+            if (is_black(p->specular)) {
+                add("reflectance.value", ParamField::PhongDiffuse, 3);
+            } else {
+                add("diffuse_reflectance.value", ParamField::PhongDiffuse, 3);
+                add("specular_reflectance.value", ParamField::PhongSpecular, 3);
+                add("exponent", ParamField::PhongExponent, 1);
+            }
+        } else if (std::holds_alternative<ConductorMaterial>(m.model)) {
+            add("specular_reflectance.value", ParamField::ConductorSpecular, 3);
+        } else if (const auto* r = std::get_if<RoughConductorMaterial>(&m.model)) {
+            if (!r->distribution.is_anisotropic()) add("alpha", ParamField::RoughConductorAlpha, 1);
+            add("specular_reflectance.value", ParamField::RoughConductorSpecular, 3);
+        } else if (std::holds_alternative<PlasticMaterial>(m.model)) {
+            add("diffuse_reflectance.value", ParamField::PlasticDiffuse, 3);
+            add("specular_reflectance.value", ParamField::PlasticSpecular, 3);
+        } else if (std::holds_alternative<RoughPlasticMaterial>(m.model)) {
+            add("diffuse_reflectance.value", ParamField::RoughPlasticDiffuse, 3);
+        }
+    }
+    for (size_t i = 0; i < d.meshes.size(); ++i)
+        if (!d.meshes[i].id.empty() && !is_black(d.meshes[i].emission))
+            out.push_back({d.meshes[i].id + ".emitter.radiance.value", ParamField::MeshRadiance, uint32_t(i), 3});
+    for (size_t i = 0; i < d.spheres.size(); ++i)
+        if (!d.spheres[i].id.empty() && !is_black(d.spheres[i].emission))
+            out.push_back({d.spheres[i].id + ".emitter.radiance.value", ParamField::SphereRadiance, uint32_t(i), 3});
+    for (size_t i = 0; i < d.lights.size(); ++i) {
+        const std::string& id = id_at(d.light_ids, i);
+        if (id.empty()) continue;
+        if (std::holds_alternative<PointLight>(d.lights[i]))
+            out.push_back({id + ".intensity.value", ParamField::PointIntensity, uint32_t(i), 3});
+        if (std::holds_alternative<EnvironmentLight>(d.lights[i]))
+            out.push_back({id + ".radiance.value", ParamField::ConstantRadiance, uint32_t(i), 3});
+    }
+    return out;
+}
+
+const SceneParameter& find_parameter(const std::vector<SceneParameter>& all, const std::string& name) {
+    for (const SceneParameter& p : all)
+        if (p.name == name) return p;
+    std::vector<std::string> names;
+    for (const SceneParameter& p : all) names.push_back(p.name);
+    throw std::invalid_argument(fmt::format("unknown parameter '{}'; the scene's parameters: {}", name,
+                                            names.empty() ? "(none: give materials and emitters ids)" : fmt::format("{}", fmt::join(names, ", "))));
+}
+
+std::vector<float> parameter_value(const SceneDescription& d, const SceneParameter& p) {
+    if (!p.is_material()) {
+        switch (p.field) {
+            case ParamField::MeshRadiance: return rgb(d.meshes.at(p.index).emission);
+            case ParamField::SphereRadiance: return rgb(d.spheres.at(p.index).emission);
+            case ParamField::PointIntensity: return rgb(std::get<PointLight>(d.lights.at(p.index)).intensity);
+            default: return rgb(std::get<EnvironmentLight>(d.lights.at(p.index)).radiance);
+        }
+    }
+    const MaterialModel& m = d.materials.at(p.index).model;
+    switch (p.field) {
+        case ParamField::PhongDiffuse: return rgb(std::get<PhongMaterial>(m).diffuse);
+        case ParamField::PhongSpecular: return rgb(std::get<PhongMaterial>(m).specular);
+        case ParamField::PhongExponent: return {std::get<PhongMaterial>(m).exponent};
+        case ParamField::ConductorSpecular: return rgb(std::get<ConductorMaterial>(m).specular_reflectance);
+        case ParamField::RoughConductorSpecular: return rgb(std::get<RoughConductorMaterial>(m).specular_reflectance);
+        case ParamField::RoughConductorAlpha: return {std::get<RoughConductorMaterial>(m).distribution.alpha_u};
+        case ParamField::PlasticDiffuse: return rgb(std::get<PlasticMaterial>(m).coat.diffuse_reflectance);
+        case ParamField::PlasticSpecular: return rgb(std::get<PlasticMaterial>(m).coat.specular_reflectance);
+        default: return rgb(std::get<RoughPlasticMaterial>(m).coat.diffuse_reflectance);
+    }
+}
+
+namespace {
+
+// A coat with new reflectances (what the constructor precomputes from them included).
+CoatedDiffuse recoat(const CoatedDiffuse& c, const Rgb& diffuse, const Rgb& specular) {
+    // eta = int_ior / ext_ior: the constructor only uses the ratio.
+    return CoatedDiffuse(diffuse, specular, c.eta, 1.0f, c.nonlinear);
+}
+
+}  // namespace
+
+void set_parameter_value(SceneDescription& d, const SceneParameter& p, const std::vector<float>& v) {
+    if (int(v.size()) != p.size) throw std::invalid_argument(fmt::format("{} takes {} values, got {}", p.name, p.size, v.size()));
+    switch (p.field) {
+        case ParamField::MeshRadiance: d.meshes.at(p.index).emission = rgb(v); return;
+        case ParamField::SphereRadiance: d.spheres.at(p.index).emission = rgb(v); return;
+        case ParamField::PointIntensity: std::get<PointLight>(d.lights.at(p.index)).intensity = rgb(v); return;
+        case ParamField::ConstantRadiance: std::get<EnvironmentLight>(d.lights.at(p.index)).radiance = rgb(v); return;
+        default: break;
+    }
+    MaterialModel& m = d.materials.at(p.index).model;
+    switch (p.field) {
+        case ParamField::PhongDiffuse: std::get<PhongMaterial>(m).diffuse = rgb(v); return;
+        case ParamField::PhongSpecular: std::get<PhongMaterial>(m).specular = rgb(v); return;
+        case ParamField::PhongExponent: std::get<PhongMaterial>(m).exponent = v[0]; return;
+        case ParamField::ConductorSpecular: std::get<ConductorMaterial>(m).specular_reflectance = rgb(v); return;
+        case ParamField::RoughConductorSpecular: std::get<RoughConductorMaterial>(m).specular_reflectance = rgb(v); return;
+        case ParamField::RoughConductorAlpha: {
+            MicrofacetDistribution& dist = std::get<RoughConductorMaterial>(m).distribution;
+            dist = MicrofacetDistribution(dist.type, v[0], v[0]);
+            return;
+        }
+        case ParamField::PlasticDiffuse: {
+            CoatedDiffuse& c = std::get<PlasticMaterial>(m).coat;
+            c = recoat(c, rgb(v), c.specular_reflectance);
+            return;
+        }
+        case ParamField::PlasticSpecular: {
+            CoatedDiffuse& c = std::get<PlasticMaterial>(m).coat;
+            c = recoat(c, c.diffuse_reflectance, rgb(v));
+            return;
+        }
+        default: {
+            RoughPlasticMaterial& r = std::get<RoughPlasticMaterial>(m);
+            r = RoughPlasticMaterial(r.distribution, recoat(r.coat, rgb(v), r.coat.specular_reflectance));
+            return;
+        }
+    }
+}
+
+void clamp_parameter_value(const SceneParameter& p, std::vector<float>& v) {
+    float lo = 0, hi = 1;
+    switch (p.field) {
+        case ParamField::PhongExponent: hi = 1e4f; break;
+        case ParamField::RoughConductorAlpha: lo = 1e-3f, hi = 10; break;
+        case ParamField::MeshRadiance:
+        case ParamField::SphereRadiance:
+        case ParamField::PointIntensity:
+        case ParamField::ConstantRadiance: lo = 1e-6f, hi = 1e30f; break;
+        default: break;
+    }
+    for (float& x : v) x = std::isnan(x) ? lo : std::clamp(x, lo, hi);
+}
+
+ParameterSet ParameterSet::choose(const SceneDescription& d, const std::vector<std::string>& names) {
+    const std::vector<SceneParameter> all = scene_parameters(d);
+    ParameterSet s;
+    s.materials.assign(d.materials.size(), MaterialBinding{});
+    std::vector<int> free_light(d.lights.size(), -1), mesh(d.meshes.size(), -1), sphere(d.spheres.size(), -1);
+    for (const std::string& name : names) {
+        const SceneParameter& p = find_parameter(all, name);
+        for (const SceneParameter& q : s.params)
+            if (q.name == name) throw std::invalid_argument(fmt::format("parameter '{}' is given twice", name));
+        s.params.push_back(p);
+        s.offsets.push_back(s.size);
+        const int off = s.size;
+        s.size += p.size;
+        MaterialBinding* mb = p.is_material() ? &s.materials[p.index] : nullptr;
+        switch (p.field) {
+            case ParamField::PhongDiffuse:
+            case ParamField::PlasticDiffuse:
+            case ParamField::RoughPlasticDiffuse: mb->diffuse = off; break;
+            case ParamField::PhongSpecular:
+            case ParamField::ConductorSpecular:
+            case ParamField::RoughConductorSpecular:
+            case ParamField::PlasticSpecular: mb->specular = off; break;
+            case ParamField::PhongExponent: mb->exponent = off; break;
+            case ParamField::RoughConductorAlpha: mb->alpha = off; break;
+            case ParamField::MeshRadiance: mesh[p.index] = off; break;
+            case ParamField::SphereRadiance: sphere[p.index] = off; break;
+            default: free_light[p.index] = off; break;
+        }
+    }
+    // Scene::build's order of lights.
+    s.lights = free_light;
+    for (size_t i = 0; i < d.meshes.size(); ++i)
+        if (!is_black(d.meshes[i].emission)) s.lights.insert(s.lights.end(), d.meshes[i].triangles.size(), mesh[i]);
+    for (size_t i = 0; i < d.spheres.size(); ++i)
+        if (!is_black(d.spheres[i].emission)) s.lights.push_back(sphere[i]);
+    return s;
+}
+
+std::vector<float> ParameterSet::values(const SceneDescription& d) const {
+    std::vector<float> theta;
+    for (const SceneParameter& p : params) {
+        const std::vector<float> v = parameter_value(d, p);
+        theta.insert(theta.end(), v.begin(), v.end());
+    }
+    return theta;
+}
+
+void ParameterSet::set_values(SceneDescription& d, const std::vector<float>& theta) const {
+    for (size_t i = 0; i < params.size(); ++i)
+        set_parameter_value(d, params[i], std::vector<float>(theta.begin() + offsets[i], theta.begin() + offsets[i] + params[i].size));
+}
+
+void ParameterSet::clamp(std::vector<float>& theta) const {
+    for (size_t i = 0; i < params.size(); ++i) {
+        std::vector<float> v(theta.begin() + offsets[i], theta.begin() + offsets[i] + params[i].size);
+        clamp_parameter_value(params[i], v);
+        std::copy(v.begin(), v.end(), theta.begin() + offsets[i]);
+    }
+}
+
+}  // namespace pathlab

@@ -1,0 +1,94 @@
+// Differentiable scene parameters by name, as Mitsuba 3's traverse() names them:
+//   <bsdf id>.reflectance.value             diffuse (Phong without a glossy lobe): rho, rgb
+//   <bsdf id>.diffuse_reflectance.value     phong, plastic, roughplastic: rho_d, rgb
+//   <bsdf id>.specular_reflectance.value    phong (rho_s), conductor, roughconductor, plastic: rgb
+//   <bsdf id>.exponent                      phong: n, float
+//   <bsdf id>.alpha                         roughconductor (isotropic): roughness, float
+//   <shape id>.emitter.radiance.value       area emitter on a shape: radiance, rgb
+//   <emitter id>.intensity.value            point light: intensity, rgb
+//   <emitter id>.radiance.value             constant environment: radiance, rgb
+// A twosided wrapper is transparent (its id names the BSDF inside). Materials without an id,
+// pure emitters' black BSDFs (paths end there) and the other models (dielectrics: only an
+// index of refraction, which moves refracted directions; blendbsdf, mask) have none; geometric
+// parameters (vertex positions, transforms) are out of scope (docs/differentiable.md).
+//
+// A parameter is a view into a SceneDescription: get/set read and write its floats there, and
+// the optimiser rebuilds the Scene from the changed description.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "scene/scene_description.hpp"
+
+namespace pathlab {
+
+enum class ParamField {
+    PhongDiffuse,
+    PhongSpecular,
+    PhongExponent,
+    ConductorSpecular,
+    RoughConductorSpecular,
+    RoughConductorAlpha,
+    PlasticDiffuse,
+    PlasticSpecular,
+    RoughPlasticDiffuse,
+    MeshRadiance,    // index: the mesh
+    SphereRadiance,  // index: the sphere
+    PointIntensity,  // index: the light in SceneDescription::lights
+    ConstantRadiance,
+};
+
+struct SceneParameter {
+    std::string name;   // e.g. "red.reflectance.value"
+    ParamField field;
+    uint32_t index = 0;  // material, mesh, sphere or free light, by field
+    int size = 3;        // 3 (rgb) or 1 (float)
+
+    bool is_material() const { return field < ParamField::MeshRadiance; }
+    // "bsdf" or "emitter".
+    std::string kind() const { return is_material() ? "bsdf" : "emitter"; }
+    // The valid range, as the optimiser clamps to it ("[0, 1]", "> 0", ">= 0").
+    std::string range() const;
+};
+
+// Every differentiable parameter of the scene, in a stable order (materials by index, then
+// meshes, spheres and free lights).
+std::vector<SceneParameter> scene_parameters(const SceneDescription& d);
+
+// The parameter named `name`; a std::invalid_argument listing the valid names otherwise.
+const SceneParameter& find_parameter(const std::vector<SceneParameter>& all, const std::string& name);
+
+std::vector<float> parameter_value(const SceneDescription& d, const SceneParameter& p);
+// Writes `value` (p.size floats) into the description (rebuilding what a model precomputes).
+void set_parameter_value(SceneDescription& d, const SceneParameter& p, const std::vector<float>& value);
+// Clamps to the valid range: reflectances to [0, 1], roughness to [1e-3, 10], the Phong
+// exponent to [0, 10^4], emission to >= 1e-6 (a zero emitter would vanish from the scene).
+void clamp_parameter_value(const SceneParameter& p, std::vector<float>& value);
+
+// A set of chosen parameters laid out in one vector theta (each at its offset), and how the
+// path replay finds them: per material and per light of a built Scene, the offsets (-1: not chosen).
+struct MaterialBinding {
+    int diffuse = -1, specular = -1, exponent = -1, alpha = -1;
+    bool any() const { return diffuse >= 0 || specular >= 0 || exponent >= 0 || alpha >= 0; }
+};
+struct ParameterSet {
+    std::vector<SceneParameter> params;
+    std::vector<int> offsets;  // of params[i] in theta
+    int size = 0;              // floats in theta
+
+    std::vector<MaterialBinding> materials;  // by material index
+    // By index in Scene::lights(), in Scene::build's order (free lights, then each emitting
+    // mesh's triangles, then emitting spheres): the offset of the light's radiance/intensity.
+    std::vector<int> lights;
+
+    // Chooses `names` of the description's parameters (std::invalid_argument for an unknown
+    // or repeated name, listing the valid ones).
+    static ParameterSet choose(const SceneDescription& d, const std::vector<std::string>& names);
+
+    std::vector<float> values(const SceneDescription& d) const;
+    void set_values(SceneDescription& d, const std::vector<float>& theta) const;
+    void clamp(std::vector<float>& theta) const;
+};
+
+}  // namespace pathlab

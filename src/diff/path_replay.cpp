@@ -1,0 +1,301 @@
+#include "diff/path_replay.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+
+#include "diff/bsdf_derivatives.hpp"
+#include "integrators/common/direct_lighting.hpp"
+#include "integrators/common/path_rules.hpp"
+
+namespace pathlab {
+
+namespace {
+
+enum class Mode { Primal, Reverse, Forward };
+
+// What the reverse and forward passes carry besides the path itself.
+struct Carry {
+    // Reverse: the adjoint radiance, the radiance still to come, the gradient.
+    Rgb delta{0.0f};
+    Rgb Lr{0.0f};
+    double* grad = nullptr;
+    // Forward: the tangent in theta and the derivative of L along it.
+    const float* tangent = nullptr;
+    Rgb dL{0.0f};
+};
+
+IntegratorOptions path_options(const DiffSettings& s) {
+    IntegratorOptions o;
+    o.max_depth = s.max_depth;
+    o.rr_depth = s.rr_depth;
+    return o;
+}
+
+class PathReplay {
+public:
+    PathReplay(const Scene& scene, const ParameterSet& set, const DiffSettings& s)
+        : scene_(scene), set_(set), rules_(path_options(s)), hide_(s.hide_emitters), faults_(s.faults) {}
+
+    template <Mode M>
+    Rgb trace(const Ray& camera_ray, Sampler& sampler, Carry& c) const {
+        Intersection hit;
+        if (!scene_.intersect(camera_ray, hit)) {
+            if (hide_) return Rgb(0.0f);
+            const Rgb Le = scene_.escaped_radiance(camera_ray.d);
+            emitter_term<M>(scene_.environment_light(), Rgb(1.0f), 1.0f, c);
+            return Le;
+        }
+        Rgb L = hide_ ? Rgb(0.0f) : emitted_radiance(scene_, hit, -camera_ray.d);
+        if (!is_black(L)) {
+            emitter_term<M>(hit.light, Rgb(1.0f), 1.0f, c);
+            if constexpr (M == Mode::Reverse) c.Lr -= L;
+        }
+        Rgb beta(1.0f), dbeta(0.0f);
+        Vec3f dir = camera_ray.d;
+        for (int bounces = 0; rules_.may_bounce(bounces); ++bounces) {
+            const ShadingPoint sp = make_shading_point(scene_, hit, dir);
+            if (sp.material->is_black()) break;
+            const size_t mat_index = size_t(sp.material - &scene_.material(0));
+            const MaterialBinding& mb = mat_index < set_.materials.size() ? set_.materials[mat_index] : kNone;
+
+            // Next-event estimation, as estimate_light_sample(mis = true).
+            const LightChoice choice = scene_.choose_light(sampler.next1d());
+            const Vec2f u = sampler.next2d();
+            if (choice.index >= 0) {
+                const Light& light = scene_.lights()[size_t(choice.index)];
+                const auto ls = sample_light(light, sp.p, u);
+                if (ls && !is_black(ls->Le) && !(dot(ls->wi, sp.ng) <= 0 && !sp.material->is_dielectric())) {
+                    const Vec3f wo = sp.frame.to_local(ls->wi);
+                    float pdf_bsdf;
+                    const Rgb f = sp.material->eval_and_pdf(sp, sp.wi, wo, pdf_bsdf);
+                    if (!is_black(f)) {
+                        const Ray shadow = std::isinf(ls->distance) ? spawn_ray(sp.p, sp.ng, ls->wi)
+                                                                    : spawn_segment(sp.p, sp.ng, ls->point, ls->normal);
+                        if (!scene_.occluded(shadow)) {
+                            const float pdf_light = choice.pmf * ls->pdfW;
+                            const float weight = !ls->delta ? balance_heuristic(pdf_light, pdf_bsdf) : 1.0f;
+                            const float k = std::abs(wo.z) * weight / pdf_light;
+                            const Rgb direct = f * ls->Le * k;
+                            L += beta * direct;
+                            const float scale = std::holds_alternative<PointLight>(light) ? 1 / (ls->distance * ls->distance) : 1.0f;
+                            vertex_term<M>(*sp.material, mb, sp.wi, wo, false, f, ls->Le, k, choice.index, scale, beta, dbeta, c);
+                        }
+                    }
+                }
+            }
+            // The BSDF sample: its MIS-weighted emission, then the continuation.
+            const auto s = sp.material->sample(sp, sp.wi, sampler.next2d());
+            EmitterHit found;
+            if (s) {
+                found = trace_to_emitter(scene_, sp.spawn(s->wo), sp.p);
+                if (!is_black(found.Le)) {
+                    const float weight = s->delta ? 1.0f : balance_heuristic(s->pdfW, found.pdf_light);
+                    const float k = std::abs(s->wo.z) * weight / s->pdfW;
+                    L += beta * (s->f * found.Le * k);
+                    const int light = found.hit ? found.isect.light : scene_.environment_light();
+                    vertex_term<M>(*sp.material, mb, sp.wi, s->wo, s->delta, s->f, found.Le, k, light, 1.0f, beta, dbeta, c);
+                }
+            }
+            if (!rules_.may_bounce(bounces + 1) || !s || !found.hit) break;
+            const float k = std::abs(s->wo.z) / s->pdfW;
+            if constexpr (M == Mode::Forward) dbeta = dbeta * (s->f * k) + beta * (bsdf_tangent(*sp.material, mb, sp.wi, *s, c) * k);
+            beta *= s->f * k;
+            if (rules_.roulette_applies(bounces + 1)) {
+                const float q = std::clamp(max_component(beta), 0.05f, 1.0f);
+                if (sampler.next1d() >= q) break;
+                beta /= q;
+                if constexpr (M == Mode::Forward) dbeta /= q;
+            }
+            // Reverse: the continuation's weight f scales everything still to come, Lr.
+            if constexpr (M == Mode::Reverse) {
+                if (mb.any() && !faults_.drop_continuation) {
+                    Rgb W(0.0f);
+                    for (int ch = 0; ch < 3; ++ch) {
+                        const float f = (&s->f.x)[ch];
+                        if (f > 0) (&W.x)[ch] = (&c.delta.x)[ch] * (&c.Lr.x)[ch] / f;
+                    }
+                    add_bsdf_adjoint(*sp.material, mb, sp.wi, s->wo, s->delta, W, c);
+                }
+            }
+            hit = found.isect;
+            dir = sp.frame.to_world(s->wo);
+        }
+        return L;
+    }
+
+private:
+    static inline const MaterialBinding kNone{};
+
+    // A term beta f Le k added at a vertex (f the BSDF towards the emitter, Le its radiance,
+    // `scale` = dLe/dtheta of the emitter's parameter).
+    template <Mode M>
+    void vertex_term(const Material& m, const MaterialBinding& mb, const Vec3f& wi, const Vec3f& wo, bool delta, const Rgb& f,
+                     const Rgb& Le, float k, int light, float scale, const Rgb& beta, const Rgb& dbeta, Carry& c) const {
+        if constexpr (M == Mode::Reverse) {
+            if (mb.any()) add_bsdf_adjoint(m, mb, wi, wo, delta, c.delta * beta * Le * k, c);
+            emitter_term<M>(light, beta * f * k, scale, c);
+            c.Lr -= beta * (f * Le * k);
+        } else if constexpr (M == Mode::Forward) {
+            Rgb dLe(0.0f);
+            const int off = light >= 0 && size_t(light) < set_.lights.size() ? set_.lights[size_t(light)] : -1;
+            if (off >= 0) dLe = Rgb(c.tangent[off], c.tangent[off + 1], c.tangent[off + 2]) * scale;
+            Rgb df(0.0f);
+            if (mb.any()) df = jacobian_dot(m, mb, wi, wo, delta, c.tangent);
+            c.dL += dbeta * (f * Le * k) + beta * ((df * Le + f * dLe) * k);
+        }
+    }
+
+    // Emission reached with weight W (everything multiplying Le, the adjoint apart): its
+    // parameter's share.
+    template <Mode M>
+    void emitter_term(int light, const Rgb& W, float scale, Carry& c) const {
+        const int off = light >= 0 && size_t(light) < set_.lights.size() ? set_.lights[size_t(light)] : -1;
+        if (off < 0) return;
+        if constexpr (M == Mode::Reverse) {
+            const Rgb g = c.delta * W * scale;
+            c.grad[off] += g.x, c.grad[off + 1] += g.y, c.grad[off + 2] += g.z;
+        } else if constexpr (M == Mode::Forward) {
+            c.dL += W * Rgb(c.tangent[off], c.tangent[off + 1], c.tangent[off + 2]) * scale;
+        }
+    }
+
+    void add_bsdf_adjoint(const Material& m, const MaterialBinding& mb, const Vec3f& wi, const Vec3f& wo, bool delta, const Rgb& W,
+                          Carry& c) const {
+        bsdf_jacobian(m, effective(m, mb), wi, wo, delta, [&](int off, const Rgb& df) { c.grad[off] += double(dot(W, df)); });
+    }
+    Rgb jacobian_dot(const Material& m, const MaterialBinding& mb, const Vec3f& wi, const Vec3f& wo, bool delta, const float* t) const {
+        Rgb d(0.0f);
+        bsdf_jacobian(m, effective(m, mb), wi, wo, delta, [&](int off, const Rgb& df) { d += df * t[off]; });
+        return d;
+    }
+    Rgb bsdf_tangent(const Material& m, const MaterialBinding& mb, const Vec3f& wi, const BsdfSample& s, const Carry& c) const {
+        return mb.any() ? jacobian_dot(m, mb, wi, s.wo, s.delta, c.tangent) : Rgb(0.0f);
+    }
+    // The binding with the fault switch applied (Phong's glossy lobe dropped).
+    MaterialBinding effective(const Material& m, MaterialBinding mb) const {
+        if (faults_.drop_glossy_lobe && std::holds_alternative<PhongMaterial>(m.model)) mb.specular = mb.exponent = -1;
+        return mb;
+    }
+
+    const Scene& scene_;
+    const ParameterSet& set_;
+    PathRules rules_;
+    bool hide_;
+    DiffFaults faults_;
+};
+
+// The camera ray of sample `sample` of pixel (x, y), drawn as PixelIntegrator draws it.
+Ray camera_ray(const PerspectiveCamera& cam, int x, int y, Sampler& sampler) {
+    const Vec2f jitter = sampler.next2d();
+    return cam.needs_lens_sample() ? cam.generate(float(x) + jitter.x, float(y) + jitter.y, sampler.next2d())
+                                   : cam.generate(float(x) + jitter.x, float(y) + jitter.y);
+}
+
+// Bands of rows, a fixed partition (not the thread count's), run in parallel.
+constexpr int kRowsPerBand = 2;
+template <typename F>
+void for_each_band(int height, F&& f) {
+    const int bands = (height + kRowsPerBand - 1) / kRowsPerBand;
+    tbb::parallel_for(tbb::blocked_range<int>(0, bands, 1), [&](const tbb::blocked_range<int>& r) {
+        for (int b = r.begin(); b != r.end(); ++b) f(b, b * kRowsPerBand, std::min(height, (b + 1) * kRowsPerBand));
+    });
+}
+
+const ParameterSet& empty_set() {
+    static const ParameterSet set;
+    return set;
+}
+
+}  // namespace
+
+Image render_primal(const Scene& scene, const DiffSettings& s) {
+    const PerspectiveCamera cam(scene.camera(), s.width, s.height);
+    const PathReplay replay(scene, empty_set(), s);
+    Image img(s.width, s.height);
+    for_each_band(s.height, [&](int, int y0, int y1) {
+        for (int y = y0; y < y1; ++y)
+            for (int x = 0; x < s.width; ++x) {
+                const size_t pixel = size_t(y) * size_t(s.width) + size_t(x);
+                Vec3d sum(0.0);
+                for (int k = 0; k < s.spp; ++k) {
+                    Sampler sampler(s.seed, pixel, s.first_pass + uint64_t(k), s.sampler);
+                    const Ray ray = camera_ray(cam, x, y, sampler);
+                    Carry c;
+                    const Rgb L = replay.trace<Mode::Primal>(ray, sampler, c);
+                    if (is_finite(L)) sum += Vec3d(L);
+                }
+                img[pixel] = Rgb(sum / double(std::max(1, s.spp)));
+            }
+    });
+    return img;
+}
+
+std::vector<double> gradient(const Scene& scene, const ParameterSet& set, const DiffSettings& s, const Image& adjoint) {
+    const PerspectiveCamera cam(scene.camera(), s.width, s.height);
+    const PathReplay replay(scene, set, s);
+    const int bands = (s.height + kRowsPerBand - 1) / kRowsPerBand;
+    std::vector<std::vector<double>> band_grad(static_cast<size_t>(bands));
+    const uint64_t replay_shift = s.faults.replay_other_numbers ? 1 : 0;
+    for_each_band(s.height, [&](int band, int y0, int y1) {
+        std::vector<double> g(size_t(set.size), 0.0);
+        for (int y = y0; y < y1; ++y)
+            for (int x = 0; x < s.width; ++x) {
+                const size_t pixel = size_t(y) * size_t(s.width) + size_t(x);
+                const Rgb delta = adjoint[pixel] / float(std::max(1, s.spp));
+                if (is_black(delta)) continue;
+                for (int k = 0; k < s.spp; ++k) {
+                    const uint64_t index = s.first_pass + uint64_t(k);
+                    Sampler primal_sampler(s.seed, pixel, index, s.sampler);
+                    const Ray ray = camera_ray(cam, x, y, primal_sampler);
+                    Carry primal;
+                    const Rgb L = replay.trace<Mode::Primal>(ray, primal_sampler, primal);
+                    if (!is_finite(L)) continue;
+                    Sampler sampler(s.seed, pixel, index + replay_shift, s.sampler);
+                    const Ray replay_ray = camera_ray(cam, x, y, sampler);
+                    Carry c;
+                    c.delta = delta;
+                    c.Lr = L;
+                    c.grad = g.data();
+                    replay.trace<Mode::Reverse>(replay_ray, sampler, c);
+                }
+            }
+        band_grad[size_t(band)] = std::move(g);
+    });
+    std::vector<double> total(size_t(set.size), 0.0);
+    for (const auto& g : band_grad)
+        for (size_t i = 0; i < g.size(); ++i) total[i] += g[i];
+    return total;
+}
+
+Image forward_gradient(const Scene& scene, const ParameterSet& set, const DiffSettings& s, const std::vector<float>& tangent) {
+    const PerspectiveCamera cam(scene.camera(), s.width, s.height);
+    const PathReplay replay(scene, set, s);
+    Image img(s.width, s.height);
+    for_each_band(s.height, [&](int, int y0, int y1) {
+        for (int y = y0; y < y1; ++y)
+            for (int x = 0; x < s.width; ++x) {
+                const size_t pixel = size_t(y) * size_t(s.width) + size_t(x);
+                Vec3d sum(0.0);
+                for (int k = 0; k < s.spp; ++k) {
+                    Sampler sampler(s.seed, pixel, s.first_pass + uint64_t(k), s.sampler);
+                    const Ray ray = camera_ray(cam, x, y, sampler);
+                    Carry c;
+                    c.tangent = tangent.data();
+                    const Rgb L = replay.trace<Mode::Forward>(ray, sampler, c);
+                    if (is_finite(L) && is_finite(c.dL)) sum += Vec3d(c.dL);
+                }
+                img[pixel] = Rgb(sum / double(std::max(1, s.spp)));
+            }
+    });
+    return img;
+}
+
+std::vector<float> parameter_tangent(const ParameterSet& set, size_t i) {
+    std::vector<float> t(size_t(set.size), 0.0f);
+    for (int k = 0; k < set.params.at(i).size; ++k) t[size_t(set.offsets[i] + k)] = 1;
+    return t;
+}
+
+}  // namespace pathlab

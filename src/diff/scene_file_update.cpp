@@ -1,0 +1,92 @@
+#include "diff/scene_file_update.hpp"
+
+#include <filesystem>
+#include <sstream>
+#include <stdexcept>
+
+#include <fmt/format.h>
+#include <pugixml.hpp>
+
+namespace pathlab {
+namespace {
+
+pugi::xml_node find_by_id(pugi::xml_node root, const char* tag, const std::string& id) {
+    for (pugi::xml_node n : root.children()) {
+        if (std::string(n.name()) == tag && id == n.attribute("id").value()) return n;
+        if (pugi::xml_node inner = find_by_id(n, tag, id)) return inner;
+    }
+    return {};
+}
+
+// The XML parameter names (Mitsuba 3's, then the camelCase of 0.6) of a parameter.
+std::vector<std::string> xml_names(const SceneParameter& p, const std::string& bsdf_type) {
+    switch (p.field) {
+        case ParamField::PhongDiffuse:
+            return bsdf_type == "diffuse" ? std::vector<std::string>{"reflectance"}
+                                          : std::vector<std::string>{"diffuse_reflectance", "diffuseReflectance"};
+        case ParamField::PlasticDiffuse:
+        case ParamField::RoughPlasticDiffuse: return {"diffuse_reflectance", "diffuseReflectance"};
+        case ParamField::PhongExponent: return {"exponent"};
+        case ParamField::RoughConductorAlpha: return {"alpha"};
+        case ParamField::MeshRadiance:
+        case ParamField::SphereRadiance:
+        case ParamField::ConstantRadiance: return {"radiance"};
+        case ParamField::PointIntensity: return {"intensity"};
+        default: return {"specular_reflectance", "specularReflectance"};
+    }
+}
+
+void set_value(pugi::xml_node element, const std::vector<std::string>& names, const std::vector<float>& v) {
+    pugi::xml_node old;
+    for (pugi::xml_node c : element.children())
+        for (const std::string& n : names)
+            if (n == c.attribute("name").value()) old = c;
+    const std::string value = v.size() == 1 ? fmt::format("{}", v[0]) : fmt::format("{}, {}, {}", v[0], v[1], v[2]);
+    pugi::xml_node fresh = old ? element.insert_child_before(v.size() == 1 ? "float" : "rgb", old)
+                               : element.prepend_child(v.size() == 1 ? "float" : "rgb");
+    fresh.append_attribute("name") = names.front().c_str();
+    fresh.append_attribute("value") = value.c_str();
+    if (old) element.remove_child(old);
+}
+
+}  // namespace
+
+std::string scene_file_with_values(const std::string& scene_file, const ParameterSet& set, const std::vector<float>& theta) {
+    pugi::xml_document doc;
+    const pugi::xml_parse_result r = doc.load_file(scene_file.c_str(), pugi::parse_default | pugi::parse_comments);
+    if (!r) throw std::runtime_error(fmt::format("{}: cannot be read again: {}", scene_file, r.description()));
+    pugi::xml_node scene = doc.child("scene");
+    for (size_t i = 0; i < set.params.size(); ++i) {
+        const SceneParameter& p = set.params[i];
+        const std::string id = p.name.substr(0, p.name.find('.'));
+        const std::vector<float> v(theta.begin() + set.offsets[i], theta.begin() + set.offsets[i] + p.size);
+        pugi::xml_node element;
+        std::string bsdf_type;
+        if (p.is_material()) {
+            element = find_by_id(scene, "bsdf", id);
+            while (element && std::string(element.attribute("type").value()) == "twosided") element = element.child("bsdf");
+            if (element) bsdf_type = element.attribute("type").value();
+        } else if (p.field == ParamField::MeshRadiance || p.field == ParamField::SphereRadiance) {
+            element = find_by_id(scene, "shape", id);
+            if (element) element = element.child("emitter");
+        } else {
+            element = find_by_id(scene, "emitter", id);
+        }
+        if (!element)
+            throw std::runtime_error(fmt::format("{}: the element of parameter {} (id '{}') is not in this file (an <include>d one?); "
+                                                 "its value is in the JSON output",
+                                                 scene_file, p.name, id));
+        set_value(element, xml_names(p, bsdf_type), v);
+    }
+    // Files the scene names are found from the original folder.
+    const std::string dir = std::filesystem::absolute(std::filesystem::path(scene_file)).parent_path().string();
+    pugi::xml_node path = scene.prepend_child("path");
+    path.append_attribute("value") = dir.c_str();
+    scene.insert_child_before(pugi::node_comment, path)
+        .set_value(" written by pathlab optimize: the original scene with the optimised parameters; meshes from its folder ");
+    std::ostringstream out;
+    doc.save(out, "    ");
+    return out.str();
+}
+
+}  // namespace pathlab

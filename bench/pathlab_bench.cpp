@@ -7,7 +7,8 @@
 //   pathlab_bench lt       light tracing: paths/s next to pt-mis, and splat accumulation
 //   pathlab_bench bdpt     bdpt against pt-mis: equal-time RMSE, and samples per second
 //   pathlab_bench pm       photons per second; hashed grid against k-d tree (build, query)
-//   pathlab_bench ic       irradiance caching against pt-mis and bdpt at short budgets
+//   pathlab_bench ic       irradiance caching and pbgi against pt-mis and bdpt at short budgets
+//   pathlab_bench pbgi-gather  pbgi's gather against a ray-traced truth per cutoff and micro-buffer
 #include <CLI/CLI.hpp>
 
 #include "bidirectional.hpp"
@@ -68,12 +69,20 @@ int main(int argc, char** argv) {
     pmc->add_option("--size", pm.size, "Queries: one per pixel of a size x size image")->capture_default_str();
     pmc->add_option("--repeats", pm.repeats, "Timed repeats (median reported)")->capture_default_str();
     IrradianceCachingOptions icopt;
-    CLI::App* icc = app.add_subcommand("ic", "Irradiance caching against pt-mis and bdpt at short budgets");
+    CLI::App* icc = app.add_subcommand("ic", "Irradiance caching and pbgi against pt-mis and bdpt at short budgets");
     icc->add_option("--size", icopt.size, "Image width and height")->capture_default_str();
     icc->add_option("--budgets", icopt.budgets, "Seconds per render")->delimiter(',')->capture_default_str();
     icc->add_option("--repeats", icopt.repeats, "Rounds (median reported)")->capture_default_str();
     icc->add_option("--scenes", icopt.scenes, "Course scene indices")->delimiter(',')->capture_default_str();
+    GatherAccuracyOptions gopt;
+    CLI::App* gat = app.add_subcommand("pbgi-gather", "pbgi's gather against brute force: error and time per cutoff and micro-buffer");
+    gat->add_option("--scenes", gopt.scenes, "Course scene indices")->delimiter(',')->capture_default_str();
+    gat->add_option("--points", gopt.points, "First hits per scene")->capture_default_str();
+    gat->add_option("--surfels", gopt.surfels, "Surfels (about)")->capture_default_str();
+    gat->add_option("--cutoffs", gopt.cutoffs, "Cutoff solid angles")->delimiter(',')->capture_default_str();
+    gat->add_option("--resolutions", gopt.resolutions, "Micro-buffer sides")->delimiter(',')->capture_default_str();
     CLI11_PARSE(app, argc, argv);
+    if (*gat) pbgi_gather_suite(gopt);
     if (*icc) irradiance_caching_suite(icopt);
     if (*pmc) photon_mapping_suite(pm);
     if (*bd) bidirectional_suite(b);

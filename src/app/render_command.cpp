@@ -96,9 +96,9 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
     app.add_option("--ic-records", o.ic_records, "ic: write an image of the cached light with the records as red dots (placeholders as for -o)");
     app.add_option("--pbgi-surfels", o.pbgi_surfels, "pbgi: about this many surfels over the scene's surfaces (default 8000)");
     app.add_option("--pbgi-cutoff", o.pbgi_cutoff,
-                   "pbgi: the solid angle (sr) above which a cluster is opened (default 0.03; 0: every surfel, brute force)");
+                   "pbgi: the solid angle (sr) above which a cluster is opened (default 0.05; 0: every surfel, brute force)");
     app.add_option("--pbgi-bounces", o.pbgi_bounces, "pbgi: surfel bounces (1: the surfels' direct light only; default 3)");
-    app.add_option("--pbgi-resolution", o.pbgi_resolution, "pbgi: the micro-buffer's side in pixels (default 12)");
+    app.add_option("--pbgi-resolution", o.pbgi_resolution, "pbgi: the micro-buffer's side in pixels (default 16)");
     app.add_option("--pbgi-direct-samples", o.pbgi_direct_samples, "pbgi: MIS pairs for each surfel side's direct light (default 16)");
     app.add_option("--pbgi-spacing", o.pbgi_spacing, "pbgi: pixels between the gathers at the first hits, interpolated between (default 2)");
     app.add_flag("-q,--quiet", o.quiet, "No progress line and no summary");

@@ -58,9 +58,9 @@ struct IntegratorOptions {
     // between the gathers at the camera's first hits.
     int pbgi_spacing = 2;
     int pbgi_surfels = 8000;
-    float pbgi_cutoff = 0.03f;
+    float pbgi_cutoff = 0.05f;
     int pbgi_bounces = 3;
-    int pbgi_resolution = 12;
+    int pbgi_resolution = 16;
     int pbgi_direct_samples = 16;
 };
 

@@ -46,8 +46,8 @@ void PointBasedGi::prepare(const RenderContext& ctx, const PassProgress& progres
         if (progress) progress(1.0 / levels);
         // Multiple bounces: every side gathers from the cloud as it was (Jacobi), then the
         // aggregates are remade. These gathers are coarser (the light of later bounces is
-        // smoother): a cutoff of at least 0.1 sr and an 8 x 8 micro-buffer.
-        const GatherSettings bounce_settings{std::max(settings_.cutoff, kBounceCutoff), std::min(settings_.resolution, 8)};
+        // smoother): a cutoff of at least 0.1 sr and at most a 12 x 12 micro-buffer.
+        const GatherSettings bounce_settings{std::max(settings_.cutoff, kBounceCutoff), std::min(settings_.resolution, 12)};
         for (int b = 1; b < bounces(); ++b) {
             std::vector<Surfel>& s = tree_.surfels();
             std::vector<Rgb> next(2 * s.size());
@@ -150,10 +150,10 @@ namespace {
 std::vector<ParamInfo> pbgi_params() {
     std::vector<ParamInfo> p = path_params();
     p.push_back({"surfels", ParamType::Integer, "8000", "about this many surfels over the scene's surfaces (--pbgi-surfels wins)"});
-    p.push_back({"cutoff", ParamType::Float, "0.03",
+    p.push_back({"cutoff", ParamType::Float, "0.05",
                  "solid angle (sr) above which a cluster is opened rather than used whole; 0: every surfel (--pbgi-cutoff wins)"});
     p.push_back({"bounces", ParamType::Integer, "3", "surfel bounces: 1 direct light only, each more one more reflection (--pbgi-bounces wins)"});
-    p.push_back({"buffer_resolution", ParamType::Integer, "12", "the micro-buffer's side in pixels (--pbgi-resolution wins)"});
+    p.push_back({"buffer_resolution", ParamType::Integer, "16", "the micro-buffer's side in pixels (--pbgi-resolution wins)"});
     p.push_back({"direct_samples", ParamType::Integer, "16", "MIS pairs per surfel side for its direct light (--pbgi-direct-samples wins)"});
     p.push_back({"gather_spacing", ParamType::Integer, "2", "pixels between the gathers at the first hits (--pbgi-spacing wins)"});
     return p;

@@ -44,8 +44,8 @@ struct SurfelTreeFaults {
 };
 
 struct GatherSettings {
-    float cutoff = 0.03f;  // solid angle (sr) above which a cluster is opened; 0: brute force
-    int resolution = 12;   // micro-buffer side (pixels)
+    float cutoff = 0.05f;  // solid angle (sr) above which a cluster is opened; 0: brute force
+    int resolution = 16;   // micro-buffer side (pixels)
 };
 
 struct GatherCounters {

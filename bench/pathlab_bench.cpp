@@ -9,12 +9,16 @@
 //   pathlab_bench pm       photons per second; hashed grid against k-d tree (build, query)
 //   pathlab_bench ic       irradiance caching and pbgi against pt-mis and bdpt at short budgets
 //   pathlab_bench pbgi-gather  pbgi's gather against a ray-traced truth per cutoff and micro-buffer
+//   pathlab_bench distributed  2 MPI ranks against 1 process, film reduction, checkpoints
+//   pathlab_bench lights   an environment map's cost per sample against the constant environment; spot and IES
 #include <CLI/CLI.hpp>
 
 #include "bidirectional.hpp"
+#include "distributed.hpp"
 #include "estimator_efficiency.hpp"
 #include "light_tracing.hpp"
 #include "irradiance_caching.hpp"
+#include "lights.hpp"
 #include "photon_mapping.hpp"
 #include "performance.hpp"
 
@@ -81,8 +85,34 @@ int main(int argc, char** argv) {
     gat->add_option("--surfels", gopt.surfels, "Surfels (about)")->capture_default_str();
     gat->add_option("--cutoffs", gopt.cutoffs, "Cutoff solid angles")->delimiter(',')->capture_default_str();
     gat->add_option("--resolutions", gopt.resolutions, "Micro-buffer sides")->delimiter(',')->capture_default_str();
+    LightsOptions lo;
+    CLI::App* lic = app.add_subcommand("lights", "An environment map's cost per sample against the constant environment; spot and IES");
+    lic->add_option("--size", lo.size, "Image width and height")->capture_default_str();
+    lic->add_option("--seconds", lo.seconds, "Seconds per timed render")->capture_default_str();
+    lic->add_option("--repeats", lo.repeats, "Interleaved rounds (median reported)")->capture_default_str();
+    lic->add_option("--scenes", lo.scenes, "Course scene indices with an environment")->delimiter(',')->capture_default_str();
+    lic->add_option("--map-width", lo.map_width, "Width of the constant environment map")->capture_default_str();
+    DistributedOptions dopt;
+    CLI::App* dist = app.add_subcommand("distributed", "2 MPI ranks against 1 process, film reduction, checkpoint write and size");
+    dist->add_option("--size", dopt.size, "Image width and height of the speedup renders")->capture_default_str();
+    dist->add_option("--spp", dopt.spp, "Their samples per pixel")->capture_default_str();
+    dist->add_option("--scene", dopt.scene, "Their scene")->capture_default_str();
+    dist->add_option("--repeats", dopt.repeats, "Timed runs per figure (median reported)")->capture_default_str();
+    dist->add_option("--film-sizes", dopt.film_sizes, "Film sizes reduced and checkpointed")->delimiter(',')->capture_default_str();
+    CLI::App* worker = app.add_subcommand("distributed-reduce-worker", "(run by `distributed` under mpirun)");
+    worker->group("");
+    worker->add_option("--film-sizes", dopt.film_sizes)->delimiter(',');
+    worker->add_option("--repeats", dopt.repeats);
+    // Under mpirun this program is one rank of the reduction benchmark.
+    std::vector<std::string> args(argv, argv + argc);
     CLI11_PARSE(app, argc, argv);
+    if (*worker) {
+        distributed_reduce_worker(dopt.film_sizes, dopt.repeats, argc, argv);
+        return 0;
+    }
     if (*gat) pbgi_gather_suite(gopt);
+    if (*dist) distributed_suite(dopt, args[0]);
+    if (*lic) lights_suite(lo);
     if (*icc) irradiance_caching_suite(icopt);
     if (*pmc) photon_mapping_suite(pm);
     if (*bd) bidirectional_suite(b);

@@ -1,26 +1,26 @@
 #!/usr/bin/env bash
 # Fuzzes pathlab's readers of untrusted files with libFuzzer (clang, AddressSanitizer, UBSan).
-#   scripts/fuzz.sh TARGET [SECONDS]   TARGET: scene_xml, exr, hdr, pfm, png, obj, or all
+#   scripts/fuzz.sh TARGET [SECONDS]   TARGET: scene_xml, exr, hdr, pfm, png, obj, ies, or all
 #                                      (all: each target in turn for SECONDS); default 660 s
 #   scripts/fuzz.sh [SECONDS]          the scene-file loader, as before (scene_xml)
-# Seeds: the shipped scenes and meshes, images and meshes written by fuzz_make_seeds (pathlab's
-# own writers and the libraries it links), and the regression corpora under tests/data/.
+# Seeds: the shipped scenes, meshes and IES files, images and meshes written by fuzz_make_seeds
+# (pathlab's own writers and the libraries it links), and the regression corpora under tests/data/.
 # Crashing or hanging inputs are written to build-fuzz/crashes/TARGET-*; once fixed, copy them
-# to tests/data/xml_regressions/, tests/data/image_regressions/ or tests/data/obj_regressions/,
-# where `make test` keeps loading them. Each run's log is build-fuzz/fuzz-TARGET.log and its
+# to tests/data/xml_regressions/, tests/data/image_regressions/, tests/data/obj_regressions/ or
+# tests/data/ies_regressions/, where `make test` keeps loading them. Each run's log is build-fuzz/fuzz-TARGET.log and its
 # figures (executions, exec/s, coverage) are summarised at the end.
 # On a shared machine run it as `nice -n 19 scripts/fuzz.sh ...`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-all_targets=(scene_xml exr hdr pfm png obj)
+all_targets=(scene_xml exr hdr pfm png obj ies)
 if [[ $# -eq 0 || $1 =~ ^[0-9]+$ ]]; then
     targets=(scene_xml)
     seconds=${1:-660}
 else
     case $1 in
         all) targets=("${all_targets[@]}") ;;
-        scene_xml | exr | hdr | pfm | png | obj) targets=("$1") ;;
+        scene_xml | exr | hdr | pfm | png | obj | ies) targets=("$1") ;;
         *) echo "fuzz.sh: unknown target '$1' (valid: ${all_targets[*]}, all)" >&2; exit 2 ;;
     esac
     seconds=${2:-660}
@@ -37,7 +37,7 @@ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=
     -DPATHLAB_BUILD_FUZZ=ON -DPATHLAB_BUILD_TESTS=OFF -DPATHLAB_BUILD_BENCH=OFF
 build_targets=()
 for t in "${targets[@]}"; do build_targets+=("fuzz_$t"); done
-[[ ${targets[*]} != scene_xml ]] && build_targets+=(fuzz_make_seeds)
+[[ ${targets[*]} != scene_xml && ${targets[*]} != ies ]] && build_targets+=(fuzz_make_seeds)
 cmake --build build-fuzz -j "$(nproc)" --target "${build_targets[@]}"
 mkdir -p build-fuzz/crashes
 
@@ -60,7 +60,7 @@ for t in "${targets[@]}"; do
         scene_xml)
             corpus=build-fuzz/corpus  # where the scene-file corpus has always been
             mkdir -p "$corpus"
-            cp -n scenes/*.xml tests/data/xml_regressions/* "$corpus"/ 2>/dev/null || true
+            cp -n scenes/*.xml tests/data/scenes/*.xml tests/data/scenes/mitsuba/*.xml tests/data/xml_regressions/* "$corpus"/ 2>/dev/null || true
             max_len=4096
             ;;
         obj)
@@ -72,6 +72,12 @@ for t in "${targets[@]}"; do
             make_seeds
             cp -n scenes/meshes/*.obj build-fuzz/seeds/obj/* "$corpus"/ 2>/dev/null || true
             cp -n tests/data/obj_regressions/* "$corpus"/ 2>/dev/null || true
+            ;;
+        ies)
+            corpus=build-fuzz/corpus-ies
+            mkdir -p "$corpus"
+            cp -n tests/data/ies/*.ies scenes/ies/*.ies "$corpus"/ 2>/dev/null || true
+            cp -n tests/data/ies_regressions/* "$corpus"/ 2>/dev/null || true
             ;;
         *)
             corpus=build-fuzz/corpus-$t

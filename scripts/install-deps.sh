@@ -9,7 +9,9 @@ packages=(
   build-essential cmake pkg-config
   libembree-dev libtbb-dev libopenexr-dev libstb-dev
   libcli11-dev libfmt-dev nlohmann-json3-dev libpugixml-dev libtinyobjloader-dev libnanoflann-dev
+  libassimp-dev zlib1g-dev
   libgtest-dev libbenchmark-dev
+  libopenmpi-dev openmpi-bin libxxhash-dev
   chromium
 )
 

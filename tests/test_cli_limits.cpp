@@ -108,7 +108,7 @@ TEST_F(CliLimits, AFilmTooLargeForMemoryFailsThatSceneOnly) {
                            "<shape type=\"rectangle\"/></scene>\n";
     const CliResult r = run({"-s", "0," + huge, "--spp", "1", "-q", "-o", path("{scene}.pfm")});
     EXPECT_EQ(r.code, 1) << r.err;
-    EXPECT_TRUE(contains(r.err, "a 32768x32768 render needs 104.0 GiB of memory")) << r.err;
+    EXPECT_TRUE(contains(r.err, "a 32768x32768 render needs 208.0 GiB of memory")) << r.err;
     EXPECT_TRUE(fs::exists(path("point-diffuse.pfm"))) << "the other scene must still render";
     EXPECT_FALSE(fs::exists(path("huge.pfm")));
     const CliResult c = run({"check", "-a", "1", "-s", "0,1", "--references", std::string(PATHLAB_SHARED_DIR) + "/npgr010-refs/direct",

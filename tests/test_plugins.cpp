@@ -48,8 +48,11 @@ TEST(Plugins, EveryDeclaredDefaultReadsAsItsType) {
 TEST(Plugins, EveryBsdfBuildsFromItsDefaults) {
     for (const BsdfPlugin& b : bsdf_plugins()) {
         const std::string type = b.info().type;
-        const std::string bsdf = type == "twosided" ? R"(<bsdf type="twosided"><bsdf type="diffuse"/></bsdf>)"
-                                                    : "<bsdf type=\"" + type + "\"/>";
+        // The wrappers need their nested BSDFs.
+        const std::string nested = type == "twosided" || type == "mask" ? R"(<bsdf type="diffuse"/>)"
+                                   : type == "blendbsdf"                 ? R"(<bsdf type="diffuse"/><bsdf type="conductor"/>)"
+                                                                         : "";
+        const std::string bsdf = "<bsdf type=\"" + type + "\">" + nested + "</bsdf>";
         EXPECT_NO_THROW(load_scene_text("<scene version=\"3\"><shape type=\"sphere\">" + bsdf + "</shape></scene>", "t.xml", "."))
             << type;
     }

@@ -305,9 +305,9 @@ TEST(SceneFileErrors, NameFileLineColumnAndTheProblem) {
         {"<scene version=\"3\"><shape type=\"sphere\">\n <float name=\"radiu\" value=\"1\"/></shape></scene>", 2, 2,
          "unsupported parameter 'radiu' for <shape type=\"sphere\">; supported: center, radius"},
         {"<scene version=\"3\"><shape type=\"sphere\"><ref id=\"nope\"/></shape></scene>", 1, 41, "no <bsdf> with id 'nope'"},
-        {"<scene version=\"3\"><bsdf type=\"blendbsdf\" id=\"p\"/><shape type=\"sphere\"/></scene>", 1, 20,
-         "unsupported bsdf type 'blendbsdf'; supported: diffuse, phong, conductor, roughconductor, dielectric, "
-         "roughdielectric, plastic, roughplastic, twosided"},
+        {"<scene version=\"3\"><bsdf type=\"hair\" id=\"p\"/><shape type=\"sphere\"/></scene>", 1, 20,
+         "unsupported bsdf type 'hair'; supported: diffuse, phong, conductor, roughconductor, dielectric, "
+         "roughdielectric, plastic, roughplastic, thindielectric, twosided, blendbsdf, mask"},
         {"<scene version=\"3\"><integrator type=\"volpath\"/><shape type=\"sphere\"/></scene>", 1, 20,
          "unsupported integrator type 'volpath'"},
         {"<scene version=\"3\"><shape type=\"sphere\"><float name=\"radius\" value=\"$r\"/></shape></scene>", 1, 41,

@@ -6,6 +6,7 @@
 
 #include "app/render_command.hpp"
 #include "app/tool_commands.hpp"
+#include "job/rank_group.hpp"
 #include "job/usage_error.hpp"
 #include "integrators/integrator.hpp"
 #include "scene/builtin_scenes.hpp"
@@ -38,7 +39,7 @@ void print_algorithms() {
 
 }  // namespace
 
-int run_cli(int argc, const char* const* argv) {
+int run_cli(int argc, const char* const* argv, RankGroup* ranks) {
     CLI::App app{"pathlab: a physically based Monte Carlo renderer and light-transport laboratory.\n"
                  "Renders the 8 NPGR010 Cornell-box scenes (or a scene file) with a chosen estimator."};
     app.set_version_flag("--version", PATHLAB_VERSION);
@@ -58,6 +59,8 @@ int run_cli(int argc, const char* const* argv) {
     CLI::App* check_cmd = add_check_command(app, check_opt);
     ReportOptions report_opt;
     CLI::App* report_cmd = add_report_command(app, report_opt);
+    MergeOptions merge_opt;
+    CLI::App* merge_cmd = add_merge_command(app, merge_opt);
 
     try {
         app.parse(argc, argv);
@@ -81,6 +84,9 @@ int run_cli(int argc, const char* const* argv) {
     }
 
     try {
+        if (ranks && ranks->size() > 1 && !app.get_subcommands().empty())
+            throw UsageError(fmt::format("only rendering runs across processes; start `pathlab {}` without mpirun",
+                                         app.get_subcommands().front()->get_name()));
         if (*scenes_cmd) {
             print_scenes();
             return 0;
@@ -97,7 +103,8 @@ int run_cli(int argc, const char* const* argv) {
         if (*reference_cmd) return run_reference_command(reference_opt);
         if (*check_cmd) return run_check_command(check_opt);
         if (*report_cmd) return run_report_command(report_opt);
-        return run_render_command(render_opt);
+        if (*merge_cmd) return run_merge_command(merge_opt);
+        return run_render_command(render_opt, ranks);
     } catch (const UsageError& e) {
         fmt::print(stderr, "pathlab: {}\n", e.what());
         return 2;

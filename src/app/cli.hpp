@@ -5,6 +5,10 @@
 
 namespace pathlab {
 
-int run_cli(int argc, const char* const* argv);
+class RankGroup;
+
+// `ranks`: the processes of an MPI job this one belongs to (app/main.cpp), null when alone. Only
+// the render command runs across processes; the others refuse to (exit code 2).
+int run_cli(int argc, const char* const* argv, RankGroup* ranks = nullptr);
 
 }  // namespace pathlab

@@ -5,6 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <filesystem>
 
 #include <fmt/format.h>
@@ -14,6 +15,9 @@
 #include "job/usage_error.hpp"
 #include "image/image_io.hpp"
 #include "job/output_paths.hpp"
+#include "job/checkpoint.hpp"
+#include "job/rank_group.hpp"
+#include "job/render_identity.hpp"
 #include "job/render_job.hpp"
 
 
@@ -23,7 +27,7 @@ namespace {
 constexpr int kDefaultSpp = 64;
 const char* const kDefaultOutputs[] = {"out/{index}-{scene}-{algorithm}.exr", "out/{index}-{scene}-{algorithm}.png"};
 
-void write_stats(const std::string& path, RenderJob& job, const RenderResult& r, int threads) {
+void write_stats(const std::string& path, RenderJob& job, const RenderResult& r, int threads, int rank_count) {
     const RenderStats& s = r.stats;
     const RenderSettings& rs = job.settings;
     nlohmann::json j = {
@@ -35,6 +39,13 @@ void write_stats(const std::string& path, RenderJob& job, const RenderResult& r,
         {"seed", rs.seed},
         {"sampler", rs.sampler == SamplerKind::Sobol ? "sobol" : "independent"},
         {"threads", threads},
+        {"processes", rank_count},
+        {"first_sample", s.passes.begin()},
+        {"passes", s.passes.to_string()},
+        {"resumed_spp", s.resumed_spp},
+        {"reduce_seconds", s.reduce_seconds},
+        {"checkpoints", s.checkpoints},
+        {"checkpoint_seconds", s.checkpoint_seconds},
         {"seconds", s.seconds},
         {"samples", s.samples},
         {"samples_per_second", s.seconds > 0 ? double(s.samples) / s.seconds : 0.0},
@@ -45,6 +56,12 @@ void write_stats(const std::string& path, RenderJob& job, const RenderResult& r,
         {"outputs", job.outputs},
     };
     for (const IntegratorStatistic& x : s.integrator) j["integrator"][x.name] = x.value;
+    for (const RankStats& k : s.ranks)
+        j["ranks"].push_back({{"name", k.name},
+                              {"spp", k.spp},
+                              {"seconds", k.seconds},
+                              {"samples_per_second", k.seconds > 0 ? double(k.spp) * double(r.film.pixel_count()) / k.seconds : 0.0},
+                              {"rays", k.rays}});
     write_text_file(path, j.dump(2) + "\n");
 }
 
@@ -101,10 +118,26 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
     app.add_option("--pbgi-resolution", o.pbgi_resolution, "pbgi: the micro-buffer's side in pixels (default 16)");
     app.add_option("--pbgi-direct-samples", o.pbgi_direct_samples, "pbgi: MIS pairs for each surfel side's direct light (default 16)");
     app.add_option("--pbgi-spacing", o.pbgi_spacing, "pbgi: pixels between the gathers at the first hits, interpolated between (default 2)");
+    app.add_option("--checkpoint", o.checkpoint,
+                   "Save the render's whole state to this file (atomically) every --checkpoint-every seconds, at the end and "
+                   "when interrupted, to continue it with --resume (placeholders as for -o)");
+    app.add_option("--checkpoint-every", o.checkpoint_every, "Seconds between checkpoints (0: only at the end and when interrupted)")
+        ->capture_default_str();
+    app.add_option("--resume", o.resume,
+                   "Continue the render saved in this checkpoint (same scene and settings; --spp may be raised); it goes on "
+                   "checkpointing to the same file unless --checkpoint says otherwise");
+    app.add_option("--first-sample", o.first_sample,
+                   "Index of the first sample (pass) to render: renders of disjoint ranges add up, with `pathlab merge`, to one render")
+        ->capture_default_str();
     app.add_flag("-q,--quiet", o.quiet, "No progress line and no summary");
 }
 
-int run_render_command(const RenderCommandOptions& o) {
+namespace {
+
+// The jobs of a render command, validated (UsageError on bad usage); `check_paths`: the outputs
+// are checked for writability (by the rank that writes them).
+std::vector<RenderJob> make_jobs(const RenderCommandOptions& o, bool check_paths, std::vector<std::string>& checkpoints,
+                                 std::vector<std::string>& resumes, bool distributed) {
     if (o.algorithm_given) integrator_or_usage_error(o.algorithm);
     SceneDefines defines;
     for (const std::string& d : o.defines) {
@@ -164,6 +197,9 @@ int run_render_command(const RenderCommandOptions& o) {
 
     std::vector<RenderJob> jobs;
     for (SceneChoice& choice : resolve_scenes(o.scene, defines)) jobs.emplace_back(std::move(choice), request);
+    for (RenderJob& job : jobs) job.settings.first_sample = o.first_sample;
+    if (!(o.checkpoint_every >= 0) || !std::isfinite(o.checkpoint_every))
+        throw UsageError("--checkpoint-every must be zero (only at the end) or a positive number of seconds");
 
     std::vector<std::string> patterns(o.outputs.begin(), o.outputs.end());
     if (patterns.empty()) patterns.assign(std::begin(kDefaultOutputs), std::end(kDefaultOutputs));
@@ -171,15 +207,41 @@ int run_render_command(const RenderCommandOptions& o) {
     OutputPaths paths;
     for (const RenderJob& job : jobs)
         if (!job.scene_choice().file.empty()) paths.input(job.scene_choice().file, "the scene file");
+    for (RenderJob& job : jobs) {
+        resumes.push_back(o.resume.empty() ? "" : job.expand(o.resume));
+        checkpoints.push_back(!o.checkpoint.empty() ? job.expand(o.checkpoint) : resumes.back());
+        if (!resumes.back().empty() && resumes.back() != checkpoints.back()) paths.input(resumes.back(), "--resume");
+    }
     for (size_t j = 0; j < jobs.size(); ++j) {
-        for (const std::string& p : patterns) jobs[j].outputs.push_back(jobs[j].expand(p));
+        // Notes of the scene loader: what it accepted and ignored, or changed.
+        if (!o.quiet)
+            for (const std::string& note : jobs[j].scene_choice().description.notes) fmt::print(stderr, "{}\n", note);
+        // Without -o, the scene file's hdrfilm file_format chooses the HDR output's format.
+        const std::string& format = jobs[j].scene_choice().description.file_format;
+        for (std::string p : patterns) {
+            if (o.outputs.empty() && p.ends_with(".exr") && format != "openexr")
+                p = p.substr(0, p.size() - 4) + (format == "rgbe" ? ".hdr" : ".pfm");
+            jobs[j].outputs.push_back(jobs[j].expand(p));
+        }
         for (size_t k = 0; k < j; ++k)
             for (const std::string& path : jobs[j].outputs)
                 if (std::find(jobs[k].outputs.begin(), jobs[k].outputs.end(), path) != jobs[k].outputs.end())
                     throw UsageError(fmt::format("scenes {} and {} would both write {}: add {{scene}} or {{index}} to -o",
                                                  jobs[k].scene_choice().name, jobs[j].scene_choice().name, path));
-        for (const std::string& path : jobs[j].outputs) paths.output(path, "the output", /*image=*/true);
-        if (!o.stats_path.empty()) paths.output(jobs[j].expand(o.stats_path), "--stats", /*image=*/false);
+        if (check_paths) {
+            for (const std::string& path : jobs[j].outputs) paths.output(path, "the output", /*image=*/true);
+            if (!o.stats_path.empty()) paths.output(jobs[j].expand(o.stats_path), "--stats", /*image=*/false);
+            if (!checkpoints[j].empty()) {
+                for (size_t k = 0; k < j; ++k)
+                    if (checkpoints[k] == checkpoints[j])
+                        throw UsageError(fmt::format("scenes {} and {} would both checkpoint to {}: add {{scene}} or {{index}} to it",
+                                                     jobs[k].scene_choice().name, jobs[j].scene_choice().name, checkpoints[j]));
+                if (resumes[j].empty() && std::filesystem::exists(checkpoints[j]))
+                    throw UsageError(fmt::format("{} exists: continue that render with --resume {}, or remove it first", checkpoints[j],
+                                                 checkpoints[j]));
+                paths.output(checkpoints[j], "--checkpoint", /*image=*/false);
+            }
+        }
         const std::string& algorithm = jobs[j].integrator_info().name;
         const auto one_of = [&algorithm](std::initializer_list<const char*> names) {
             for (const char* n : names)
@@ -216,14 +278,83 @@ int run_render_command(const RenderCommandOptions& o) {
             const std::string dir = jobs[j].expand(o.strategies_dir);
             paths.output((std::filesystem::path(dir) / "montage-weighted.png").string(), "--strategies", /*image=*/true);
             jobs[j].integrator_options().strategies_dir = dir;
+            if (distributed || !checkpoints[j].empty())
+                throw UsageError("--strategies keeps per-strategy images that checkpoints and processes do not carry; render them in "
+                                 "one process without --checkpoint and --resume");
         }
     }
+    return jobs;
+}
+
+// Messages agreed on by the ranks (RankGroup::agree), each line as pathlab prints errors.
+void print_messages(const std::string& messages) {
+    for (size_t a = 0; a < messages.size();) {
+        size_t b = messages.find('\n', a);
+        if (b == std::string::npos) b = messages.size();
+        // A message's continuation lines (indented) are printed as they are.
+        fmt::print(stderr, "{}{}\n", messages[a] == ' ' ? "" : "pathlab: ", messages.substr(a, b - a));
+        a = b + 1;
+    }
+}
+
+void print_summary(const RenderJob& job, const RenderStats& s) {
+    const std::string& name = job.scene_choice().name;
+    fmt::print(stderr, "{}: {} spp{} in {:.2f}s ({:.2f} Msamples/s, {:.2f} Mrays/s){}{} -> {}\n", name, s.spp,
+               s.resumed_spp ? fmt::format(" ({} resumed)", s.resumed_spp) : "", s.seconds,
+               s.seconds > 0 ? double(s.samples) / s.seconds * 1e-6 : 0.0, s.seconds > 0 ? double(s.rays) / s.seconds * 1e-6 : 0.0,
+               s.invalid_samples ? fmt::format(", {} NaN/Inf samples discarded", s.invalid_samples) : "",
+               s.integrator.empty() ? "" : fmt::format(", {}", fmt::join([&] {
+                   std::vector<std::string> parts;
+                   for (const IntegratorStatistic& x : s.integrator) parts.push_back(fmt::format("{} {:g}", x.name, x.value));
+                   return parts;
+               }(), ", ")),
+               fmt::join(job.outputs, ", "));
+    if (s.ranks.size() > 1) {
+        const double pixels = double(s.samples) / double(std::max<uint64_t>(1, s.spp - s.resumed_spp));
+        for (const RankStats& k : s.ranks)
+            fmt::print(stderr, "  {}: {} spp in {:.2f}s ({:.2f} Msamples/s)\n", k.name, k.spp, k.seconds,
+                       k.seconds > 0 ? double(k.spp) * pixels / k.seconds * 1e-6 : 0.0);
+        fmt::print(stderr, "  film reduction {:.3f}s\n", s.reduce_seconds);
+    }
+    if (s.checkpoints) fmt::print(stderr, "  {} checkpoint(s) written in {:.3f}s\n", s.checkpoints, s.checkpoint_seconds);
+}
+
+}  // namespace
+
+int run_render_command(const RenderCommandOptions& o, RankGroup* ranks) {
+    LocalRanks alone;
+    RankGroup& group = ranks ? *ranks : alone;
+    const bool root = group.root(), distributed = group.size() > 1;
+    // Everything that may fail before the renders, agreed on by the ranks (a rank that stopped
+    // alone would leave the others waiting).
+    std::vector<RenderJob> jobs;
+    std::vector<std::string> checkpoints, resumes;
+    {
+        int code = 0;
+        std::string message;
+        try {
+            jobs = make_jobs(o, root, checkpoints, resumes, distributed);
+        } catch (const UsageError& e) {
+            if (!distributed) throw;
+            code = 2, message = e.what();
+        } catch (const std::exception& e) {
+            if (!distributed) throw;
+            code = 1, message = fmt::format("error: {}", e.what());
+        }
+        std::string messages;
+        if (const int agreed = group.agree(code, message, &messages)) {
+            if (root) print_messages(messages);
+            return agreed;
+        }
+    }
+    std::string defines_text;
+    for (const std::string& d : o.defines) defines_text += " -D " + d;
 
     std::optional<tbb::global_control> thread_limit;
     if (o.threads != 0) thread_limit.emplace(tbb::global_control::max_allowed_parallelism, thread_count_or_cap(o.threads));
     const int threads = int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
 
-    const bool show_progress = !o.quiet && isatty(STDERR_FILENO);
+    const bool show_progress = root && !o.quiet && isatty(STDERR_FILENO);
 
     InterruptGuard interrupt;
     // A scene that fails (too large for memory, a full disk) is reported and the others still
@@ -233,38 +364,102 @@ int run_render_command(const RenderCommandOptions& o) {
         RenderJob& job = jobs[j];
         job.settings.progress = show_progress;
         job.settings.cancel = &InterruptGuard::flag();
+        job.settings.ranks = &group;
         const std::string& name = job.scene_choice().name;
         if (show_progress) fmt::print(stderr, "{} / {}\n", name, job.integrator_info().name);
+
+        // Every rank loads the scene from the same path and makes its film; the root takes up
+        // the checkpoint to resume.
         RenderResult result;
+        RenderIdentity identity;
+        std::string done_text;
+        double seconds_before = 0;
+        int width = 0, height = 0;
+        {
+            int code = 0;
+            std::string message;
+            try {
+                const Scene& scene = job.scene();
+                width = job.settings.width > 0 ? job.settings.width : scene.default_width();
+                height = job.settings.height > 0 ? job.settings.height : scene.default_height();
+                identity = render_identity(job, width, height, defines_text);
+                if (root && !resumes[j].empty()) {
+                    Checkpoint c = read_checkpoint(resumes[j]);
+                    const std::string diff = c.info.identity.differences(identity, kIdentityFields, "the checkpoint", "this render");
+                    if (!diff.empty())
+                        throw CheckpointError(fmt::format("{} is a checkpoint of another render; they differ in\n{}", resumes[j], diff));
+                    const uint64_t first = job.settings.first_sample;
+                    if (job.settings.spp > 0 && !PassSet::range(first, first + job.settings.spp).contains(c.info.passes))
+                        throw CheckpointError(fmt::format("{} holds passes {}, more than this render's {} (raise --spp to continue it)",
+                                                          resumes[j], c.info.passes.to_string(),
+                                                          PassSet::range(first, first + job.settings.spp).to_string()));
+                    if (c.info.passes.begin() < first)
+                        throw CheckpointError(fmt::format("{} holds passes {}, before --first-sample {}", resumes[j], c.info.passes.to_string(), first));
+                    result.film = std::move(c.film);
+                    done_text = c.info.passes.to_string();
+                    seconds_before = c.info.seconds;
+                } else {
+                    result.film = make_film(width, height);
+                }
+            } catch (const UsageError& e) {
+                code = 2, message = e.what();
+            } catch (const CheckpointError& e) {
+                code = 2, message = e.what();
+            } catch (const std::exception& e) {
+                code = 1, message = fmt::format("error: {}: {}", name, e.what());
+            }
+            std::string messages;
+            code = group.agree(code, message, &messages);
+            if (code == 2) {
+                if (root) print_messages(messages);
+                return 2;
+            }
+            if (code) {
+                if (root) print_messages(messages);
+                ++failed;
+                continue;
+            }
+        }
+        group.broadcast_text(done_text);
+        job.settings.done = *PassSet::parse(done_text);
+        if (!checkpoints[j].empty()) {
+            job.settings.checkpoint_every = o.checkpoint_every;
+            job.settings.checkpoint = [&, j](RankGroup& parts, const Film& film, const PassSet& done, const RenderStats& st) {
+                const CheckpointInfo info{identity, done, width, height, seconds_before + st.seconds, PATHLAB_VERSION};
+                try {
+                    write_checkpoint(checkpoints[j], parts, film, info);
+                } catch (const std::exception& e) {
+                    // The render goes on; the file keeps the last complete checkpoint.
+                    fmt::print(stderr, "pathlab: warning: {}: checkpoint not written: {}\n", name, e.what());
+                }
+            };
+        }
         try {
-            result = job.run();
-            job.write_outputs(result, o.exposure);
-            if (!o.stats_path.empty()) write_stats(job.expand(o.stats_path), job, result, threads);
-        } catch (const UsageError&) {
-            throw;
+            result.stats = job.run_into(result.film);
         } catch (const std::exception& e) {
-            fmt::print(stderr, "pathlab: error: {}: {}\n", name, e.what());
+            fmt::print(stderr, "pathlab: error: {}{}: {}\n", distributed ? group.name() + ": " : "", name, e.what());
+            if (distributed) group.abort(1);
             ++failed;
             continue;
         }
         const RenderStats& s = result.stats;
-        if (!o.quiet)
-            fmt::print(stderr, "{}: {} spp in {:.2f}s ({:.2f} Msamples/s, {:.2f} Mrays/s){}{} -> {}\n", name, s.spp,
-                       s.seconds, s.seconds > 0 ? double(s.samples) / s.seconds * 1e-6 : 0.0,
-                       s.seconds > 0 ? double(s.rays) / s.seconds * 1e-6 : 0.0,
-                       s.invalid_samples ? fmt::format(", {} NaN/Inf samples discarded", s.invalid_samples) : "",
-                       s.integrator.empty() ? "" : fmt::format(", {}", fmt::join([&] {
-                           std::vector<std::string> parts;
-                           for (const IntegratorStatistic& x : s.integrator) parts.push_back(fmt::format("{} {:g}", x.name, x.value));
-                           return parts;
-                       }(), ", ")),
-                       fmt::join(job.outputs, ", "));
+        if (root) {
+            try {
+                job.write_outputs(result, o.exposure, render_metadata(identity, s.passes, s.invalid_samples));
+                if (!o.stats_path.empty()) write_stats(job.expand(o.stats_path), job, result, threads, group.size());
+            } catch (const std::exception& e) {
+                fmt::print(stderr, "pathlab: error: {}: {}\n", name, e.what());
+                ++failed;
+                continue;
+            }
+            if (!o.quiet) print_summary(job, s);
+        }
         if (s.interrupted) {
-            if (j + 1 < jobs.size()) fmt::print(stderr, "pathlab: interrupted; {} scene(s) not rendered\n", jobs.size() - j - 1);
+            if (root && j + 1 < jobs.size()) fmt::print(stderr, "pathlab: interrupted; {} scene(s) not rendered\n", jobs.size() - j - 1);
             return interrupted_exit_code();
         }
     }
-    if (failed && jobs.size() > 1) fmt::print(stderr, "pathlab: {} of {} scenes failed\n", failed, jobs.size());
+    if (root && failed && jobs.size() > 1) fmt::print(stderr, "pathlab: {} of {} scenes failed\n", failed, jobs.size());
     return failed ? 1 : 0;
 }
 

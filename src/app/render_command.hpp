@@ -47,10 +47,18 @@ struct RenderCommandOptions {
     std::optional<int> pbgi_resolution;
     std::optional<int> pbgi_direct_samples;
     std::optional<int> pbgi_spacing;
+    std::string checkpoint;          // --checkpoint FILE
+    double checkpoint_every = 300;   // --checkpoint-every SECONDS
+    std::string resume;              // --resume FILE
+    uint64_t first_sample = 0;       // --first-sample N
 };
 
+class RankGroup;
+
 void add_render_options(CLI::App& app, RenderCommandOptions& opt);
-// Validates the options (exit code 2 on bad usage) and runs the renders.
-int run_render_command(const RenderCommandOptions& opt);
+// Validates the options (exit code 2 on bad usage) and runs the renders; `ranks` (null: this
+// process alone) are the processes of an MPI job rendering each image together, of which rank 0
+// writes the outputs, the checkpoints and the summary.
+int run_render_command(const RenderCommandOptions& opt, RankGroup* ranks = nullptr);
 
 }  // namespace pathlab

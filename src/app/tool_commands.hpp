@@ -75,5 +75,15 @@ struct ReportOptions {
 CLI::App* add_report_command(CLI::App& app, ReportOptions& o);
 int run_report_command(const ReportOptions& o);
 
+// `pathlab merge OUT.exr IN...`: one image from renders of the same scene and settings with
+// disjoint passes or different seeds (app/merge_command.cpp).
+struct MergeOptions {
+    std::string output;
+    std::vector<std::string> inputs;
+    bool quiet = false;
+};
+CLI::App* add_merge_command(CLI::App& app, MergeOptions& o);
+int run_merge_command(const MergeOptions& o);
+
 
 }  // namespace pathlab

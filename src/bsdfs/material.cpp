@@ -2,6 +2,49 @@
 
 namespace pathlab {
 
+// The composite models (blendbsdf, mask) out of line: they call Material back, and inlined
+// into the dispatch they would make every caller of it larger (pt-mis's hot loop).
+Rgb BlendMaterial::eval(const Vec3f& wi, const Vec3f& wo) const {
+    return first->eval(wi, wo) * (1 - weight) + second->eval(wi, wo) * weight;
+}
+float BlendMaterial::pdf(const Vec3f& wi, const Vec3f& wo) const {
+    return (1 - weight) * first->pdf(wi, wo) + weight * second->pdf(wi, wo);
+}
+std::optional<BsdfSample> BlendMaterial::sample(const Vec3f& wi, Vec2f u) const {
+    const bool pick_second = u.x < weight;
+    const float p = pick_second ? weight : 1 - weight;
+    u.x = pick_second ? u.x / weight : (u.x - weight) / (1 - weight);
+    u.x = std::min(u.x, 0.99999994f);
+    std::optional<BsdfSample> s = (pick_second ? second : first)->sample(wi, u);
+    if (!s) return s;
+    if (s->delta) {
+        s->f *= p;
+        s->pdfW *= p;
+    } else {
+        s->f = eval(wi, s->wo);
+        s->pdfW = pdf(wi, s->wo);
+        if (!(s->pdfW > 0)) return std::nullopt;
+    }
+    return s;
+}
+
+Rgb MaskMaterial::eval(const Vec3f& wi, const Vec3f& wo) const { return inner->eval(wi, wo) * opacity; }
+float MaskMaterial::pdf(const Vec3f& wi, const Vec3f& wo) const { return opacity * inner->pdf(wi, wo); }
+std::optional<BsdfSample> MaskMaterial::sample(const Vec3f& wi, Vec2f u) const {
+    if (u.x >= opacity) {
+        const float c = std::abs(wi.z);
+        if (!(c > 0)) return std::nullopt;
+        return BsdfSample{-wi, Rgb((1 - opacity) / c), 1 - opacity, true, kLobeSpecular | kLobeTransmission};
+    }
+    u.x = std::min(u.x / opacity, 0.99999994f);
+    std::optional<BsdfSample> s = inner->sample(wi, u);
+    if (!s) return s;
+    s->f *= opacity;
+    s->pdfW *= opacity;
+    return s;
+}
+
+
 std::optional<BsdfSample> Material::sample_adjusted(const BsdfContext& ctx, const Vec3f& wi, const Vec2f& u) const {
     std::optional<BsdfSample> s = sample(wi, u);
     if (!s) return s;

@@ -13,6 +13,7 @@
 // without a context are the plain radiance-mode models.
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <variant>
 
@@ -25,18 +26,47 @@
 #include "bsdfs/roughconductor.hpp"
 #include "bsdfs/roughdielectric.hpp"
 #include "bsdfs/roughplastic.hpp"
+#include "bsdfs/thindielectric.hpp"
 
 namespace pathlab {
 
+struct Material;
+
+// blendbsdf: (1 - weight) * first + weight * second (Mitsuba's blendbsdf with a constant
+// weight; a texture weight needs textures). Sampling picks a BSDF with probability 1 - weight
+// or weight; eval and pdf mix both (their non-delta lobes), a delta sample keeps its own
+// coefficient times the choice's probability (bsdf_sample.hpp).
+struct BlendMaterial {
+    std::shared_ptr<const Material> first, second;
+    float weight = 0.5f;  // of `second`
+
+    Rgb eval(const Vec3f& wi, const Vec3f& wo) const;
+    float pdf(const Vec3f& wi, const Vec3f& wo) const;
+    std::optional<BsdfSample> sample(const Vec3f& wi, Vec2f u) const;
+};
+
+// mask: opacity * the nested BSDF, and with probability 1 - opacity the path goes straight
+// through (a Dirac delta along -wi of coefficient 1 - opacity, on either side). A constant
+// opacity (a texture needs textures).
+struct MaskMaterial {
+    std::shared_ptr<const Material> inner;
+    float opacity = 0.5f;
+
+    Rgb eval(const Vec3f& wi, const Vec3f& wo) const;
+    float pdf(const Vec3f& wi, const Vec3f& wo) const;
+    std::optional<BsdfSample> sample(const Vec3f& wi, Vec2f u) const;
+};
+
 // One BSDF per header (parameters and defaults documented at the top of each).
 using MaterialModel = std::variant<PhongMaterial, ConductorMaterial, DielectricMaterial, RoughConductorMaterial,
-                                   RoughDielectricMaterial, PlasticMaterial, RoughPlasticMaterial>;
+                                   RoughDielectricMaterial, PlasticMaterial, RoughPlasticMaterial, ThinDielectricMaterial,
+                                   BlendMaterial, MaskMaterial>;
 
 // std::visit, as a switch that the compiler always inlines: the hot loop calls sample() at
 // several places, and an out-of-line dispatch there cost about 3% of pt-mis's time.
 template <typename F>
 [[gnu::always_inline]] inline decltype(auto) visit_model(const MaterialModel& model, F&& f) {
-    static_assert(std::variant_size_v<MaterialModel> == 7, "add the new model's case below");
+    static_assert(std::variant_size_v<MaterialModel> == 10, "add the new model's case below");
     switch (model.index()) {
         case 0: return f(*std::get_if<0>(&model));
         case 1: return f(*std::get_if<1>(&model));
@@ -44,7 +74,10 @@ template <typename F>
         case 3: return f(*std::get_if<3>(&model));
         case 4: return f(*std::get_if<4>(&model));
         case 5: return f(*std::get_if<5>(&model));
-        default: return f(*std::get_if<6>(&model));
+        case 6: return f(*std::get_if<6>(&model));
+        case 7: return f(*std::get_if<7>(&model));
+        case 8: return f(*std::get_if<8>(&model));
+        default: return f(*std::get_if<9>(&model));
     }
 }
 
@@ -54,25 +87,26 @@ struct Material {
     // to face the incoming direction); one-sided ones are black from behind. A dielectric
     // is neither: both of its sides are meaningful, and its frame is never flipped.
     bool two_sided = true;
+    // twosided with two BSDFs: the index (in the scene's materials) of the one for the back,
+    // used with the frame flipped as for the front; -1: the same material on both sides.
+    int32_t back = -1;
 
     Rgb eval(const Vec3f& wi, const Vec3f& wo) const {
-        return std::visit([&](const auto& m) { return m.eval(wi, wo); }, model);
+        return visit_model(model, [&](const auto& m) { return m.eval(wi, wo); });
     }
     float pdf(const Vec3f& wi, const Vec3f& wo) const {
-        return std::visit([&](const auto& m) { return m.pdf(wi, wo); }, model);
+        return visit_model(model, [&](const auto& m) { return m.pdf(wi, wo); });
     }
     // eval() and pdf() together, for models that can share work between them.
     Rgb eval_and_pdf(const Vec3f& wi, const Vec3f& wo, float& pdf) const {
-        return std::visit(
-            [&](const auto& m) {
-                if constexpr (requires { m.eval_and_pdf(wi, wo, pdf); }) {
-                    return m.eval_and_pdf(wi, wo, pdf);
-                } else {
-                    pdf = m.pdf(wi, wo);
-                    return m.eval(wi, wo);
-                }
-            },
-            model);
+        return visit_model(model, [&](const auto& m) {
+            if constexpr (requires { m.eval_and_pdf(wi, wo, pdf); }) {
+                return m.eval_and_pdf(wi, wo, pdf);
+            } else {
+                pdf = m.pdf(wi, wo);
+                return m.eval(wi, wo);
+            }
+        });
     }
     [[gnu::always_inline]] std::optional<BsdfSample> sample(const Vec3f& wi, const Vec2f& u) const {
         return visit_model(model, [&](const auto& m) { return m.sample(wi, u); });
@@ -110,7 +144,10 @@ struct Material {
     // True when every lobe is a Dirac delta: light sampling cannot contribute there (eval()
     // is zero everywhere). Materials that mix delta and non-delta lobes (plastic) are not.
     bool is_delta() const {
-        return std::holds_alternative<ConductorMaterial>(model) || std::holds_alternative<DielectricMaterial>(model);
+        if (const auto* b = std::get_if<BlendMaterial>(&model)) return b->first->is_delta() && b->second->is_delta();
+        if (const auto* m = std::get_if<MaskMaterial>(&model)) return m->inner->is_delta();
+        return std::holds_alternative<ConductorMaterial>(model) || std::holds_alternative<DielectricMaterial>(model) ||
+               std::holds_alternative<ThinDielectricMaterial>(model);
     }
     // True for materials that transmit (both sides matter: never flipped, never twosided).
     bool is_dielectric() const {
@@ -136,7 +173,22 @@ private:
     static uint32_t lobes_of(const RoughDielectricMaterial&) { return kLobeGlossy | kLobeReflection | kLobeTransmission; }
     static uint32_t lobes_of(const PlasticMaterial&) { return kLobeDiffuse | kLobeSpecular | kLobeReflection; }
     static uint32_t lobes_of(const RoughPlasticMaterial&) { return kLobeDiffuse | kLobeGlossy | kLobeReflection; }
+    static uint32_t lobes_of(const ThinDielectricMaterial&) { return kLobeSpecular | kLobeReflection | kLobeTransmission; }
+    static uint32_t lobes_of(const BlendMaterial& m) { return m.first->lobes() | m.second->lobes(); }
+    static uint32_t lobes_of(const MaskMaterial& m) { return m.inner->lobes() | kLobeSpecular | kLobeTransmission; }
 };
+
+// The diffuse reflectance (Mitsuba's aov "albedo"): Lambertian and Phong's rho_d, a coated
+// base's rho, mixtures of them; 0 for purely glossy or specular materials.
+inline Rgb diffuse_albedo(const Material& m) {
+    if (const auto* p = std::get_if<PhongMaterial>(&m.model)) return p->diffuse;
+    if (const auto* p = std::get_if<PlasticMaterial>(&m.model)) return p->coat.diffuse_reflectance;
+    if (const auto* p = std::get_if<RoughPlasticMaterial>(&m.model)) return p->coat.diffuse_reflectance;
+    if (const auto* b = std::get_if<BlendMaterial>(&m.model))
+        return diffuse_albedo(*b->first) * (1 - b->weight) + diffuse_albedo(*b->second) * b->weight;
+    if (const auto* k = std::get_if<MaskMaterial>(&m.model)) return diffuse_albedo(*k->inner) * k->opacity;
+    return Rgb(0.0f);
+}
 
 inline Material make_phong(const Rgb& diffuse, const Rgb& specular = Rgb(0.0f), float exponent = 1) {
     return Material{PhongMaterial{diffuse, specular, exponent}};

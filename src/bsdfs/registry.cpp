@@ -16,8 +16,22 @@ Material one_sided(Properties& p) {
 
 const PluginInfo& twosided_plugin() {
     static const PluginInfo info{"bsdf", "twosided",
-                                 "shades the back of a surface like its front; wraps exactly one nested BSDF (not a dielectric)",
+                                 "shades the back of a surface like its front (one nested BSDF), or with a second nested BSDF (front, back); not dielectrics",
                                  {}};
+    return info;
+}
+
+const PluginInfo& blendbsdf_plugin() {
+    static const PluginInfo info{"bsdf", "blendbsdf",
+                                 "(1 - weight) first + weight second: wraps exactly two nested BSDFs (<bsdf> or <ref>, not dielectrics)",
+                                 {{"weight", ParamType::Float, "0.5", "the second BSDF's share, 0 to 1 (a <texture> needs textures: refused)"}}};
+    return info;
+}
+
+const PluginInfo& mask_plugin() {
+    static const PluginInfo info{"bsdf", "mask",
+                                 "opacity * the nested BSDF; the rest passes straight through (cut-outs such as leaves): wraps one BSDF",
+                                 {{"opacity", ParamType::Float, "0.5", "0 (invisible) to 1 (opaque) (a <texture> needs textures: refused)"}}};
     return info;
 }
 
@@ -31,7 +45,10 @@ const std::vector<BsdfPlugin>& bsdf_plugins() {
         {roughdielectric_plugin, one_sided<RoughDielectricMaterial, read_roughdielectric>},
         {plastic_plugin, one_sided<PlasticMaterial, read_plastic>},
         {roughplastic_plugin, one_sided<RoughPlasticMaterial, read_roughplastic>},
+        {thindielectric_plugin, [](Properties& p) { return Material{read_thindielectric(p), true}; }},
         {twosided_plugin, nullptr},
+        {blendbsdf_plugin, nullptr},
+        {mask_plugin, nullptr},
     };
     return table;
 }

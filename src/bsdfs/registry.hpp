@@ -23,5 +23,8 @@ const std::vector<BsdfPlugin>& bsdf_plugins();
 const BsdfPlugin* find_bsdf_plugin(const std::string& type);
 std::string bsdf_type_names();  // "diffuse, phong, ..." for error messages
 const PluginInfo& twosided_plugin();
+// The wrappers that the scene-file reader builds from their nested BSDFs (read is null).
+const PluginInfo& blendbsdf_plugin();
+const PluginInfo& mask_plugin();
 
 }  // namespace pathlab

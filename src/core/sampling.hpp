@@ -39,6 +39,16 @@ inline Vec3f square_to_uniform_hemisphere(const Vec2f& u) {
 }
 inline float uniform_hemisphere_pdf(const Vec3f& w) { return w.z > 0 ? 1.0f / (2.0f * kPi) : 0.0f; }
 
+// Directions uniformly inside the cone of half-angle acos(cos_max) around +z:
+// pdfW = 1 / (2 pi (1 - cos_max)).
+inline Vec3f square_to_uniform_cone(const Vec2f& u, float cos_max) {
+    const float z = 1.0f - u.x * (1.0f - cos_max);
+    const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+    const float phi = 2.0f * kPi * u.y;
+    return {r * std::cos(phi), r * std::sin(phi), z};
+}
+inline float uniform_cone_pdf(float cos_max) { return 1.0f / (2.0f * kPi * (1.0f - cos_max)); }
+
 // Malley's method: project the concentric disk up to the hemisphere. pdfW = cos(theta) / pi.
 inline Vec3f square_to_cosine_hemisphere(const Vec2f& u) {
     const Vec2f d = square_to_concentric_disk(u);

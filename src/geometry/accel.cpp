@@ -107,8 +107,53 @@ Accel::Accel() {
 }
 
 Accel::~Accel() {
+    for (RTCScene g : groups_) rtcReleaseScene(g);
     if (scene_) rtcReleaseScene(scene_);
     if (device_) rtcReleaseDevice(device_);
+}
+
+namespace {
+
+RTCGeometry mesh_geometry(RTCDevice device_, const MeshDesc& mesh) {
+    RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                          3 * sizeof(float), mesh.positions.size()));
+    std::memcpy(v, mesh.positions.data(), mesh.positions.size() * sizeof(Vec3f));
+    auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                               3 * sizeof(uint32_t), mesh.triangles.size()));
+    std::memcpy(idx, mesh.triangles.data(), mesh.triangles.size() * 3 * sizeof(uint32_t));
+    rtcCommitGeometry(geom);
+    return geom;
+}
+
+}  // namespace
+
+uint32_t Accel::add_group(const std::vector<MeshDesc>& meshes) {
+    RTCScene group = rtcNewScene(device_);
+    rtcSetSceneFlags(group, RTC_SCENE_FLAG_ROBUST);
+    groups_.push_back(group);
+    for (const MeshDesc& m : meshes) {
+        RTCGeometry geom = mesh_geometry(device_, m);
+        rtcAttachGeometry(group, geom);
+        rtcReleaseGeometry(geom);
+    }
+    rtcCommitScene(group);
+    throw_on_device_error(device_, "build a shapegroup");
+    return uint32_t(groups_.size() - 1);
+}
+
+uint32_t Accel::add_instance(uint32_t group, const Transform& t) {
+    RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_INSTANCE);
+    rtcSetGeometryInstancedScene(geom, groups_.at(group));
+    float m[12];  // 3x4, row major
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 4; ++j) m[i * 4 + j] = float(t.m[size_t(i)][size_t(j)]);
+    rtcSetGeometryTransform(geom, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, m);
+    rtcCommitGeometry(geom);
+    const uint32_t id = rtcAttachGeometry(scene_, geom);
+    rtcReleaseGeometry(geom);
+    throw_on_device_error(device_, "add an instance");
+    return id;
 }
 
 uint32_t Accel::add_mesh(const MeshDesc& mesh) {
@@ -154,7 +199,7 @@ bool Accel::intersect(const Ray& ray, RawHit& hit) const {
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(scene_, &context, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
-    hit = RawHit{rh.ray.tfar, rh.hit.u, rh.hit.v, rh.hit.geomID, rh.hit.primID};
+    hit = RawHit{rh.ray.tfar, rh.hit.u, rh.hit.v, rh.hit.geomID, rh.hit.primID, rh.hit.instID[0]};
     return true;
 }
 

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "geometry/ray.hpp"
+#include "core/transform.hpp"
 #include "geometry/shape.hpp"
 
 struct RTCDeviceTy;
@@ -18,6 +19,8 @@ struct RawHit {
     float t;
     float u, v;  // barycentrics of vertices 1 and 2 (triangles)
     uint32_t geom_id, prim_id;
+    uint32_t inst_id = kNoInstance;  // the instance hit (geom_id is then the mesh's id in its group)
+    static constexpr uint32_t kNoInstance = 0xffffffffu;
 };
 
 class Accel {
@@ -30,6 +33,10 @@ public:
     // Each returns the Embree geometry id.
     uint32_t add_mesh(const MeshDesc& mesh);
     uint32_t add_sphere(const SphereDesc& sphere);
+    // A group of meshes for instances (its own Embree scene, committed here); returns its index.
+    uint32_t add_group(const std::vector<MeshDesc>& meshes);
+    // An instance of group `group`; returns its Embree geometry id (which hits report as inst_id).
+    uint32_t add_instance(uint32_t group, const Transform& to_world);
     void commit();
 
     bool intersect(const Ray& ray, RawHit& hit) const;
@@ -42,6 +49,7 @@ private:
     RTCDeviceTy* device_ = nullptr;
     RTCSceneTy* scene_ = nullptr;
     std::vector<std::unique_ptr<SphereDesc>> spheres_;  // stable addresses for Embree callbacks
+    std::vector<RTCSceneTy*> groups_;
 };
 
 }  // namespace pathlab

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "core/transform.hpp"
 #include "core/vec.hpp"
 
 namespace pathlab {
@@ -27,6 +28,18 @@ struct SphereDesc {
     uint32_t material = 0;
     bool flip_normals = false;  // normals point inwards
     Rgb emission{0.0f};         // radiance of a one-sided area emitter on the normal side
+};
+
+// A shapegroup: meshes that instances place, each instance by its own transform (Embree
+// instancing: the group's triangles are stored once).
+struct ShapeGroupDesc {
+    std::string name;
+    std::vector<MeshDesc> meshes;  // in the group's space; their materials are the scene's
+};
+
+struct InstanceDesc {
+    uint32_t group = 0;
+    Transform to_world;
 };
 
 }  // namespace pathlab

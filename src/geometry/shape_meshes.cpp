@@ -45,6 +45,24 @@ MeshDesc disk_mesh(int segments) {
     return m;
 }
 
+MeshDesc cylinder_mesh(int segments) {
+    MeshDesc m;
+    for (int i = 0; i < segments; ++i) {
+        const double phi = 2 * 3.14159265358979323846 * i / segments;
+        const Vec3f c(float(std::cos(phi)), float(std::sin(phi)), 0);
+        m.positions.push_back(c);
+        m.positions.push_back({c.x, c.y, 1});
+        m.normals.push_back(c);
+        m.normals.push_back(c);
+    }
+    for (int i = 0; i < segments; ++i) {
+        const uint32_t a = uint32_t(2 * i), b = uint32_t(2 * ((i + 1) % segments));
+        m.triangles.push_back({a, b, b + 1});  // counter-clockwise seen from outside
+        m.triangles.push_back({b + 1, a + 1, a});
+    }
+    return m;
+}
+
 namespace {
 
 // Two inputs on which tinyobjloader 2.0.0rc10 has undefined behaviour (found by fuzz_obj):

@@ -18,6 +18,8 @@ MeshDesc cube_mesh();       // [-1,1]^3, outward normals
 // The unit disk in the z = 0 plane, normal +z, as a fan of `segments` triangles; its area is
 // (segments / 2) sin(2 pi / segments), 0.04% short of pi with the default 128.
 MeshDesc disk_mesh(int segments = 128);
+// The open unit tube (radius 1, z from 0 to 1) as `segments` flat sides with radial vertex normals.
+MeshDesc cylinder_mesh(int segments = 128);
 
 // Triangulated OBJ (tinyobjloader). Vertex normals are kept when every face has them;
 // throws MeshLoadError naming the file for a missing file, a parse error, no faces, or a

@@ -16,6 +16,13 @@ namespace pathlab {
 struct ShapeContext {
     std::string base_dir = ".";  // relative file names are resolved against it
     bool allow_files = true;     // false: shapes that read files are an error (the fuzzer)
+    // Where else relative file names are searched, in order (the scene file's folder and its
+    // <path> folders); base_dir when empty.
+    std::vector<std::string> search_dirs = {};
+
+    // A relative file name: the first of search_dirs (or base_dir) where it exists, else its
+    // place in the first, so that the error names a path.
+    std::string resolve(const std::string& name) const;
 };
 
 using ShapeDesc = std::variant<MeshDesc, SphereDesc>;

@@ -7,6 +7,7 @@
 #include <ImfIO.h>
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
+#include <ImfStringAttribute.h>
 #include <stb_image_write.h>
 
 #include <algorithm>
@@ -18,6 +19,7 @@
 #include <cstring>
 #include <filesystem>
 #include <map>
+#include <set>
 #include <string_view>
 #include <vector>
 
@@ -69,16 +71,31 @@ private:
     io::FdWriter& w_;
 };
 
-void write_exr(const Image& img, io::FdWriter& out, const std::string& name) {
+void write_exr(const Image& img, io::FdWriter& out, const std::string& name, const ExrExtras& extras = {}) {
     try {
         Imf::Header header(img.width(), img.height());
-        for (const char* c : {"R", "G", "B"}) header.channels().insert(c, Imf::Channel(Imf::FLOAT));
         Imf::FrameBuffer fb;
-        auto* base = const_cast<char*>(reinterpret_cast<const char*>(img.data()));
         const size_t xs = sizeof(Rgb), ys = sizeof(Rgb) * size_t(img.width());
-        fb.insert("R", Imf::Slice(Imf::FLOAT, base + 0 * sizeof(float), xs, ys));
-        fb.insert("G", Imf::Slice(Imf::FLOAT, base + 1 * sizeof(float), xs, ys));
-        fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
+        const auto insert = [&](const Image& layer, const std::string& prefix) {
+            if (layer.width() != img.width() || layer.height() != img.height())
+                throw ImageIoError(fmt::format("{}: the layer '{}' has another size than the image", name, prefix));
+            auto* base = const_cast<char*>(reinterpret_cast<const char*>(layer.data()));
+            const char* names[3] = {"R", "G", "B"};
+            for (int c = 0; c < 3; ++c) {
+                const std::string channel = prefix.empty() ? names[c] : prefix + "." + names[c];
+                header.channels().insert(channel, Imf::Channel(Imf::FLOAT));
+                fb.insert(channel, Imf::Slice(Imf::FLOAT, base + size_t(c) * sizeof(float), xs, ys));
+            }
+        };
+        insert(img, "");
+        for (const auto& [layer, image] : extras.layers) insert(image, layer);
+        for (const ExrChannel& c : extras.channels) {
+            if (c.values.size() != img.pixel_count()) throw ImageIoError(fmt::format("{}: channel {} has the wrong size", name, c.name));
+            header.channels().insert(c.name, Imf::Channel(Imf::FLOAT));
+            fb.insert(c.name, Imf::Slice(Imf::FLOAT, const_cast<char*>(reinterpret_cast<const char*>(c.values.data())), sizeof(float),
+                                         sizeof(float) * size_t(img.width())));
+        }
+        for (const auto& [key, value] : extras.attributes) header.insert(key, Imf::StringAttribute(value));
         ExrOutput stream(out, name);
         Imf::OutputFile file(stream, header);
         struct Quiet {  // destroyed before `file`, on every path
@@ -330,7 +347,7 @@ ExrLayout scan_exr_header(const io::ByteSource& src, const ImageReadLimits& limi
     return layout;
 }
 
-Image read_exr(const io::ByteSource& src, const ImageReadLimits& limits) {
+Image read_exr(const io::ByteSource& src, const ImageReadLimits& limits, ExrExtras* extras = nullptr) {
     const std::string& name = src.name();
     const ExrLayout layout = scan_exr_header(src, limits);
     try {
@@ -345,6 +362,19 @@ Image read_exr(const io::ByteSource& src, const ImageReadLimits& limits) {
         if (!grey && !(channels.findChannel("R") && channels.findChannel("G") && channels.findChannel("B")))
             throw ImageIoError(fmt::format("{}: no R, G, B (or Y) channels", name));
         const int64_t w = layout.width, h = layout.height;
+        // The layers asked for: every layer with R, G and B channels, and the string attributes.
+        std::vector<std::string> layers;
+        if (extras) {
+            for (auto a = file.header().begin(); a != file.header().end(); ++a)
+                if (const auto* text = dynamic_cast<const Imf::StringAttribute*>(&a.attribute()))
+                    extras->attributes.emplace_back(a.name(), text->value());
+            std::set<std::string> names;
+            channels.layers(names);
+            for (const std::string& l : names)
+                if (channels.findChannel(l + ".R") && channels.findChannel(l + ".G") && channels.findChannel(l + ".B")) layers.push_back(l);
+            if (layers.size() > 16) throw ImageIoError(fmt::format("{}: more than 16 RGB layers", name));
+        }
+        std::vector<std::vector<Rgb>> layer_pixels(layers.size());
         // Read in bands of whole chunks, so that memory grows with the pixels actually decoded:
         // a file that claims a large image but holds few chunks fails before taking much.
         const int64_t band = layout.chunk_lines * std::max<int64_t>(1, 64 / layout.chunk_lines);
@@ -362,9 +392,17 @@ Image read_exr(const io::ByteSource& src, const ImageReadLimits& limits) {
             for (int c = 0; c < 3; ++c)
                 fb.insert(grey ? "Y" : names[c], Imf::Slice::Make(Imf::FLOAT, base + c * sizeof(float), origin, w, rows, sizeof(Rgb),
                                                                   sizeof(Rgb) * size_t(w)));
+            for (size_t l = 0; l < layers.size(); ++l) {
+                layer_pixels[l].resize(needed);
+                auto* lbase = reinterpret_cast<char*>(&layer_pixels[l][size_t(y0) * size_t(w)]);
+                for (int c = 0; c < 3; ++c)
+                    fb.insert(layers[l] + "." + names[c], Imf::Slice::Make(Imf::FLOAT, lbase + c * sizeof(float), origin, w, rows,
+                                                                           sizeof(Rgb), sizeof(Rgb) * size_t(w)));
+            }
             file.setFrameBuffer(fb);
             file.readPixels(int(layout.min_y + y0), int(layout.min_y + y0 + rows - 1));
         }
+        for (size_t l = 0; l < layers.size(); ++l) extras->layers.emplace_back(layers[l], Image(int(w), int(h), std::move(layer_pixels[l])));
         return Image(int(w), int(h), std::move(pixels));
     } catch (const ImageIoError&) {
         throw;
@@ -587,6 +625,17 @@ void write_png8(const Image8& img, const std::string& path) {
 void write_image(const Image& img, const std::string& path, float png_exposure) {
     const ImageFormat format = image_format_for(path);
     io::write_file_atomically(path, [&](io::FdWriter& out) { write_encoded(img, format, out, path, png_exposure); });
+}
+
+void write_exr(const Image& img, const ExrExtras& extras, const std::string& path) {
+    if (image_format_for(path) != ImageFormat::Exr) throw ImageIoError(fmt::format("{}: layers and attributes need an .exr file", path));
+    io::write_file_atomically(path, [&](io::FdWriter& out) { write_exr(img, out, path, extras); });
+}
+
+Image read_exr(const std::string& path, ExrExtras& extras, const ImageReadLimits& limits) {
+    if (image_format_for(path) != ImageFormat::Exr) throw ImageIoError(fmt::format("{}: not an .exr file", path));
+    const io::FileSource src(path);
+    return reading(src, "EXR", [&] { return read_exr(src, limits, &extras); });
 }
 
 void write_text_file(const std::string& path, const std::string& text) {

@@ -22,6 +22,8 @@
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "image/image.hpp"
 
@@ -53,6 +55,25 @@ void check_writable_image_path(const std::string& path);
 void check_writable_path(const std::string& path);
 void write_image(const Image& img, const std::string& path, float png_exposure = 0.0f);
 void write_png8(const Image8& img, const std::string& path);
+
+// One extra EXR channel: width x height floats, row by row (e.g. "m2.R", "dd.Y").
+struct ExrChannel {
+    std::string name;
+    std::vector<float> values;
+};
+// An EXR's content beyond its RGB image: RGB layers (channels "<name>.R", "<name>.G",
+// "<name>.B"; a render's "stderr"), single channels (the moment and aov integrators') and
+// string attributes of the header (a render's "pathlab:spp", "pathlab:seed", ...; README,
+// "Rendering across processes"). Reading fills the layers and attributes.
+struct ExrExtras {
+    std::vector<std::pair<std::string, Image>> layers;
+    std::vector<std::pair<std::string, std::string>> attributes;
+    std::vector<ExrChannel> channels;
+};
+// Writes an .exr with its extras (atomically, as write_image).
+void write_exr(const Image& img, const ExrExtras& extras, const std::string& path);
+// Reads an .exr's RGB image and fills `extras` with its RGB layers and string attributes.
+Image read_exr(const std::string& path, ExrExtras& extras, const ImageReadLimits& limits = {});
 
 // Reads a linear HDR image (.exr, .hdr or .pfm).
 Image read_image(const std::string& path, const ImageReadLimits& limits = {});

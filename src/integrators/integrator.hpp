@@ -14,6 +14,21 @@
 //  - integrators that splat onto arbitrary pixels (the light tracer) collect each pass in a
 //    PassImage (render/pass_image.hpp).
 // To add an integrator: one file under src/integrators/<family>/ and one line in registry.cpp.
+//
+// Across processes and checkpoints (docs/distributed.md) the passes of one render are split
+// into parts rendered by different processes, or before and after a restart, each part into its
+// own film, and the films are summed exactly (render/film.hpp). That gives the one-process image
+// bit for bit if, and only if, the integrator keeps to this contract:
+//  1. a pass is a pure function of (scene, seed, image size, options, pass index): anything
+//     that changes from pass to pass (sppm's radius, vcm's) is computed from the pass index,
+//     never carried from the previous pass;
+//  2. prepare() is a pure function of (scene, seed, image size, options), since every process
+//     runs it (pm's photon maps, ic's cache: built identically on every rank, not shared);
+//  3. everything a pass contributes goes into the film given to render_passes (add, or
+//     add_pass of a PassImage); state that accumulates across passes elsewhere (bdpt's
+//     --strategies films) is neither summed across processes nor checkpointed, so the command
+//     line refuses those options there;
+//  4. finish() writes extra outputs only; with several processes it runs on rank 0 alone.
 #pragma once
 
 #include <functional>
@@ -24,6 +39,7 @@
 #include "cameras/camera.hpp"
 #include "core/properties.hpp"
 #include "render/film.hpp"
+#include "render/pixel_filter.hpp"
 #include "samplers/sampler.hpp"
 #include "scene/scene.hpp"
 
@@ -62,6 +78,8 @@ struct IntegratorOptions {
     int pbgi_bounces = 3;
     int pbgi_resolution = 16;
     int pbgi_direct_samples = 16;
+    // Paths of no bounce (emitters and the environment seen directly) are left out (Mitsuba's hide_emitters).
+    bool hide_emitters = false;
 };
 
 // What every pass of one render sees; fixed for the whole render.
@@ -72,6 +90,8 @@ struct RenderContext {
     uint64_t seed = 0;
     SamplerKind sampler = SamplerKind::Independent;
     int tile_size = 32;  // largest tile edge for pixel integrators (smaller when there are few tiles)
+    // The reconstruction filter (render/pixel_filter.hpp); null or box: each sample in its own pixel.
+    const PixelFilter* filter = nullptr;
 
     size_t pixel_count() const { return size_t(width) * size_t(height); }
 };
@@ -113,13 +133,20 @@ public:
     virtual Rgb radiance(const Scene& scene, const Ray& ray, Sampler& sampler) const = 0;
     PassCounters render_passes(const RenderContext& ctx, Film& film, uint64_t first, int count,
                                const PassProgress& progress) final;
+
+private:
+    PassCounters render_filtered_passes(const RenderContext& ctx, Film& film, uint64_t first, int count, const PassProgress& progress);
+    std::vector<Vec3d> lattice_, filtered_;  // a filtered pass (pixel_filter.hpp)
 };
+
+// The lattice shift of a filtered pass: every pixel's sample of that pass is at pixel + shift.
+Vec2f filter_shift(const RenderContext& ctx, uint64_t pass);
 
 struct IntegratorInfo {
     std::string name;                  // e.g. "direct-light"
     std::vector<std::string> aliases;  // the course's assignment numbers ("1"), Mitsuba's names ("ptracer")
     std::string summary;               // one line
-    // True when the integrator cannot see delta (point/directional) lights at all, so its image
+    // True when the integrator cannot see delta (point, spot, ies, directional) lights at all, so its image
     // is black in scenes lit only by them (BRDF-sampled estimators).
     bool blind_to_delta_lights = false;
     // False when pixels whose first camera-side vertex is specular stay black (the light
@@ -128,6 +155,12 @@ struct IntegratorInfo {
     // Its parameters in scene files (<integrator type=...>), Mitsuba's names and depth convention.
     std::vector<ParamInfo> params;
     std::function<std::unique_ptr<Integrator>(const IntegratorOptions&)> make;
+    // What of a scene file's sensor and film it supports (RenderJob refuses the rest, saying why):
+    // thin lens and orthographic cameras (false: it connects light paths to the pinhole, or
+    // sizes its radii by the pinhole's pixel angle), and reconstruction filters other than box
+    // (false: it adds its samples to the film without them).
+    bool any_camera = true;
+    bool any_filter = true;
 
     PluginInfo plugin() const;
 };

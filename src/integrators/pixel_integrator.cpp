@@ -13,6 +13,7 @@ namespace pathlab {
 
 PassCounters PixelIntegrator::render_passes(const RenderContext& ctx, Film& film, uint64_t first, int count,
                                             const PassProgress& progress) {
+    if (ctx.filter && !ctx.filter->is_box()) return render_filtered_passes(ctx, film, first, count, progress);
     const int w = ctx.width, h = ctx.height;
     // Tiles small enough that every worker gets several (small images still use all cores).
     const int workers = std::max(1, tbb::this_task_arena::max_concurrency());
@@ -23,6 +24,7 @@ PassCounters PixelIntegrator::render_passes(const RenderContext& ctx, Film& film
 
     std::atomic<uint64_t> rays{0}, invalid{0};
     std::atomic<int> tiles_done{0};
+    const bool lens = ctx.camera.needs_lens_sample();
     tbb::parallel_for(tbb::blocked_range<int>(0, tile_count, 1), [&](const tbb::blocked_range<int>& range) {
         for (int tile = range.begin(); tile != range.end(); ++tile) {
             const uint64_t rays_before = Scene::rays_traced_by_this_thread();
@@ -34,7 +36,8 @@ PassCounters PixelIntegrator::render_passes(const RenderContext& ctx, Film& film
                     for (int k = 0; k < count; ++k) {
                         Sampler sampler(ctx.seed, pixel, first + uint64_t(k), ctx.sampler);
                         const Vec2f jitter = sampler.next2d();
-                        const Ray ray = ctx.camera.generate(float(x) + jitter.x, float(y) + jitter.y);
+                        const Ray ray = lens ? ctx.camera.generate(float(x) + jitter.x, float(y) + jitter.y, sampler.next2d())
+                                             : ctx.camera.generate(float(x) + jitter.x, float(y) + jitter.y);
                         const Rgb L = radiance(ctx.scene, ray, sampler);
                         if (is_finite(L)) film.add(pixel, L);
                         else ++tile_invalid;
@@ -46,6 +49,58 @@ PassCounters PixelIntegrator::render_passes(const RenderContext& ctx, Film& film
         }
     });
     return {rays.load(), invalid.load()};
+}
+
+// With a reconstruction filter (render/pixel_filter.hpp): pass by pass, every pixel's sample at
+// the pass's lattice shift, then the pass filtered into the film as one sample of every pixel.
+// The pixel's own jitter is drawn and not used, so the rest of its random numbers are those of
+// the unfiltered render.
+PassCounters PixelIntegrator::render_filtered_passes(const RenderContext& ctx, Film& film, uint64_t first, int count,
+                                                     const PassProgress& progress) {
+    const int w = ctx.width, h = ctx.height;
+    const int rows_per_task = std::max(1, 1024 / std::max(1, w));
+    const int tasks = (h + rows_per_task - 1) / rows_per_task;
+    lattice_.assign(ctx.pixel_count(), Vec3d(0.0));
+    std::atomic<uint64_t> rays{0}, invalid{0};
+    for (int k = 0; k < count; ++k) {
+        const uint64_t pass = first + uint64_t(k);
+        const Vec2f shift = filter_shift(ctx, pass);
+        std::atomic<int> done{0};
+        tbb::parallel_for(tbb::blocked_range<int>(0, tasks, 1), [&](const tbb::blocked_range<int>& range) {
+            for (int task = range.begin(); task != range.end(); ++task) {
+                const uint64_t rays_before = Scene::rays_traced_by_this_thread();
+                uint64_t task_invalid = 0;
+                for (int y = task * rows_per_task; y < std::min(h, (task + 1) * rows_per_task); ++y)
+                    for (int x = 0; x < w; ++x) {
+                        const size_t pixel = size_t(y) * size_t(w) + size_t(x);
+                        Sampler sampler(ctx.seed, pixel, pass, ctx.sampler);
+                        sampler.next2d();  // the unfiltered render's jitter
+                        const float sx = float(x) + shift.x, sy = float(y) + shift.y;
+                        const Ray ray = ctx.camera.needs_lens_sample() ? ctx.camera.generate(sx, sy, sampler.next2d())
+                                                                       : ctx.camera.generate(sx, sy);
+                        const Rgb L = radiance(ctx.scene, ray, sampler);
+                        if (is_finite(L)) {
+                            lattice_[pixel] = Vec3d(L);
+                        } else {
+                            lattice_[pixel] = Vec3d(0.0);
+                            ++task_invalid;
+                        }
+                    }
+                rays += Scene::rays_traced_by_this_thread() - rays_before;
+                invalid += task_invalid;
+                if (progress) progress((double(k) + double(++done) / tasks) / count);
+            }
+        });
+        ctx.filter->filter_pass(lattice_, shift, filtered_);
+        film.add_pass(filtered_);
+    }
+    return {rays.load(), invalid.load()};
+}
+
+Vec2f filter_shift(const RenderContext& ctx, uint64_t pass) {
+    // A stream no pixel or path index uses.
+    Sampler sampler(ctx.seed, ~uint64_t(0), pass, ctx.sampler);
+    return sampler.next2d();
 }
 
 }  // namespace pathlab

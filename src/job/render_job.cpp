@@ -1,8 +1,11 @@
 #include "job/render_job.hpp"
 
+#include <algorithm>
+
 #include <fmt/format.h>
 
 #include "image/image_io.hpp"
+#include "job/extra_channels.hpp"
 #include "job/usage_error.hpp"
 
 namespace pathlab {
@@ -38,6 +41,17 @@ RenderJob::RenderJob(SceneChoice scene, const JobRequest& r) : choice_(std::move
     options_.pbgi_resolution = r.pbgi_resolution ? *r.pbgi_resolution : d.pbgi_resolution.value_or(options_.pbgi_resolution);
     options_.pbgi_direct_samples = r.pbgi_direct_samples ? *r.pbgi_direct_samples : d.pbgi_direct_samples.value_or(options_.pbgi_direct_samples);
     options_.pbgi_spacing = r.pbgi_spacing ? *r.pbgi_spacing : d.pbgi_spacing.value_or(options_.pbgi_spacing);
+    options_.hide_emitters = d.hide_emitters.value_or(false);
+    // What the integrator cannot do with this scene's sensor and film.
+    if (!info_->any_camera && d.camera.kind != CameraKind::Perspective)
+        throw UsageError(fmt::format("{} cannot render through a {} sensor: it connects light paths to a pinhole camera (or sizes "
+                                     "its radii by the pinhole's pixels); use a camera-side integrator (path, direct, pt-naive, "
+                                     "pm, eyelight) or a perspective sensor",
+                                     info_->name, d.camera.kind == CameraKind::ThinLens ? "thinlens" : "orthographic"));
+    if (!info_->any_filter && !(d.filter.is_box() && d.filter.radius == 0.5))
+        throw UsageError(fmt::format("{} adds its samples to the film without a reconstruction filter; the scene's rfilter '{}' "
+                                     "works with the pixel integrators (path, direct, pt-naive, pm, ic, eyelight, ...); use "
+                                     "<rfilter type=\"box\"/> for {}", info_->name, d.filter.type, info_->name));
     if (options_.photons < 0) throw UsageError("--photons must be zero (the default count) or positive");
     if (!(options_.photon_radius >= 0) || !std::isfinite(options_.photon_radius))
         throw UsageError("--radius must be zero (from the scene's size) or a positive distance");
@@ -78,9 +92,27 @@ std::string RenderJob::expand(const std::string& pattern) const {
     }
 }
 
-void RenderJob::write_outputs(const RenderResult& result, float exposure) const {
+void RenderJob::write_outputs(const RenderResult& result, float exposure,
+                              const std::vector<std::pair<std::string, std::string>>& attributes) const {
     const Image image = result.film.mean();
-    for (const std::string& path : outputs) write_image(image, path, exposure);
+    const SceneDescription& d = choice_.description;
+    const bool has_exr = std::any_of(outputs.begin(), outputs.end(), [](const std::string& p) { return image_format_for(p) == ImageFormat::Exr; });
+    if (!has_exr) {
+        for (const std::string& path : outputs) write_image(image, path, exposure);
+        return;
+    }
+    // An EXR carries the standard errors, the render's identity, and the moment and aov
+    // integrators' channels.
+    ExrExtras extras{{{"stderr", result.film.standard_error()}}, attributes, {}};
+    if (d.moment) extras.channels = moment_channels(result.film);
+    if (!d.aovs.empty()) {
+        std::vector<ExrChannel> a = aov_channels(*scene_, d.aovs, result.film.width(), result.film.height(), result.stats.spp, settings.seed);
+        for (ExrChannel& c : a) extras.channels.push_back(std::move(c));
+    }
+    for (const std::string& path : outputs) {
+        if (image_format_for(path) == ImageFormat::Exr) write_exr(image, extras, path);
+        else write_image(image, path, exposure);
+    }
 }
 
 }  // namespace pathlab

@@ -82,8 +82,11 @@ public:
 
     // Expands {scene}, {index} and {algorithm} in an output pattern (UsageError if malformed).
     std::string expand(const std::string& pattern) const;
-    // Writes the mean image to every output (format by extension; `exposure` for .png).
-    void write_outputs(const RenderResult& result, float exposure = 0) const;
+    // Writes the mean image to every output (format by extension; `exposure` for .png); an .exr
+    // also gets the standard-error image as its layer "stderr" and `attributes` in its header
+    // (render_metadata in job/render_identity.hpp).
+    void write_outputs(const RenderResult& result, float exposure = 0,
+                       const std::vector<std::pair<std::string, std::string>>& attributes = {}) const;
 
 private:
     SceneChoice choice_;

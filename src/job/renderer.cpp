@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <fstream>
+#include <algorithm>
 #include <new>
 #include <stdexcept>
 
@@ -30,7 +31,8 @@ uint64_t available_memory() {
     return 0;
 }
 
-// A film of w x h pixels, or a FilmTooLarge saying how much memory it needs.
+}  // namespace
+
 Film make_film(int w, int h) {
     const uint64_t pixels = uint64_t(w) * uint64_t(h), bytes = pixels * kRenderBytesPerPixel;
     const uint64_t available = available_memory();
@@ -48,7 +50,6 @@ Film make_film(int w, int h) {
     }
 }
 
-}  // namespace
 
 RenderResult render(const Scene& scene, Integrator& integrator, const RenderSettings& settings) {
     int w, h;
@@ -65,55 +66,132 @@ RenderStats render_into(const Scene& scene, Integrator& integrator, const Render
         throw std::invalid_argument(fmt::format("the film is {}x{}, the render {}x{}", film.width(), film.height(), w, h));
     if (settings.spp <= 0 && settings.time_limit <= 0)
         throw std::invalid_argument("a render needs a positive sample count or time limit");
+    const uint64_t first = settings.first_sample;
+    const PassSet target = settings.spp > 0 ? PassSet::range(first, first + settings.spp) : PassSet::range(first, UINT64_MAX);
+    if (!target.contains(settings.done))
+        throw std::invalid_argument(fmt::format("the film holds passes {} outside the render's passes {}", settings.done.to_string(),
+                                                target.to_string()));
 
+    LocalRanks alone;
+    RankGroup& ranks = settings.ranks ? *settings.ranks : alone;
+    const int rank_count = ranks.size(), me = ranks.rank();
     const PerspectiveCamera camera(scene.camera(), w, h);
-    const RenderContext ctx{scene, camera, w, h, settings.seed, settings.sampler, settings.tile_size};
-    Progress progress(settings.progress);
+    const PixelFilter filter(scene.description().filter, w, h);
+    const RenderContext ctx{scene, camera, w, h, settings.seed, settings.sampler, settings.tile_size, &filter};
+    const bool show_progress = settings.progress && ranks.root();
+    Progress progress(show_progress);
     const auto start = std::chrono::steady_clock::now();
     const auto seconds_since_start = [&] {
         return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     };
     PassProgress on_prepare;
-    if (settings.progress) on_prepare = [&](double fraction) { progress.update(0.0, 0, fmt::format("preparing: {:.0f}%", 100 * fraction)); };
+    if (show_progress) on_prepare = [&](double fraction) { progress.update(0.0, 0, fmt::format("preparing: {:.0f}%", 100 * fraction)); };
     integrator.prepare(ctx, on_prepare);
 
     RenderStats st;
-    uint64_t done = 0, batch = 1;
-    while (settings.spp <= 0 || done < settings.spp) {
-        const uint64_t passes = settings.spp > 0 ? std::min(batch, settings.spp - done) : batch;
-        const double batch_start = seconds_since_start();
-        PassProgress on_progress;
-        if (settings.progress)
-            on_progress = [&](double fraction_of_batch) {
-                const double within = double(done) + double(passes) * fraction_of_batch;
-                double fraction = settings.spp > 0 ? within / double(settings.spp) : 0;
-                if (settings.time_limit > 0) fraction = std::max(fraction, seconds_since_start() / settings.time_limit);
-                progress.update(std::min(fraction, 1.0), uint64_t(within * double(w) * double(h)), fmt::format("{} spp", done));
-            };
-        const PassCounters c = integrator.render_passes(ctx, film, settings.first_sample + done, int(passes), on_progress);
-        done += passes;
-        st.spp = done;
-        st.samples = done * uint64_t(w) * uint64_t(h);
-        st.rays += c.rays;
-        st.invalid_samples += c.invalid_samples;
-        st.seconds = seconds_since_start();
-        const double batch_seconds = st.seconds - batch_start;
-        if (settings.after_pass) settings.after_pass(film, st);
-        if (settings.cancel && settings.cancel->load()) {
+    st.resumed_spp = settings.done.count();
+    PassSet done = settings.done;
+    uint64_t batch = 1, my_spp = 0, my_rays = 0;
+    double my_seconds = 0, last_checkpoint = 0;
+    const uint64_t pixels = uint64_t(w) * uint64_t(h);
+    while (true) {
+        // This round: the next passes still to do, one contiguous part per rank.
+        const uint64_t left = settings.spp > 0 ? settings.spp - done.count() : UINT64_MAX;
+        if (left == 0) break;
+        const uint64_t round_size = std::min(left, batch * uint64_t(rank_count));
+        const PassSet round = target.minus(done).first(round_size);
+        const PassSet mine = round.part(me, rank_count);
+        const double round_start = seconds_since_start();
+        const uint64_t done_before = done.count();
+        uint64_t mine_done = 0;
+        for (const PassRange& r : mine.ranges()) {
+            PassProgress on_progress;
+            if (show_progress)
+                on_progress = [&](double fraction_of_call) {
+                    // The whole round advances about as this rank's part does.
+                    const double part = (double(mine_done) + double(r.size()) * fraction_of_call) / double(mine.count());
+                    const double within = double(done_before) + double(round.count()) * part;
+                    double fraction = settings.spp > 0 ? within / double(settings.spp) : 0;
+                    if (settings.time_limit > 0) fraction = std::max(fraction, seconds_since_start() / settings.time_limit);
+                    progress.update(std::min(fraction, 1.0), uint64_t((within - double(st.resumed_spp)) * double(pixels)),
+                                    fmt::format("{} spp", done_before));
+                };
+            const PassCounters c = integrator.render_passes(ctx, film, r.begin, int(r.size()), on_progress);
+            mine_done += r.size();
+            st.rays += c.rays;
+            st.invalid_samples += c.invalid_samples;
+        }
+        const double my_round_seconds = seconds_since_start() - round_start;
+        my_spp += mine.count(), my_seconds += my_round_seconds;
+        done.insert(round);
+        // The collective of the round: the slowest part, the time spent, any rank interrupted.
+        double shared[3] = {my_round_seconds, seconds_since_start(), settings.cancel && settings.cancel->load() ? 1.0 : 0.0};
+        ranks.all_max(shared);
+        const double round_seconds = shared[0];
+        st.seconds = shared[1];
+        st.spp = done.count();
+        st.passes = done;
+        st.samples = (st.spp - st.resumed_spp) * pixels;
+        if (settings.after_pass && rank_count == 1) settings.after_pass(film, st);
+        if (shared[2] > 0) {
             st.interrupted = true;
             break;
         }
-        // Stop when another batch would end further past the budget than stopping now ends short of it.
-        if (settings.time_limit > 0) {
-            const double per_pass = batch_seconds / double(passes);
-            const double left = settings.time_limit - st.seconds;
-            if (left <= 0.5 * per_pass) break;
-            batch = std::max<uint64_t>(1, std::min<uint64_t>(batch, uint64_t(left / per_pass)));
+        if (settings.checkpoint && settings.checkpoint_every > 0 && st.seconds - last_checkpoint >= settings.checkpoint_every &&
+            done.count() < (settings.spp > 0 ? settings.spp : UINT64_MAX)) {
+            const double t0 = seconds_since_start();
+            settings.checkpoint(ranks, film, done, st);
+            ++st.checkpoints;
+            st.checkpoint_seconds += seconds_since_start() - t0;
+            last_checkpoint = st.seconds;
         }
-        if (batch_seconds < 0.05 && batch < (1u << 20)) batch *= 2;
+        // Stop when another round would end further past the budget than stopping now ends short of it.
+        const uint64_t per_rank = (round.count() + uint64_t(rank_count) - 1) / uint64_t(rank_count);
+        if (settings.time_limit > 0) {
+            const double per_pass = round_seconds / double(per_rank);
+            const double time_left = settings.time_limit - st.seconds;
+            if (time_left <= 0.5 * per_pass) break;
+            batch = std::max<uint64_t>(1, std::min<uint64_t>(batch, uint64_t(time_left / per_pass)));
+        }
+        if (round_seconds < 0.05 && batch < (1u << 20)) batch *= 2;
     }
     progress.finish();
-    integrator.finish(ctx);
+    st.spp = done.count();
+    st.passes = done;
+    st.samples = (st.spp - st.resumed_spp) * pixels;
+
+    if (rank_count > 1) {
+        // The ranks' films summed into the root's (chunks of 64Ki pixels, 10 MiB).
+        const double t0 = seconds_since_start();
+        ranks.reduce_film(film, size_t(1) << 16, [&](size_t first_pixel, const PixelSums* sums, size_t count) {
+            std::copy(sums, sums + count, film.data() + first_pixel);
+        });
+        st.reduce_seconds = seconds_since_start() - t0;
+        const double mine_figures[4] = {double(my_spp), my_seconds, double(st.rays), double(st.invalid_samples)};
+        const std::vector<double> all = ranks.gather(mine_figures);
+        const std::vector<std::string> names = ranks.gather_text(ranks.name());
+        if (ranks.root()) {
+            st.rays = st.invalid_samples = 0;
+            for (int r = 0; r < rank_count; ++r) {
+                const double* f = &all[size_t(4 * r)];
+                st.ranks.push_back({names[size_t(r)], uint64_t(f[0]), f[1], uint64_t(f[2])});
+                st.rays += uint64_t(f[2]);
+                st.invalid_samples += uint64_t(f[3]);
+            }
+        }
+        st.seconds = seconds_since_start();
+    } else {
+        st.ranks.push_back({ranks.name(), my_spp, my_seconds, st.rays});
+    }
+    if (ranks.root()) {
+        integrator.finish(ctx);
+        if (settings.checkpoint) {
+            const double t0 = seconds_since_start();
+            settings.checkpoint(alone, film, done, st);
+            ++st.checkpoints;
+            st.checkpoint_seconds += seconds_since_start() - t0;
+        }
+    }
     st.integrator = integrator.statistics();
     return st;
 }

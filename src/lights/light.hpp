@@ -1,7 +1,8 @@
 // Light sources: one interface that every light type implements (a closed set, dispatched
 // with std::visit in the hot loop). Each type lives in its own header:
-//   point.hpp (point), triangle.hpp and sphere.hpp (area emitters on shapes),
-//   constant.hpp (constant environment), directional.hpp (directional).
+//   point.hpp (point), spot.hpp (spot), ies.hpp (ies: a point light with a photometric
+//   profile), triangle.hpp and sphere.hpp (area emitters on shapes), constant.hpp (constant
+//   environment), envmap.hpp (environment map), directional.hpp (directional).
 // Every type provides, with the measures of light_sample.hpp:
 //   flags                                 kLightDeltaPosition, kLightDeltaDirection, kLightInfinite, kLightSurface
 //   sample_li(p, u) -> LightSample        incident illumination at p (direction, radiance, pdfW)
@@ -20,13 +21,17 @@
 
 #include "lights/constant.hpp"
 #include "lights/directional.hpp"
+#include "lights/envmap.hpp"
+#include "lights/ies.hpp"
 #include "lights/point.hpp"
 #include "lights/sphere.hpp"
+#include "lights/spot.hpp"
 #include "lights/triangle.hpp"
 
 namespace pathlab {
 
-using Light = std::variant<PointLight, TriangleLight, SphereLight, EnvironmentLight, DirectionalLight>;
+using Light = std::variant<PointLight, TriangleLight, SphereLight, EnvironmentLight, DirectionalLight, EnvMapLight, SpotLight,
+                           IesLight>;
 
 inline uint32_t light_flags(const Light& light) {
     return std::visit([](const auto& l) { return l.flags; }, light);
@@ -47,6 +52,23 @@ inline float surface_light_pdf_li(const Light& light, const Vec3f& p, const Vec3
     if (const auto* t = std::get_if<TriangleLight>(&light)) return t->pdf_li(p, q);
     if (const auto* s = std::get_if<SphereLight>(&light)) return s->pdf_li(p, q, n);
     return 0.0f;
+}
+
+// The environment (constant or a map; see Scene::environment_light): radiance arriving along
+// an escaped ray's direction w, and the solid-angle density with which light sampling produces
+// w (without the light's selection probability). Black and 0 for other lights.
+inline Rgb environment_radiance(const Light& light, const Vec3f& w) {
+    if (const auto* c = std::get_if<EnvironmentLight>(&light)) return c->Le(w);
+    if (const auto* m = std::get_if<EnvMapLight>(&light)) return m->Le(w);
+    return Rgb(0.0f);
+}
+inline float environment_pdf_li(const Light& light, const Vec3f& w) {
+    if (const auto* c = std::get_if<EnvironmentLight>(&light)) return c->pdf_li(w);
+    if (const auto* m = std::get_if<EnvMapLight>(&light)) return m->pdf_li(w);
+    return 0.0f;
+}
+inline bool is_environment(const Light& light) {
+    return std::holds_alternative<EnvironmentLight>(light) || std::holds_alternative<EnvMapLight>(light);
 }
 
 inline std::optional<LightSample> sample_light(const Light& light, const Vec3f& p, const Vec2f& u) {

@@ -15,6 +15,7 @@
 
 #include "core/vec.hpp"
 #include "render/film.hpp"
+#include "render/pixel_filter.hpp"
 
 namespace pathlab {
 
@@ -23,14 +24,26 @@ struct Splat {
     Rgb value;
 };
 
+// A splat at a raster position, spread by a reconstruction filter (pixel_filter.hpp).
+struct RasterSplat {
+    Vec2f raster;
+    Rgb value;
+};
+
 class SplatList {
 public:
     void add(uint32_t pixel, const Rgb& value) { splats_.push_back({pixel, value}); }
-    void clear() { splats_.clear(); }
+    void add_at(const Vec2f& raster, const Rgb& value) { raster_splats_.push_back({raster, value}); }
+    void clear() {
+        splats_.clear();
+        raster_splats_.clear();
+    }
     const std::vector<Splat>& splats() const { return splats_; }
+    const std::vector<RasterSplat>& raster_splats() const { return raster_splats_; }
 
 private:
     std::vector<Splat> splats_;  // keeps its capacity from pass to pass: no allocation once warm
+    std::vector<RasterSplat> raster_splats_;
 };
 
 class PassImage {
@@ -52,10 +65,21 @@ public:
             for (const Splat& s : lists_[size_t(k)].splats()) values_[s.pixel] += Vec3d(s.value);
         film.add_pass(values_);
     }
+    // With a reconstruction filter: the per-pixel contributions are the pass's lattice samples
+    // (at pixel + shift), filtered; the raster splats are spread in chunk order; then the pass.
+    void finish(Film& film, const PixelFilter* filter, const Vec2f& shift) {
+        if (!filter || filter->is_box()) return finish(film);
+        filter->filter_pass(values_, shift, filtered_);
+        for (int k = 0; k < chunks_; ++k) {
+            for (const Splat& s : lists_[size_t(k)].splats()) filtered_[s.pixel] += Vec3d(s.value);
+            for (const RasterSplat& s : lists_[size_t(k)].raster_splats()) filter->splat(s.raster, Vec3d(s.value), filtered_);
+        }
+        film.add_pass(filtered_);
+    }
     const std::vector<Vec3d>& values() const { return values_; }
 
 private:
-    std::vector<Vec3d> values_;
+    std::vector<Vec3d> values_, filtered_;
     std::vector<SplatList> lists_;
     int chunks_ = 0;
 };

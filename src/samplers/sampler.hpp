@@ -8,6 +8,8 @@
 #include "core/rng.hpp"
 #include "core/vec.hpp"
 #include "samplers/sobol.hpp"
+#include <vector>
+
 #include "core/properties.hpp"
 
 namespace pathlab {
@@ -61,12 +63,29 @@ private:
     uint64_t pixel_hash_;
 };
 
-// The scene-file sampler (Mitsuba 3's independent): its sample count is the render's default spp;
-// pathlab's sampler is chosen with --sampler.
+// The scene-file samplers (Mitsuba's independent, stratified, ...): their sample count is the
+// render's default spp; the pattern is pathlab's, chosen with --sampler (independent or sobol),
+// so a file's other sampler types and their pattern parameters are accepted with a note.
 inline const PluginInfo& independent_plugin() {
     static const PluginInfo info{"sampler", "independent", "the number of samples per pixel",
-                                 {{"sample_count", ParamType::Integer, "4", "samples per pixel (--spp wins)"}}};
+                                 {{"sample_count", ParamType::Integer, "4", "samples per pixel (--spp wins)", "sampleCount"},
+                                  {"seed", ParamType::Integer, "0", "accepted and ignored: pathlab's --seed sets the random numbers"}}};
     return info;
+}
+inline const std::vector<PluginInfo>& other_sampler_plugins() {
+    static const std::vector<PluginInfo> plugins = [] {
+        std::vector<PluginInfo> out;
+        const ParamInfo count{"sample_count", ParamType::Integer, "4", "samples per pixel (--spp wins)", "sampleCount"};
+        const ParamInfo seed{"seed", ParamType::Integer, "0", "accepted and ignored: pathlab's --seed sets the random numbers"};
+        const ParamInfo jitter{"jitter", ParamType::Boolean, "true", "accepted and ignored (the pattern is pathlab's)"};
+        const ParamInfo scramble{"scramble", ParamType::Integer, "-1", "accepted and ignored (the pattern is pathlab's)"};
+        const ParamInfo strength{"strength", ParamType::Integer, "2", "accepted and ignored (the pattern is pathlab's)"};
+        for (const char* type : {"stratified", "multijitter", "orthogonal", "ldsampler", "halton", "hammersley", "sobol"})
+            out.push_back({"sampler", type, "accepted as independent: its sample_count counts, its pattern is pathlab's --sampler (with a note)",
+                           {count, seed, jitter, scramble, strength}});
+        return out;
+    }();
+    return plugins;
 }
 
 }  // namespace pathlab

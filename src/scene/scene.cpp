@@ -41,8 +41,24 @@ void validate(const SceneDescription& d) {
         if (!is_finite(s.emission) || min_component(s.emission) < 0)
             throw SceneError(what + " has an invalid emitted radiance");
     }
+    for (size_t g = 0; g < d.groups.size(); ++g)
+        for (const MeshDesc& m : d.groups[g].meshes) {
+            const std::string what = fmt::format("mesh '{}' of shapegroup '{}'", m.name, d.groups[g].name);
+            if (m.triangles.empty()) throw SceneError(what + " has no faces");
+            check_material(m.material, what);
+            for (const auto& tri : m.triangles)
+                for (uint32_t v : tri)
+                    if (v >= m.positions.size()) throw SceneError(what + " has a vertex index out of range");
+            if (!m.normals.empty() && m.normals.size() != m.positions.size()) throw SceneError(what + " has a normal count unlike its vertex count");
+            if (!m.uvs.empty() && m.uvs.size() != m.positions.size()) throw SceneError(what + " has a uv count unlike its vertex count");
+            if (!is_black(m.emission)) throw SceneError(what + " emits light: emitters cannot be instanced");
+        }
+    for (const InstanceDesc& inst : d.instances)
+        if (inst.group >= d.groups.size() || !inst.to_world.is_finite() || !inst.to_world.is_affine_invertible())
+            throw SceneError("an instance refers to a missing shapegroup or has a degenerate transform");
     int environments = 0;
-    for (const FreeLight& l : d.lights) environments += std::holds_alternative<EnvironmentLight>(l);
+    for (const FreeLight& l : d.lights)
+        environments += std::holds_alternative<EnvironmentLight>(l) || std::holds_alternative<EnvMapLight>(l);
     if (environments > 1) throw SceneError("a scene can have at most one environment light");
 }
 
@@ -62,7 +78,7 @@ std::unique_ptr<Scene> Scene::build(const SceneDescription& desc) {
 
     for (const FreeLight& l : desc.lights) {
         std::visit([&](const auto& light) { s->lights_.emplace_back(light); }, l);
-        if (std::holds_alternative<EnvironmentLight>(l)) s->environment_ = int(s->lights_.size()) - 1;
+        if (is_environment(s->lights_.back())) s->environment_ = int(s->lights_.size()) - 1;
     }
 
     Vec3f lo(kInf), hi(-kInf);
@@ -98,6 +114,20 @@ std::unique_ptr<Scene> Scene::build(const SceneDescription& desc) {
         s->geometry_[id] = rec;
         lo = min(lo, sp.center - Vec3f(sp.radius)), hi = max(hi, sp.center + Vec3f(sp.radius));
     }
+    for (const ShapeGroupDesc& g : desc.groups) s->accel_.add_group(g.meshes);
+    for (size_t i = 0; i < desc.instances.size(); ++i) {
+        const InstanceDesc& inst = desc.instances[i];
+        const uint32_t id = s->accel_.add_instance(inst.group, inst.to_world);
+        if (id >= s->geometry_.size()) s->geometry_.resize(id + 1);
+        GeometryRecord rec;
+        rec.instance = int32_t(i);
+        s->geometry_[id] = rec;
+        for (const MeshDesc& m : desc.groups[inst.group].meshes)
+            for (const Vec3f& p : m.positions) {
+                const Vec3f w(inst.to_world.point(Vec3d(p)));
+                lo = min(lo, w), hi = max(hi, w);
+            }
+    }
     s->accel_.commit();
     if (lo.x <= hi.x) {
         s->center_ = (lo + hi) * 0.5f;
@@ -120,9 +150,13 @@ bool Scene::intersect(const Ray& ray, Intersection& hit) const {
     ++t_rays_traced;
     RawHit raw;
     if (!accel_.intersect(ray, raw)) return false;
-    const GeometryRecord& rec = geometry_[raw.geom_id];
     hit.t = raw.t;
     hit.uv = Vec2f(0.0f, 0.0f);
+    if (raw.inst_id != RawHit::kNoInstance) [[unlikely]] {
+        instance_hit(raw, hit);
+        return true;
+    }
+    const GeometryRecord& rec = geometry_[raw.geom_id];
     if (rec.is_sphere) {
         const SphereDesc& sp = desc_.spheres[rec.index];
         // Project the hit back onto the sphere in double precision.
@@ -150,6 +184,37 @@ bool Scene::intersect(const Ray& ray, Intersection& hit) const {
         hit.light = rec.first_light >= 0 ? rec.first_light + int32_t(raw.prim_id) : -1;
     }
     return true;
+}
+
+void Scene::instance_hit(const RawHit& raw, Intersection& hit) const {
+    const InstanceDesc& inst = desc_.instances[size_t(geometry_[raw.inst_id].instance)];
+    const MeshDesc& m = desc_.groups[inst.group].meshes[raw.geom_id];
+    const Transform& t = inst.to_world;
+    const bool identity = t.m == Transform().m;  // transform_mesh keeps such a mesh's floats as they are
+    const auto place = [&](const Vec3f& v) { return identity ? v : Vec3f(t.point(Vec3d(v))); };
+    const auto& tri = m.triangles[raw.prim_id];
+    const Vec3f p0 = place(m.positions[tri[0]]), p1 = place(m.positions[tri[1]]), p2 = place(m.positions[tri[2]]);
+    const float b1 = raw.u, b2 = raw.v, b0 = 1 - b1 - b2;
+    hit.p = p0 * b0 + p1 * b1 + p2 * b2;
+    hit.ng = normalize(cross(p1 - p0, p2 - p0));
+    hit.ns = hit.ng;
+    if (!m.normals.empty()) {
+        Vec3f n[3];
+        for (int k = 0; k < 3; ++k) {
+            if (identity) {
+                n[k] = m.normals[tri[size_t(k)]];
+                continue;
+            }
+            const Vec3d tn = t.normal(Vec3d(m.normals[tri[size_t(k)]]));
+            const double len = length(tn);
+            n[k] = len > 0 ? Vec3f(tn / len) : Vec3f(0.0f);
+        }
+        const Vec3f ns = n[0] * b0 + n[1] * b1 + n[2] * b2;
+        if (dot(ns, ns) > 0) hit.ns = normalize(ns);
+    }
+    if (!m.uvs.empty()) hit.uv = m.uvs[tri[0]] * b0 + m.uvs[tri[1]] * b1 + m.uvs[tri[2]] * b2;
+    hit.material = m.material;
+    hit.light = -1;
 }
 
 bool Scene::occluded(const Ray& ray) const {

@@ -52,8 +52,9 @@ public:
 
     // Radiance along a ray that escapes the scene in direction w (the environment, if any).
     Rgb escaped_radiance(const Vec3f& w = {}) const {
-        return environment_ >= 0 ? std::get<EnvironmentLight>(lights_[size_t(environment_)]).Le(w) : Rgb(0.0f);
+        return environment_ >= 0 ? environment_radiance(lights_[size_t(environment_)], w) : Rgb(0.0f);
     }
+    // The environment light (constant or envmap), or -1.
     int environment_light() const { return environment_; }
 
     // Chooses a light with probability proportional to its power (uniformly if all are 0).
@@ -77,7 +78,13 @@ private:
         int32_t first_light = -1;  // area light of triangle k is first_light + k
         const MeshDesc* mesh = nullptr;       // triangles: the mesh, and its unit face normals
         const Vec3f* face_normals = nullptr;  // (computed once, not per hit)
+        int32_t instance = -1;                // an instance: its index in desc_.instances
     };
+
+    // A hit on an instance: the group's mesh placed by the instance's transform, computed as
+    // transform_mesh would have placed its vertices (so a shapegroup renders like the same
+    // meshes written out, bit for bit wherever Embree's object-space hit is exact).
+    void instance_hit(const RawHit& raw, Intersection& hit) const;
 
     SceneDescription desc_;
     std::string name_;

@@ -8,6 +8,7 @@
 
 #include "bsdfs/material.hpp"
 #include "cameras/camera.hpp"
+#include "core/reconstruction_filter.hpp"
 #include "geometry/shape.hpp"
 #include "lights/registry.hpp"
 
@@ -20,6 +21,8 @@ struct SceneDescription {
     std::vector<Material> materials;
     std::vector<MeshDesc> meshes;
     std::vector<SphereDesc> spheres;
+    std::vector<ShapeGroupDesc> groups;  // placed by instances
+    std::vector<InstanceDesc> instances;
     std::vector<FreeLight> lights;
     // Render settings a scene file may suggest; command-line options override them.
     std::optional<std::string> algorithm;
@@ -32,6 +35,17 @@ struct SceneDescription {
     std::optional<int> ic_rays;                                                            // ic
     std::optional<float> ic_error;
     std::optional<bool> ic_gradients, ic_clamp_screen, ic_clamp_neighbours;
+    std::optional<bool> hide_emitters;            // paths of no bounce (emitters seen directly) left out
+    // The film: its reconstruction filter, the format of the default output (hdrfilm's
+    // file_format: "openexr", "rgbe" or "pfm"), and extra outputs an integrator asks for
+    // (moment: the second moment; aov: depth, position, normals, albedo).
+    FilterDesc filter;
+    std::string file_format = "openexr";
+    bool moment = false;
+    std::vector<std::pair<std::string, std::string>> aovs;  // (channel name, kind)
+    // What the loader accepted but ignored, or changed ("file:line:column: note: ..."), for the
+    // command line to print.
+    std::vector<std::string> notes;
 };
 
 }  // namespace pathlab

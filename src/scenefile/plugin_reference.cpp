@@ -10,6 +10,7 @@
 #include "lights/registry.hpp"
 #include "render/film.hpp"
 #include "samplers/sampler.hpp"
+#include "scenefile/readers.hpp"
 
 namespace pathlab {
 namespace {
@@ -26,10 +27,16 @@ std::string cell(const std::string& text) {
 std::vector<PluginInfo> all_plugins() {
     std::vector<PluginInfo> out;
     for (const IntegratorInfo& i : integrators()) out.push_back(i.plugin());
+    for (const PluginInfo& w : integrator_wrapper_plugins()) out.push_back(w);
     out.push_back(perspective_plugin());
+    out.push_back(thinlens_plugin());
+    out.push_back(orthographic_plugin());
     out.push_back(hdrfilm_plugin());
+    for (const PluginInfo& f : rfilter_plugins()) out.push_back(f);
     out.push_back(independent_plugin());
+    for (const PluginInfo& s : other_sampler_plugins()) out.push_back(s);
     for (const ShapePlugin& s : shape_plugins()) out.push_back(s.info());
+    for (const PluginInfo& s : group_shape_plugins()) out.push_back(s);
     for (const BsdfPlugin& b : bsdf_plugins()) out.push_back(b.info());
     for (const EmitterPlugin& e : emitter_plugins()) out.push_back(e.info());
     return out;

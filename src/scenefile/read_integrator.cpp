@@ -1,19 +1,41 @@
-// <integrator type>: any pathlab integrator by name or alias (Mitsuba's path, direct and
-// ptracer among them), with its declared parameters.
+// <integrator type>: any pathlab integrator by name or alias (Mitsuba's path, direct, ptracer,
+// bdpt, sppm, ppm, photonmapper, irrcache among them), with its declared parameters; and
+// Mitsuba's wrappers moment (the second moment beside the image) and aov (extra channels:
+// depth, position, normals, albedo, uv) around one nested integrator.
 #include <fmt/format.h>
 
 #include "integrators/integrator.hpp"
 #include "scenefile/readers.hpp"
 
 namespace pathlab {
+namespace {
 
-void read_integrator(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b) {
-    xml.check_attributes(n, {"type"});
-    if (b.have_integrator) xml.fail(n, "a scene can have only one <integrator>");
-    b.have_integrator = true;
+const PluginInfo& moment_plugin() {
+    static const PluginInfo info{"integrator", "moment",
+                                 "wraps one nested integrator; EXR outputs also get its second moment per pixel (channels m2.R, m2.G, m2.B) "
+                                 "and the variance of the mean (var.R, var.G, var.B)",
+                                 {}};
+    return info;
+}
+const PluginInfo& aov_plugin() {
+    static const PluginInfo info{"integrator", "aov",
+                                 "extra EXR channels of the first surface seen (optionally around one nested integrator for the image)",
+                                 {{"aovs", ParamType::String, "",
+                                   "name:kind, ... with kinds depth, position, sh_normal, geo_normal, albedo, uv (e.g. \"dd.y:depth,nn:sh_normal\")"}}};
+    return info;
+}
+
+const char* const kAovKinds[] = {"depth", "position", "sh_normal", "geo_normal", "albedo", "uv"};
+
+void read_plain_integrator(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b) {
+    xml.check_attributes(n, {"type", "id", "name"});
     const std::string type = xml.attr(n, "type");
+    if (type == "volpath" || type == "volpathmis" || type == "volpath_simple")
+        xml.fail(n, fmt::format("unsupported integrator type '{}': it renders participating media, which pathlab does not have yet; "
+                                "for surfaces alone use 'path'", type));
     const IntegratorInfo* info = find_integrator(type);
-    if (!info) xml.fail(n, fmt::format("unsupported integrator type '{}'; supported: {}", type, integrator_names()));
+    if (!info)
+        xml.fail(n, fmt::format("unsupported integrator type '{}'; supported: {}, and the wrappers moment and aov", type, integrator_names()));
     b.desc.algorithm = info->name;
     if (!xml.plugin_children(n).empty()) xml.fail(xml.plugin_children(n).front(), "an <integrator> has no nested plugins");
     const PluginInfo plugin = info->plugin();
@@ -31,11 +53,24 @@ void read_integrator(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b) {
             if (depth < 1) p.fail("rr_depth", fmt::format("rr_depth must be at least 1, got {}", depth));
             b.desc.rr_depth = depth - 1;
         }
+        if (plugin.find("hide_emitters") && p.has("hide_emitters")) b.desc.hide_emitters = p.get_bool("hide_emitters");
+        if (plugin.find("samples_per_pass") && p.has("samples_per_pass")) {
+            p.get_int("samples_per_pass");
+            xml.note(n, "samples_per_pass is ignored: pathlab adds one sample per pixel per pass and stops on --spp or --time");
+        }
+        if (plugin.find("strict_normals") && p.has("strict_normals")) {
+            p.get_bool("strict_normals");
+            xml.note(n, "strict_normals is ignored: pathlab refuses light paths whose sides differ for the shading and geometric normal");
+        }
+        for (const char* count : {"shading_samples", "emitter_samples", "bsdf_samples"})
+            if (plugin.find(count) && p.has(count) && p.get_int(count) != 1)
+                p.fail(count, fmt::format("{} must be 1: pathlab's direct takes one light and one BSDF sample per pixel sample (raise "
+                                          "the sample count instead), got {}", count, p.get_int(count)));
         // Photon mapping (Mitsuba 0.6's sppm spells them photonCount, initialRadius, alpha).
         if (plugin.find("photon_count") && p.has("photon_count")) {
-            const int n = p.get_int("photon_count");
-            if (n < 0) p.fail("photon_count", fmt::format("photon_count must be zero (the default) or positive, got {}", n));
-            b.desc.photons = n;
+            const int count = p.get_int("photon_count");
+            if (count < 0) p.fail("photon_count", fmt::format("photon_count must be zero (the default) or positive, got {}", count));
+            b.desc.photons = count;
         }
         if (plugin.find("initial_radius") && p.has("initial_radius")) {
             const float r = p.get_float("initial_radius");
@@ -90,6 +125,67 @@ void read_integrator(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b) {
         p.check_all_used();
         return 0;
     });
+}
+
+// The nested integrators of a wrapper: at most one.
+std::optional<pugi::xml_node> nested_integrator(XmlSource& xml, const pugi::xml_node& n, const char* type) {
+    std::optional<pugi::xml_node> inner;
+    for (const pugi::xml_node& c : xml.plugin_children(n)) {
+        if (std::string(c.name()) != "integrator") xml.fail(c, fmt::format("unsupported element <{}> in <integrator type=\"{}\">", c.name(), type));
+        if (inner) xml.fail(c, fmt::format("pathlab's {} wraps one integrator, not several", type));
+        inner = c;
+    }
+    return inner;
+}
+
+}  // namespace
+
+std::vector<PluginInfo> integrator_wrapper_plugins() { return {moment_plugin(), aov_plugin()}; }
+
+void read_integrator(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b) {
+    xml.check_attributes(n, {"type", "id", "name"});
+    if (b.have_integrator) xml.fail(n, "a scene can have only one <integrator>");
+    b.have_integrator = true;
+    const std::string type = xml.attr(n, "type");
+    if (type == "moment") {
+        Properties p = xml.properties(n, moment_plugin());
+        reading([&] { return p.check_all_used(), 0; });
+        const auto inner = nested_integrator(xml, n, "moment");
+        if (!inner) xml.fail(n, "<integrator type=\"moment\"> wraps one nested <integrator>");
+        if (std::string(inner->attribute("type").value()) == "moment") xml.fail(*inner, "a moment integrator cannot wrap another");
+        b.desc.moment = true;
+        b.have_integrator = false;
+        read_integrator(xml, *inner, b);
+        return;
+    }
+    if (type == "aov") {
+        Properties p = xml.properties(n, aov_plugin());
+        reading([&] {
+            if (!p.has("aovs")) p.fail("<integrator type=\"aov\"> needs <string name=\"aovs\" value=\"name:kind, ...\"/>");
+            const std::string list = p.get_string("aovs");
+            for (const std::string& item : split_list(list)) {
+                const size_t colon = item.find(':');
+                if (colon == std::string::npos || colon == 0)
+                    p.fail("aovs", fmt::format("'{}' is not name:kind (kinds: {})", item, fmt::join(kAovKinds, ", ")));
+                const std::string name = item.substr(0, colon), kind = item.substr(colon + 1);
+                if (std::find(std::begin(kAovKinds), std::end(kAovKinds), kind) == std::end(kAovKinds))
+                    p.fail("aovs", fmt::format("unsupported aov kind '{}'; supported: {}", kind, fmt::join(kAovKinds, ", ")));
+                for (const auto& [other, _] : b.desc.aovs)
+                    if (other == name) p.fail("aovs", fmt::format("the aov name '{}' is given twice", name));
+                b.desc.aovs.emplace_back(name, kind);
+            }
+            if (b.desc.aovs.empty()) p.fail("aovs", "no aov given");
+            p.check_all_used();
+            return 0;
+        });
+        if (const auto inner = nested_integrator(xml, n, "aov")) {
+            if (std::string(inner->attribute("type").value()) == "aov") xml.fail(*inner, "an aov integrator cannot wrap another");
+            b.have_integrator = false;
+            read_integrator(xml, *inner, b);
+        }
+        return;
+    }
+    read_plain_integrator(xml, n, b);
 }
 
 }  // namespace pathlab

@@ -1,19 +1,84 @@
 // <shape type>: a plugin of geometry/shape_plugins.hpp, with one <bsdf> or <ref id> (default:
-// one-sided diffuse 0.5) and optionally an <emitter type="area">.
+// one-sided diffuse 0.5) and optionally an <emitter type="area">; or a shapegroup (meshes
+// placed by instances, through Embree instancing) and its instances.
 #include <fmt/format.h>
 
 #include "lights/area.hpp"
 #include "scenefile/readers.hpp"
 
 namespace pathlab {
+namespace {
 
-void read_shape(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b) {
-    xml.check_attributes(n, {"type", "id"});
+const PluginInfo& shapegroup_plugin() {
+    static const PluginInfo info{"shape", "shapegroup",
+                                 "meshes (nested <shape>s, not spheres or emitters) stored once and placed by instances; needs an id", {}};
+    return info;
+}
+const PluginInfo& instance_plugin() {
+    static const PluginInfo info{"shape", "instance", "a shapegroup (<ref id>) placed by to_world (Embree instancing)",
+                                 {{"to_world", ParamType::Transform, "", "placement of the group", "toWorld"}}};
+    return info;
+}
+
+// `group`: the shape belongs to a shapegroup (its mesh goes there).
+void read_shape_into(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b, std::vector<MeshDesc>* group);
+
+void read_shapegroup(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b) {
+    const auto id = xml.optional_attr(n, "id");
+    if (!id) xml.fail(n, "a shapegroup needs an id (instances refer to it)");
+    Properties p = xml.properties(n, shapegroup_plugin());
+    reading([&] { return p.check_all_used(), 0; });
+    ShapeGroupDesc g;
+    g.name = *id;
+    for (const pugi::xml_node& c : xml.plugin_children(n)) {
+        if (std::string(c.name()) != "shape") xml.fail(c, fmt::format("unsupported element <{}> in a shapegroup; supported: <shape>", c.name()));
+        const std::string type = c.attribute("type").value();
+        if (type == "shapegroup" || type == "instance") xml.fail(c, "shapegroups and instances cannot be nested in a shapegroup");
+        read_shape_into(xml, c, b, &g.meshes);
+    }
+    if (g.meshes.empty()) xml.fail(n, "an empty shapegroup");
+    b.desc.groups.push_back(std::move(g));
+    b.name(xml, n, *id, "shapegroup", uint32_t(b.desc.groups.size() - 1));
+}
+
+void read_instance(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b) {
+    std::optional<uint32_t> group;
+    for (const pugi::xml_node& c : xml.plugin_children(n)) {
+        if (std::string(c.name()) != "ref" || group)
+            xml.fail(c, "an instance has exactly one <ref id> to a shapegroup (and its to_world)");
+        group = std::any_cast<uint32_t>(b.resolve(xml, c, "shapegroup").value);
+    }
+    if (!group) xml.fail(n, "an instance needs a <ref id> to a shapegroup");
+    Properties p = xml.properties(n, instance_plugin());
+    InstanceDesc inst;
+    inst.group = *group;
+    reading([&] {
+        if (const auto t = p.get_transform("to_world")) inst.to_world = *t;
+        p.check_all_used();
+        return 0;
+    });
+    b.desc.instances.push_back(inst);
+}
+
+}  // namespace
+
+std::vector<PluginInfo> group_shape_plugins() { return {shapegroup_plugin(), instance_plugin()}; }
+
+void read_shape(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b) { read_shape_into(xml, n, b, nullptr); }
+
+namespace {
+
+void read_shape_into(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b, std::vector<MeshDesc>* group) {
+    xml.check_attributes(n, {"type", "id", "name"});
     const std::string type = xml.attr(n, "type");
+    if (type == "shapegroup" && !group) return read_shapegroup(xml, n, b);
+    if (type == "instance" && !group) return read_instance(xml, n, b);
     const ShapePlugin* plugin = find_shape_plugin(type);
     if (!plugin) {
         std::vector<std::string> names;
         for (const ShapePlugin& s : shape_plugins()) names.push_back(s.info().type);
+        names.push_back("shapegroup");
+        names.push_back("instance");
         xml.fail(n, fmt::format("unsupported shape type '{}'; supported: {}", type, fmt::join(names, ", ")));
     }
 
@@ -22,18 +87,24 @@ void read_shape(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b) {
     bool emitter = false;
     for (const pugi::xml_node& c : xml.plugin_children(n)) {
         const std::string tag = c.name();
-        if (tag == "bsdf" || tag == "ref") {
+        const std::string ref_name = tag == "ref" ? std::string(c.attribute("name").value()) : "";
+        if (ref_name == "interior" || ref_name == "exterior" || tag == "medium")
+            xml.fail(c, "a shape's interior/exterior medium needs participating media, which pathlab does not have yet");
+        if (tag == "ref") {
+            // A <ref> names its kind by what it refers to (a bsdf, an emitter, ...).
+            xml.check_attributes(c, {"id", "name"});
+            const std::string id = xml.attr(c, "id");
+            const auto it = b.named.find(id);
+            if (it == b.named.end()) xml.fail(c, fmt::format("no <bsdf> with id '{}' is declared before this reference", id));
+            if (it->second.kind != "bsdf")
+                xml.fail(c, fmt::format("'{}' is a <{}>; a shape refers to a <bsdf> (its emitter is nested: <emitter type=\"area\">)", id,
+                                        it->second.kind));
             if (material) xml.fail(c, "a shape can have only one BSDF");
-            if (tag == "bsdf") {
-                if (c.attribute("id")) xml.fail(c, "a nested <bsdf> cannot have an id; declare it at the top level and use <ref>");
-                material = b.add_material(read_bsdf(xml, c));
-            } else {
-                xml.check_attributes(c, {"id", "name"});
-                const std::string id = xml.attr(c, "id");
-                const auto it = b.named_bsdfs.find(id);
-                if (it == b.named_bsdfs.end()) xml.fail(c, fmt::format("no <bsdf> with id '{}' is declared before this reference", id));
-                material = it->second;
-            }
+            material = std::any_cast<uint32_t>(it->second.value);
+        } else if (tag == "bsdf") {
+            if (material) xml.fail(c, "a shape can have only one BSDF");
+            material = b.add_material(read_bsdf(xml, c, b));
+            if (const auto id = xml.optional_attr(c, "id")) b.name(xml, c, *id, "bsdf", *material);
         } else if (tag == "emitter") {
             xml.check_attributes(c, {"type", "id", "name"});
             const std::string etype = xml.attr(c, "type");
@@ -61,11 +132,18 @@ void read_shape(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b) {
     }
 
     Properties p = xml.properties(n, plugin->info());
+    ShapeContext files = b.shapes;
+    if (files.allow_files) files.search_dirs = xml.search_dirs();
     ShapeDesc shape = reading([&] {
-        ShapeDesc s = plugin->read(p, b.shapes);
+        ShapeDesc s = plugin->read(p, files);
         p.check_all_used();
         return s;
     });
+    if (group) {
+        if (emitter) xml.fail(n, "a shape in a shapegroup cannot emit light (pathlab samples emitters one by one)");
+        if (std::holds_alternative<SphereDesc>(shape))
+            xml.fail(n, "an exact sphere cannot be in a shapegroup; place spheres one by one, or use a sphere mesh (obj, ply)");
+    }
     if (auto* sphere = std::get_if<SphereDesc>(&shape)) {
         sphere->material = *material;
         sphere->emission = emission;
@@ -77,7 +155,8 @@ void read_shape(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b) {
     if (const auto id = xml.optional_attr(n, "id")) m.name = *id;
     m.material = *material;
     m.emission = emission;
-    b.desc.meshes.push_back(std::move(m));
+    (group ? *group : b.desc.meshes).push_back(std::move(m));
 }
 
+}  // namespace
 }  // namespace pathlab

@@ -3,6 +3,7 @@
 // through the plugin's declared parameters.
 #pragma once
 
+#include <any>
 #include <map>
 #include <optional>
 #include <string>
@@ -13,10 +14,19 @@
 
 namespace pathlab {
 
+// An object declared with an id, for <ref id> and <alias>: its kind (the element's name: bsdf,
+// emitter, shape, texture, medium, ...) and what its reader made of it (a BSDF: the uint32_t
+// index of its material). Readers of other kinds (textures, media) add theirs the same way.
+struct NamedObject {
+    std::string kind;
+    SourceLocation where;
+    std::any value;
+};
+
 // What the readers build up while a file is read.
 struct SceneBuilder {
     SceneDescription desc;
-    std::map<std::string, uint32_t> named_bsdfs;  // id -> index into desc.materials
+    std::map<std::string, NamedObject> named;  // by id
     std::optional<uint32_t> default_material;
     bool have_sensor = false, have_integrator = false;
     ShapeContext shapes;
@@ -25,15 +35,25 @@ struct SceneBuilder {
         desc.materials.push_back(m);
         return uint32_t(desc.materials.size() - 1);
     }
+    // Declares `id` (an error at n if it is taken).
+    void name(const XmlSource& xml, const pugi::xml_node& n, const std::string& id, const std::string& kind, std::any value);
+    // The object a <ref id> names, which must be of kind `expected` (the error lists what the id is).
+    const NamedObject& resolve(const XmlSource& xml, const pugi::xml_node& ref, const std::string& expected) const;
 };
 
 void read_integrator(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b);  // read_integrator.cpp
+// moment and aov (their PluginInfo, for the plugin reference).
+std::vector<PluginInfo> integrator_wrapper_plugins();
+// "a, b c" -> {"a", "b", "c"} (commas and spaces separate).
+std::vector<std::string> split_list(const std::string& text);
 void read_sensor(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b);      // read_sensor.cpp (film, sampler)
 // The camera and film of a file without a <sensor>: the plugins' defaults.
 void use_default_sensor(SceneBuilder& b);
-Material read_bsdf(XmlSource& xml, const pugi::xml_node& n);                     // read_bsdf.cpp
+// A <bsdf> element, or a <ref> to one (nested BSDFs of twosided, blendbsdf, mask may be refs).
+Material read_bsdf(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b);   // read_bsdf.cpp
 void read_named_bsdf(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b);
 void read_shape(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b);       // read_shape.cpp
+std::vector<PluginInfo> group_shape_plugins();  // shapegroup, instance
 void read_free_emitter(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b);  // read_emitter.cpp
 
 }  // namespace pathlab

@@ -2,21 +2,34 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <set>
 
 #include <fmt/format.h>
+
+#include "core/spectrum.hpp"
 
 namespace pathlab {
 namespace {
 
 // Property element names (the value types of plugin parameters).
-const std::set<std::string> kPropertyTags = {"float", "integer", "boolean", "string", "rgb",
-                                             "spectrum", "point", "vector", "transform"};
+const std::set<std::string> kPropertyTags = {"float", "integer", "boolean", "string", "rgb",    "spectrum",
+                                             "point", "vector",  "transform", "srgb",   "blackbody"};
+
+std::string rgb_text(const Vec3d& c) { return fmt::format("{}, {}, {}", float(c.x), float(c.y), float(c.z)); }
+
+// sRGB's transfer function, decoded (Mitsuba 0.6's <srgb>).
+double srgb_to_linear(double v) { return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4); }
 
 }  // namespace
 
 XmlSource::XmlSource(const std::string& text, std::string file, SceneDefines defines)
-    : text_(text), file_(std::move(file)), defines_(std::move(defines)) {
+    : XmlSource(text, std::move(file), std::make_shared<LoadContext>(LoadContext{std::move(defines)})) {}
+
+XmlSource::XmlSource(const std::string& text, std::string file, std::shared_ptr<LoadContext> context)
+    : text_(text), file_(std::move(file)), context_(std::move(context)) {
     line_starts_.push_back(0);
     for (size_t i = 0; i < text_.size(); ++i)
         if (text_[i] == '\n') line_starts_.push_back(i + 1);
@@ -70,8 +83,8 @@ std::string XmlSource::substitute(const pugi::xml_node& n, const std::string& va
         while (j < value.size() && (std::isalnum(static_cast<unsigned char>(value[j])) || value[j] == '_')) ++j;
         const std::string name = value.substr(i + 1, j - i - 1);
         if (name.empty()) fail(n, fmt::format("'$' must be followed by a parameter name in \"{}\"", value));
-        const auto it = defines_.find(name);
-        if (it == defines_.end())
+        const auto it = context_->defines.find(name);
+        if (it == context_->defines.end())
             fail(n, fmt::format("undefined parameter ${} (define it with <default name=\"{}\" value=\"...\"/> or -D {}=...)", name,
                                 name, name));
         out += it->second;
@@ -98,7 +111,44 @@ void XmlSource::define(const pugi::xml_node& n) {
     if (name.empty() ||
         !std::all_of(name.begin(), name.end(), [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }))
         fail(n, fmt::format("invalid parameter name '{}'", name));
-    defines_.emplace(name, attr(n, "value"));  // -D values (already present) win
+    context_->defines.emplace(name, attr(n, "value"));  // -D values (and earlier <default>s) win
+}
+
+std::string XmlSource::dir() const {
+    const std::filesystem::path p(file_);
+    return p.has_parent_path() ? p.parent_path().string() : context_->scene_dir;
+}
+
+std::vector<std::string> XmlSource::search_dirs() const {
+    std::vector<std::string> dirs{dir()};
+    for (const std::string& d : context_->search_paths) dirs.push_back(d);
+    dirs.push_back(context_->scene_dir);
+    std::vector<std::string> unique;
+    for (const std::string& d : dirs)
+        if (std::find(unique.begin(), unique.end(), d) == unique.end()) unique.push_back(d);
+    return unique;
+}
+
+std::string XmlSource::find_file(const pugi::xml_node& n, const std::string& name, const char* what) const {
+    if (!context_->allow_files) fail(n, fmt::format("this loader does not read files ({} '{}')", what, name));
+    if (name.empty()) fail(n, fmt::format("an empty {} name", what));
+    const std::filesystem::path p(name);
+    std::error_code ec;
+    if (p.is_absolute()) {
+        if (!std::filesystem::exists(p, ec)) fail(n, fmt::format("{} '{}' does not exist", what, name));
+        return name;
+    }
+    const std::vector<std::string> dirs = search_dirs();
+    for (const std::string& d : dirs) {
+        const std::filesystem::path candidate = std::filesystem::path(d) / p;
+        if (std::filesystem::exists(candidate, ec)) return candidate.string();
+    }
+    fail(n, fmt::format("cannot find {} '{}' (searched: {})", what, name, fmt::join(dirs, ", ")));
+}
+
+void XmlSource::note(const pugi::xml_node& n, const std::string& message) const {
+    const SourceLocation w = where(n);
+    context_->notes.push_back(fmt::format("{}:{}:{}: note: {}", w.file, w.line, w.column, message));
 }
 
 double XmlSource::parse_number(const pugi::xml_node& n, const std::string& s) const {
@@ -193,6 +243,9 @@ Properties XmlSource::properties(const pugi::xml_node& plugin_node, const Plugin
             v.xyz = {parse_float(c, attr(c, "x")), parse_float(c, attr(c, "y")), parse_float(c, attr(c, "z"))};
             v.xyz_given = true;
             v.text = "x y z";
+        } else if (v.tag == "spectrum" || v.tag == "srgb" || v.tag == "blackbody") {
+            v.text = spectrum_value(c, plugin);
+            if (v.tag != "spectrum") v.tag = "rgb";
         } else {
             v.text = attr(c, "value");
             // Numbers and lists are checked here, where the element is, whatever reads them.
@@ -207,6 +260,80 @@ Properties XmlSource::properties(const pugi::xml_node& plugin_node, const Plugin
         }
     }
     return p;
+}
+
+std::string XmlSource::spectrum_value(const pugi::xml_node& c, const PluginInfo& plugin) const {
+    const std::string tag = c.name(), name = attr(c, "name");
+    // Mitsuba's RGB mode: an emitter's spectrum is an illuminant; an index of refraction is
+    // unbounded; anything else is a reflectance under D65 (core/spectrum.hpp).
+    const bool emitter = plugin.kind == "emitter";
+    const bool unbounded = name == "eta" || name == "k" || name == "int_ior" || name == "ext_ior" || name == "intIOR" || name == "extIOR";
+    const SpectrumUse use = emitter ? SpectrumUse::Illuminant : unbounded ? SpectrumUse::Unbounded : SpectrumUse::Reflectance;
+    const auto convert = [&](const SampledSpectrum& s) {
+        bool clamped = false;
+        const Vec3d rgb = spectrum_to_linear_srgb(s, use, &clamped);
+        if (clamped) note(c, fmt::format("the spectrum's sRGB colour was out of gamut and is clamped to {}", rgb_text(rgb)));
+        return rgb_text(rgb);
+    };
+    if (tag == "srgb") {  // Mitsuba 0.6: gamma-encoded sRGB, as numbers or #rrggbb
+        check_attributes(c, {"name", "value"});
+        std::string value = attr(c, "value");
+        Vec3d rgb;
+        if (!value.empty() && value[0] == '#') {
+            const auto hex = [&](size_t i) {
+                const std::string h = value.substr(i, 2);
+                if (h.size() != 2 || !std::isxdigit(static_cast<unsigned char>(h[0])) || !std::isxdigit(static_cast<unsigned char>(h[1])))
+                    fail(c, fmt::format("'{}' is not a colour #rrggbb", value));
+                return std::stoi(h, nullptr, 16) / 255.0;
+            };
+            if (value.size() != 7) fail(c, fmt::format("'{}' is not a colour #rrggbb", value));
+            rgb = {hex(1), hex(3), hex(5)};
+        } else {
+            rgb = Vec3d(parse_vec3(c, value, true));
+        }
+        for (int i = 0; i < 3; ++i) rgb[i] = srgb_to_linear(rgb[i]);
+        return rgb_text(rgb);
+    }
+    if (tag == "blackbody") {  // Mitsuba 0.6: <blackbody name temperature="5000K" scale="1"/>
+        check_attributes(c, {"name", "temperature", "scale", "multiplier"});
+        std::string t = attr(c, "temperature");
+        if (!t.empty() && (t.back() == 'K' || t.back() == 'k')) t.pop_back();
+        const double kelvin = parse_number(c, t);
+        if (!(kelvin >= 100 && kelvin <= 1e6)) fail(c, fmt::format("a black body's temperature must be 100 K to 1e6 K, got {}", kelvin));
+        double scale = 1;
+        if (c.attribute("scale")) scale = parse_number(c, attr(c, "scale"));
+        if (c.attribute("multiplier")) scale = parse_number(c, attr(c, "multiplier"));
+        if (!(scale >= 0)) fail(c, "a black body's scale must not be negative");
+        SampledSpectrum s = blackbody_spectrum(kelvin);
+        for (double& v : s.values) v *= scale;
+        return convert(s);
+    }
+    check_attributes(c, {"name", "value", "filename"});
+    SampledSpectrum s;
+    if (c.attribute("filename")) {
+        if (c.attribute("value")) fail(c, "a <spectrum> has a value or a filename, not both");
+        const std::string path = find_file(c, attr(c, "filename"), "spectrum file");
+        std::ifstream in(path, std::ios::binary);
+        std::error_code ec;
+        if (!in || !std::filesystem::is_regular_file(path, ec)) fail(c, fmt::format("cannot read the spectrum file '{}'", path));
+        std::string text;
+        text.resize(std::min<uint64_t>(std::filesystem::file_size(path, ec), 1 << 24));
+        in.read(text.data(), std::streamsize(text.size()));
+        const std::string why = parse_spectrum_file(text, s);
+        if (!why.empty()) fail(c, fmt::format("spectrum file '{}': {}", path, why));
+        return convert(s);
+    }
+    const std::string value = attr(c, "value");
+    if (value.find(':') == std::string::npos) {
+        const float v = parse_float(c, value);
+        // Mitsuba 3 turns an emitter's uniform spectrum into the sRGB of illuminant E (a flat
+        // spectrum); Mitsuba 0.6 kept it grey.
+        if (emitter && context_->version_major >= 3) return rgb_text(xyz_to_linear_srgb(Vec3d(1.0)) * double(v));
+        return value;
+    }
+    const std::string why = parse_spectrum_pairs(value, s);
+    if (!why.empty()) fail(c, why);
+    return convert(s);
 }
 
 std::vector<pugi::xml_node> XmlSource::plugin_children(const pugi::xml_node& n) const {

@@ -7,6 +7,7 @@
 
 #include <initializer_list>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -15,13 +16,37 @@
 
 namespace pathlab {
 
+// What every file of one load shares (the main file and its <include>s): the $name values, the
+// folders that file names are searched in, whether files may be read at all, the scene's
+// version, and the notes about what was accepted but ignored.
+struct LoadContext {
+    SceneDefines defines;
+    std::vector<std::string> search_paths;  // <path> folders, the latest first
+    std::string scene_dir = ".";            // the main file's folder, searched last
+    bool allow_files = true;
+    int version_major = 3, version_minor = 0;  // <scene version>: 0.5 to 3.x
+    std::vector<std::string> notes;         // "file:line:column: note: ..."
+};
+
 class XmlSource {
 public:
     XmlSource(const std::string& text, std::string file, SceneDefines defines);
+    XmlSource(const std::string& text, std::string file, std::shared_ptr<LoadContext> context);
 
     // The document's root element (parsing errors are SceneFileErrors).
     pugi::xml_node root();
     const std::string& file() const { return file_; }
+    // The folder of this file (relative names in it are searched there first).
+    std::string dir() const;
+    LoadContext& context() const { return *context_; }
+    // A file a scene refers to: an absolute name, or the first that exists of this file's
+    // folder, the <path> folders (the latest first) and the main scene file's folder. Fails at
+    // `n` naming the folders searched; with files disabled (the fuzzer) fails too.
+    std::string find_file(const pugi::xml_node& n, const std::string& name, const char* what) const;
+    // The folders find_file searches, in order.
+    std::vector<std::string> search_dirs() const;
+    // A note (printed by the command line): something accepted and ignored, or changed.
+    void note(const pugi::xml_node& n, const std::string& message) const;
 
     // ---- errors: at an element's '<', or an offset -----------------------------------------
     [[noreturn]] void fail(const pugi::xml_node& n, const std::string& message) const;
@@ -51,12 +76,14 @@ public:
     [[noreturn]] static void rethrow(const PropertyError& e);
 
 private:
+    // A <spectrum>, <srgb> or <blackbody> as the text of an rgb value.
+    std::string spectrum_value(const pugi::xml_node& c, const PluginInfo& plugin) const;
     std::string substitute(const pugi::xml_node& n, const std::string& value) const;
     Vec3f xyz_default(const pugi::xml_node& n, float fallback) const;
 
     const std::string& text_;
     std::string file_;
-    SceneDefines defines_;
+    std::shared_ptr<LoadContext> context_;
     std::vector<size_t> line_starts_;
     pugi::xml_document doc_;
 };

@@ -102,7 +102,8 @@ void Bdpt::random_walk(const RenderContext& ctx, Ray ray, Sampler& sampler, Rgb 
     }
 }
 
-void Bdpt::camera_subpath(const RenderContext& ctx, size_t pixel, Sampler& sampler, std::vector<PathVertex>& path) const {
+void Bdpt::camera_subpath(const RenderContext& ctx, size_t pixel, Sampler& sampler, std::vector<PathVertex>& path,
+                          const Vec2f* shift) const {
     path.clear();
     PathVertex c;
     c.kind = VertexKind::Camera;
@@ -110,7 +111,7 @@ void Bdpt::camera_subpath(const RenderContext& ctx, size_t pixel, Sampler& sampl
     c.beta = Rgb(1.0f);
     c.pdf_fwd = 1;
     path.push_back(c);
-    const Vec2f jitter = sampler.next2d();
+    const Vec2f jitter = shift ? (sampler.next2d(), *shift) : sampler.next2d();
     const float x = float(pixel % size_t(ctx.width)), y = float(pixel / size_t(ctx.width));
     const Ray ray = ctx.camera.generate(x + jitter.x, y + jitter.y);
     // We cos / (pdfA pdfW) = 1 for the pinhole: the camera path starts with throughput 1.
@@ -279,6 +280,8 @@ PassCounters Bdpt::render_passes(const RenderContext& ctx, Film& film, uint64_t 
     for (int k = 0; k < count; ++k) {
         const uint64_t pass = first + uint64_t(k);
         pass_.begin(pixels, chunks);
+        const bool filtered = ctx.filter && !ctx.filter->is_box();
+        const Vec2f shift = filtered ? filter_shift(ctx, pass) : Vec2f(0.0f, 0.0f);
         if (strategies_) strategies_->begin_pass(ctx.width, ctx.height, chunks);
         std::atomic<int> chunks_done{0};
         tbb::parallel_for(tbb::blocked_range<int>(0, chunks, 1), [&](const tbb::blocked_range<int>& range) {
@@ -291,7 +294,7 @@ PassCounters Bdpt::render_passes(const RenderContext& ctx, Film& film, uint64_t 
                 for (size_t pixel = size_t(c) * per_chunk; pixel < std::min(pixels, size_t(c + 1) * per_chunk); ++pixel) {
                     Sampler camera_sampler(ctx.seed, pixel, pass, ctx.sampler);
                     Sampler light_sampler(ctx.seed, sample_stream(pixel, 1), pass, ctx.sampler);
-                    camera_subpath(ctx, pixel, camera_sampler, camera);
+                    camera_subpath(ctx, pixel, camera_sampler, camera, filtered ? &shift : nullptr);
                     light_subpath(ctx, light_sampler, light);
                     for_each_connection(
                         ctx, pixel, pass, light, camera, nullptr,
@@ -299,7 +302,8 @@ PassCounters Bdpt::render_passes(const RenderContext& ctx, Film& film, uint64_t 
                             const Rgb value = r.L * r.weight;
                             if (!is_finite(value)) return void(++chunk_invalid);
                             const uint32_t target = r.splat ? uint32_t(ctx.camera.pixel_of(r.raster)) : uint32_t(pixel);
-                            if (r.splat) splats.add(target, value);
+                            if (r.splat && filtered) splats.add_at(r.raster, value);
+                            else if (r.splat) splats.add(target, value);
                             else pass_.pixel(pixel) += Vec3d(value);
                             if (s + t - 2 <= strategies_depth)
                                 strategies_->chunk(c).push_back({target, uint16_t(StrategyImages::index(s, t)), value, r.L});
@@ -311,7 +315,7 @@ PassCounters Bdpt::render_passes(const RenderContext& ctx, Film& film, uint64_t 
                 if (progress) progress((double(k) + double(++chunks_done) / chunks) / count);
             }
         });
-        pass_.finish(film);
+        pass_.finish(film, ctx.filter, shift);
         if (strategies_) strategies_->finish_pass();
     }
     return {rays.load(), invalid.load()};
@@ -325,7 +329,7 @@ const IntegratorInfo& bdpt_integrator() {
     static const IntegratorInfo info{"bdpt", {"bpt"}, "bidirectional path tracing: every connection strategy (s, t), combined by MIS",
                                      false, true, path_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
                                          return std::make_unique<Bdpt>(o);
-                                     }};
+                                     }, false, true};
     return info;
 }
 

@@ -12,8 +12,8 @@
 // sampling, the balance heuristic by default or the power heuristic (`--mis power`), with the
 // weights computed by Veach's ratio walk over the densities stored on the vertices
 // (path_vertex.hpp), as pbrt formulates it. Dirac lobes (mirrors, glass, the coating of
-// plastic), delta lights (point, directional), the constant environment and one-sided emitters
-// each enter the densities as path_vertex.hpp says.
+// plastic), delta lights (point, spot, ies, directional), the environment (constant or a map)
+// and one-sided emitters each enter the densities as path_vertex.hpp says.
 //
 // Depth: a path of s + t vertices has s + t - 2 bounces, counted as the path tracers count
 // them, so `--max-depth` means the same and bdpt converges to pt-mis's image at every depth.
@@ -75,7 +75,9 @@ public:
     void finish(const RenderContext& ctx) override;
 
     // The subpaths of one sample (for the tests and the per-pixel loop).
-    void camera_subpath(const RenderContext& ctx, size_t pixel, Sampler& sampler, std::vector<PathVertex>& path) const;
+    // `shift`: with a reconstruction filter, the pass's lattice shift replaces the pixel's jitter.
+    void camera_subpath(const RenderContext& ctx, size_t pixel, Sampler& sampler, std::vector<PathVertex>& path,
+                        const Vec2f* shift = nullptr) const;
     void light_subpath(const RenderContext& ctx, Sampler& sampler, std::vector<PathVertex>& path) const;
     // Strategy (s, t) on the subpaths (which it may modify temporarily); `vm`: the merging
     // strategies that also take part in its MIS weight (vcm).
@@ -101,6 +103,7 @@ public:
                 const int depth = s + t - 2;
                 if ((s == 1 && t == 1) || depth < 0 || depth > max_bounces_) continue;
                 if (options_.only_length >= 0 && depth != options_.only_length) continue;
+                if (options_.hide_emitters && depth == 0) continue;
                 const StrategyResult r = connect(ctx, light, s, camera, t, sampler, vm);
                 if (!is_black(r.L)) strategy(s, t, r);
             }

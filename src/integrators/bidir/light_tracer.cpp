@@ -11,12 +11,14 @@
 namespace pathlab {
 namespace {
 
-void splat(SplatList& out, const PerspectiveCamera& camera, const Vec2f& raster, const Rgb& value, uint64_t& invalid) {
+void splat(SplatList& out, const RenderContext& ctx, const Vec2f& raster, const Rgb& value, uint64_t& invalid) {
     if (!is_finite(value)) {
         ++invalid;
         return;
     }
-    if (!is_black(value)) out.add(uint32_t(camera.pixel_of(raster)), value);
+    if (is_black(value)) return;
+    if (ctx.filter && !ctx.filter->is_box()) out.add_at(raster, value);
+    else out.add(uint32_t(ctx.camera.pixel_of(raster)), value);
 }
 
 }  // namespace
@@ -33,11 +35,12 @@ void LightTracer::trace(const RenderContext& ctx, Sampler& sampler, SplatList& o
     const uint32_t flags = light_flags(light);
 
     // Paths of no bounce: the emitter seen by the camera.
-    if (flags & kLightSurface) {
+    if (hide_emitters_) {
+    } else if (flags & kLightSurface) {
         if (const auto k = camera.connect(es->origin)) {
             const float cos_light = dot(es->normal, k->wi);
             if (cos_light > 0 && !scene.occluded(spawn_segment(es->origin, es->normal, camera.position(), Vec3f(0.0f))))
-                splat(out, camera, k->raster, es->Le * (cos_light * k->We / (choice.pmf * es->pdfA * k->pdfW)), invalid);
+                splat(out, ctx, k->raster, es->Le * (cos_light * k->We / (choice.pmf * es->pdfA * k->pdfW)), invalid);
         }
     } else if ((flags & kLightInfinite) && !(flags & kLightDeltaDirection)) {
         const Vec2f u = sampler.next2d();
@@ -45,7 +48,7 @@ void LightTracer::trace(const RenderContext& ctx, Sampler& sampler, SplatList& o
             const auto raster = camera.raster_of(ls->wi);
             if (raster && ls->pdfW > 0 && !scene.occluded(Ray{camera.position(), ls->wi, kInf})) {
                 const float cos_lens = dot(ls->wi, camera.forward());
-                splat(out, camera, *raster, ls->Le * (camera.We(ls->wi) * cos_lens / (choice.pmf * ls->pdfW)), invalid);
+                splat(out, ctx, *raster, ls->Le * (camera.We(ls->wi) * cos_lens / (choice.pmf * ls->pdfW)), invalid);
             }
         }
     }
@@ -68,7 +71,7 @@ void LightTracer::trace(const RenderContext& ctx, Sampler& sampler, SplatList& o
                 const Rgb f = m.eval(sp, sp.wi, wo);
                 const float camera_pdf = faults_.drop_camera_geometry ? 1.0f : k->pdfW;
                 if (!is_black(f) && !scene.occluded(spawn_segment(sp.p, sp.ng, camera.position(), Vec3f(0.0f))))
-                    splat(out, camera, k->raster, power * beta * f * (std::abs(wo.z) * k->We / camera_pdf), invalid);
+                    splat(out, ctx, k->raster, power * beta * f * (std::abs(wo.z) * k->We / camera_pdf), invalid);
             }
         }
         if (!rules_.may_bounce(bounces)) return;
@@ -104,7 +107,7 @@ PassCounters LightTracer::render_passes(const RenderContext& ctx, Film& film, ui
                 if (progress) progress((double(k) + double(++chunks_done) / chunks) / count);
             }
         });
-        pass_.finish(film);
+        pass_.finish(film, ctx.filter, Vec2f(0.0f, 0.0f));
     }
     return {rays.load(), invalid.load()};
 }
@@ -113,7 +116,7 @@ const IntegratorInfo& light_tracer_integrator() {
     static const IntegratorInfo info{"lt", {"ptracer"}, "light tracing: paths from the lights, every vertex connected to the camera",
                                      false, false, path_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
                                          return std::make_unique<LightTracer>(o);
-                                     }};
+                                     }, false, true};
     return info;
 }
 

@@ -34,7 +34,8 @@ struct LightTracerFaults {
 
 class LightTracer final : public Integrator {
 public:
-    explicit LightTracer(const IntegratorOptions& options, LightTracerFaults faults = {}) : rules_(options), faults_(faults) {}
+    explicit LightTracer(const IntegratorOptions& options, LightTracerFaults faults = {})
+        : rules_(options), faults_(faults), hide_emitters_(options.hide_emitters) {}
 
     PassCounters render_passes(const RenderContext& ctx, Film& film, uint64_t first, int count,
                                const PassProgress& progress) override;
@@ -49,6 +50,7 @@ public:
 private:
     PathRules rules_;
     LightTracerFaults faults_;
+    bool hide_emitters_ = false;
     PassImage pass_;
 };
 

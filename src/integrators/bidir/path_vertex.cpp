@@ -66,8 +66,7 @@ float pdf_light_origin(const Scene& scene, const PathVertex& v, const PathVertex
     const Light& light = scene.lights()[size_t(v.light)];
     if (v.infinite) {
         // Light sampling picks directions at infinity: only the environment has a density.
-        if (const auto* env = std::get_if<EnvironmentLight>(&light)) return scene.light_pmf(v.light) * env->pdf_li(v.dir);
-        return 0.0f;
+        return is_environment(light) ? scene.light_pmf(v.light) * environment_pdf_li(light, v.dir) : 0.0f;
     }
     const Vec3f w = normalize(from.p - v.p);
     return scene.light_pmf(v.light) * pdf_emission(light, v.p, v.emitter_n, w, scene.scene_sphere()).pdfA;

@@ -6,6 +6,7 @@
 //       as pt-mis continues a path.
 // Elsewhere (other materials, mirrors and glass first, everything after the first hit) it is
 // pt-mis. E_indirect excludes light arriving straight from emitters (the direct light's).
+// hide_emitters leaves out the paths of no bounce (emitters and the environment seen directly).
 #pragma once
 
 #include "integrators/common/direct_lighting.hpp"
@@ -22,11 +23,11 @@ inline const PhongMaterial* cached_diffuse(const ShadingPoint& sp) {
 
 // indirect_irradiance(sp, sampler) returns E_indirect at the first hit sp.
 template <typename IndirectIrradiance>
-Rgb first_hit_radiance(const Scene& scene, const Ray& ray, Sampler& sampler, const PathRules& rules,
+Rgb first_hit_radiance(const Scene& scene, const Ray& ray, Sampler& sampler, const PathRules& rules, bool hide_emitters,
                        IndirectIrradiance&& indirect_irradiance) {
     Intersection hit;
-    if (!scene.intersect(ray, hit)) return scene.escaped_radiance(ray.d);
-    Rgb L = emitted_radiance(scene, hit, -ray.d);
+    if (!scene.intersect(ray, hit)) return hide_emitters ? Rgb(0.0f) : scene.escaped_radiance(ray.d);
+    Rgb L = hide_emitters ? Rgb(0.0f) : emitted_radiance(scene, hit, -ray.d);
     const ShadingPoint sp = make_shading_point(scene, hit, ray.d);
     const PhongMaterial* phong = sp.material->is_black() ? nullptr : cached_diffuse(sp);
     if (!phong) return pt_mis_from_hit(scene, hit, ray.d, 0, sampler, rules, false, -1, L);

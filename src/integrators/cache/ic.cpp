@@ -117,7 +117,7 @@ void IrradianceCaching::prepare(const RenderContext& ctx, const PassProgress& pr
 }
 
 Rgb IrradianceCaching::radiance(const Scene& scene, const Ray& ray, Sampler& sampler) const {
-    return first_hit_radiance(scene, ray, sampler, rules_,
+    return first_hit_radiance(scene, ray, sampler, rules_, options_.hide_emitters,
                               [&](const ShadingPoint& sp, Sampler& s) { return indirect_irradiance(scene, sp, s); });
 }
 
@@ -169,7 +169,7 @@ const IntegratorInfo& ic_integrator() {
     static const IntegratorInfo info{"ic", {"irrcache"}, "irradiance caching with gradients (Ward): cached indirect diffuse light at first hits, pt-mis elsewhere",
                                      false, true, ic_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
                                          return std::make_unique<IrradianceCaching>(o);
-                                     }};
+                                     }, false, true};
     return info;
 }
 

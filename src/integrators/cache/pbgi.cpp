@@ -127,9 +127,9 @@ Rgb PointBasedGi::indirect_irradiance(const ShadingPoint& sp, const Vec3f& d) co
 Rgb PointBasedGi::radiance(const Scene& scene, const Ray& ray, Sampler& sampler) const {
     if (tree_.surfels().empty()) {
         // Not prepared (or direct light only): no indirect diffuse light from the cloud.
-        return first_hit_radiance(scene, ray, sampler, rules_, [](const ShadingPoint&, Sampler&) { return Rgb(0.0f); });
+        return first_hit_radiance(scene, ray, sampler, rules_, options_.hide_emitters, [](const ShadingPoint&, Sampler&) { return Rgb(0.0f); });
     }
-    return first_hit_radiance(scene, ray, sampler, rules_, [&](const ShadingPoint& sp, Sampler&) { return indirect_irradiance(sp, ray.d); });
+    return first_hit_radiance(scene, ray, sampler, rules_, options_.hide_emitters, [&](const ShadingPoint& sp, Sampler&) { return indirect_irradiance(sp, ray.d); });
 }
 
 std::vector<IntegratorStatistic> PointBasedGi::statistics() const {
@@ -165,7 +165,7 @@ const IntegratorInfo& pbgi_integrator() {
     static const IntegratorInfo info{"pbgi", {}, "point-based global illumination (Christensen): indirect diffuse light at first hits gathered from a surfel octree, pt-mis elsewhere",
                                      false, true, pbgi_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
                                          return std::make_unique<PointBasedGi>(o);
-                                     }};
+                                     }, /*any_camera=*/false, /*any_filter=*/true};
     return info;
 }
 

@@ -53,7 +53,7 @@ inline EmitterHit trace_to_emitter(const Scene& scene, const Ray& ray, const Vec
         const int env = scene.environment_light();
         if (env >= 0) {
             e.Le = scene.escaped_radiance(ray.d);
-            e.pdf_light = scene.light_pmf(env) * std::get<EnvironmentLight>(scene.lights()[size_t(env)]).pdf_li(ray.d);
+            e.pdf_light = scene.light_pmf(env) * environment_pdf_li(scene.lights()[size_t(env)], ray.d);
         }
         return e;
     }

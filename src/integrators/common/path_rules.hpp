@@ -21,9 +21,13 @@ inline constexpr int kMaxBounces = 1024;
 // bounces: max_depth 2 is direct illumination, one bounce (the reader converts).
 inline std::vector<ParamInfo> path_params() {
     return {{"max_depth", ParamType::Integer, "-1",
-             "longest path in Mitsuba's convention: -1 unlimited, 2 direct light only (pathlab's bounces: max_depth - 1)"},
+             "longest path in Mitsuba's convention: -1 unlimited, 2 direct light only (pathlab's bounces: max_depth - 1)", "maxDepth"},
             {"rr_depth", ParamType::Integer, "4",
-             "path depth at which Russian roulette starts, Mitsuba's convention (pathlab's bounces: rr_depth - 1; --rr-depth wins)"}};
+             "path depth at which Russian roulette starts, Mitsuba's convention (pathlab's bounces: rr_depth - 1; --rr-depth wins)", "rrDepth"},
+            {"hide_emitters", ParamType::Boolean, "false", "emitters (and the environment) seen directly are black", "hideEmitters"},
+            {"samples_per_pass", ParamType::Integer, "-1",
+             "accepted and ignored (noted): pathlab adds one sample per pixel per pass and stops on --spp or --time", "samplesPerPass"},
+            {"strict_normals", ParamType::Boolean, "false", "accepted and ignored (noted): pathlab's shading-normal handling is its own", "strictNormals"}};
 }
 
 // The options with max_depth cut to only_length when only paths of that length count.

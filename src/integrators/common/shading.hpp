@@ -30,6 +30,7 @@ inline ShadingPoint make_shading_point(const Scene& scene, const Intersection& h
     if (sp.material->two_sided && dot(ray_dir, hit.ng) > 0) {
         sp.ng = -sp.ng;
         ns = -ns;
+        if (sp.material->back >= 0) sp.material = &scene.material(uint32_t(sp.material->back));
     }
     sp.frame = Frame(ns);
     sp.wi = sp.frame.to_local(-ray_dir);

@@ -10,22 +10,26 @@ namespace {
 
 class DirectLight final : public PixelIntegrator {
 public:
+    explicit DirectLight(bool hide) : hide_(hide) {}
     Rgb radiance(const Scene& scene, const Ray& ray, Sampler& sampler) const override {
         Intersection hit;
-        if (!scene.intersect(ray, hit)) return scene.escaped_radiance(ray.d);
-        Rgb L = emitted_radiance(scene, hit, -ray.d);
+        if (!scene.intersect(ray, hit)) return hide_ ? Rgb(0.0f) : scene.escaped_radiance(ray.d);
+        Rgb L = hide_ ? Rgb(0.0f) : emitted_radiance(scene, hit, -ray.d);
         const ShadingPoint sp = make_shading_point(scene, hit, ray.d);
         if (sp.material->is_black()) return L;
         return L + estimate_light_sample(scene, sp, sampler, /*mis=*/false);
     }
+
+private:
+    bool hide_;
 };
 
 }  // namespace
 
 const IntegratorInfo& direct_light_integrator() {
     static const IntegratorInfo info{"direct-light", {"1"}, "direct illumination by light sampling (one light chosen by power)",
-                                     false, true, {}, [](const IntegratorOptions&) -> std::unique_ptr<Integrator> {
-                                         return std::make_unique<DirectLight>();
+                                     false, true, {{"hide_emitters", ParamType::Boolean, "false", "emitters (and the environment) seen directly are black", "hideEmitters"}}, [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
+                                         return std::make_unique<DirectLight>(o.hide_emitters);
                                      }};
     return info;
 }

@@ -11,12 +11,23 @@ namespace pathlab {
 
 namespace {
 
+// Mitsuba's direct: its sample counts must be 1 (one light and one BSDF sample per pass; more
+// passes take more), and 0.6's strictNormals is accepted with a note (read_integrator.cpp).
+std::vector<ParamInfo> direct_params() {
+    return {{"hide_emitters", ParamType::Boolean, "false", "emitters (and the environment) seen directly are black", "hideEmitters"},
+            {"shading_samples", ParamType::Integer, "1", "must be 1: pathlab takes one light and one BSDF sample per pixel sample (raise the spp instead)", "shadingSamples"},
+            {"emitter_samples", ParamType::Integer, "1", "must be 1 (as shading_samples)", "emitterSamples"},
+            {"bsdf_samples", ParamType::Integer, "1", "must be 1 (as shading_samples)", "bsdfSamples"},
+            {"strict_normals", ParamType::Boolean, "false", "accepted and ignored (noted): pathlab's shading-normal handling is its own", "strictNormals"}};
+}
+
 class DirectMis final : public PixelIntegrator {
 public:
+    explicit DirectMis(bool hide) : hide_(hide) {}
     Rgb radiance(const Scene& scene, const Ray& ray, Sampler& sampler) const override {
         Intersection hit;
-        if (!scene.intersect(ray, hit)) return scene.escaped_radiance(ray.d);
-        Rgb L = emitted_radiance(scene, hit, -ray.d);
+        if (!scene.intersect(ray, hit)) return hide_ ? Rgb(0.0f) : scene.escaped_radiance(ray.d);
+        Rgb L = hide_ ? Rgb(0.0f) : emitted_radiance(scene, hit, -ray.d);
         const ShadingPoint sp = make_shading_point(scene, hit, ray.d);
         if (sp.material->is_black()) return L;
         L += estimate_light_sample(scene, sp, sampler, /*mis=*/true);
@@ -27,14 +38,17 @@ public:
         }
         return L;
     }
+
+private:
+    bool hide_;
 };
 
 }  // namespace
 
 const IntegratorInfo& direct_mis_integrator() {
     static const IntegratorInfo info{"direct-mis", {"3", "direct"}, "light + BRDF sampling combined by MIS (balance heuristic)",
-                                     false, true, {}, [](const IntegratorOptions&) -> std::unique_ptr<Integrator> {
-                                         return std::make_unique<DirectMis>();
+                                     false, true, direct_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
+                                         return std::make_unique<DirectMis>(o.hide_emitters);
                                      }};
     return info;
 }

@@ -15,12 +15,12 @@ enum class Strategy { UniformHemisphere, CosineHemisphere, Brdf };
 
 class DirectBySampling final : public PixelIntegrator {
 public:
-    explicit DirectBySampling(Strategy s) : strategy_(s) {}
+    DirectBySampling(Strategy s, bool hide) : strategy_(s), hide_(hide) {}
 
     Rgb radiance(const Scene& scene, const Ray& ray, Sampler& sampler) const override {
         Intersection hit;
-        if (!scene.intersect(ray, hit)) return scene.escaped_radiance(ray.d);
-        Rgb L = emitted_radiance(scene, hit, -ray.d);
+        if (!scene.intersect(ray, hit)) return hide_ ? Rgb(0.0f) : scene.escaped_radiance(ray.d);
+        Rgb L = hide_ ? Rgb(0.0f) : emitted_radiance(scene, hit, -ray.d);
         const ShadingPoint sp = make_shading_point(scene, hit, ray.d);
         if (sp.material->is_black()) return L;
 
@@ -53,28 +53,29 @@ public:
 
 private:
     Strategy strategy_;
+    bool hide_;
 };
 
 }  // namespace
 
 const IntegratorInfo& direct_uniform_integrator() {
-    static const IntegratorInfo info{"direct-uniform", {"2a"}, "direct illumination by uniform hemisphere sampling", true, true, {},
-                                     [](const IntegratorOptions&) -> std::unique_ptr<Integrator> {
-                                         return std::make_unique<DirectBySampling>(Strategy::UniformHemisphere);
+    static const IntegratorInfo info{"direct-uniform", {"2a"}, "direct illumination by uniform hemisphere sampling", true, true, {{"hide_emitters", ParamType::Boolean, "false", "emitters (and the environment) seen directly are black", "hideEmitters"}},
+                                     [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
+                                         return std::make_unique<DirectBySampling>(Strategy::UniformHemisphere, o.hide_emitters);
                                      }};
     return info;
 }
 const IntegratorInfo& direct_cosine_integrator() {
     static const IntegratorInfo info{"direct-cosine", {"2b"}, "direct illumination by cosine-weighted hemisphere sampling", true,
-                                     true, {}, [](const IntegratorOptions&) -> std::unique_ptr<Integrator> {
-                                         return std::make_unique<DirectBySampling>(Strategy::CosineHemisphere);
+                                     true, {{"hide_emitters", ParamType::Boolean, "false", "emitters (and the environment) seen directly are black", "hideEmitters"}}, [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
+                                         return std::make_unique<DirectBySampling>(Strategy::CosineHemisphere, o.hide_emitters);
                                      }};
     return info;
 }
 const IntegratorInfo& direct_brdf_integrator() {
-    static const IntegratorInfo info{"direct-brdf", {"2c"}, "direct illumination by BRDF importance sampling", true, true, {},
-                                     [](const IntegratorOptions&) -> std::unique_ptr<Integrator> {
-                                         return std::make_unique<DirectBySampling>(Strategy::Brdf);
+    static const IntegratorInfo info{"direct-brdf", {"2c"}, "direct illumination by BRDF importance sampling", true, true, {{"hide_emitters", ParamType::Boolean, "false", "emitters (and the environment) seen directly are black", "hideEmitters"}},
+                                     [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
+                                         return std::make_unique<DirectBySampling>(Strategy::Brdf, o.hide_emitters);
                                      }};
     return info;
 }

@@ -59,7 +59,7 @@ namespace {
 class PtMis final : public PixelIntegrator {
 public:
     PtMis(const IntegratorOptions& o, bool separate_continuation)
-        : rules_(limited_to_length(o)), three_rays_(separate_continuation), only_length_(o.only_length) {}
+        : rules_(limited_to_length(o)), three_rays_(separate_continuation), only_length_(o.only_length), hide_(o.hide_emitters) {}
 
     Rgb radiance(const Scene& scene, const Ray& camera_ray, Sampler& sampler) const override {
         Intersection hit;
@@ -69,11 +69,12 @@ public:
     }
 
 private:
-    bool counts(int length) const { return only_length_ < 0 || only_length_ == length; }
+    bool counts(int length) const { return (only_length_ < 0 || only_length_ == length) && !(hide_ && length == 0); }
 
     PathRules rules_;
     bool three_rays_;
     int only_length_;
+    bool hide_;
 };
 
 }  // namespace

@@ -12,15 +12,16 @@ namespace {
 
 class PtNaive final : public PixelIntegrator {
 public:
-    explicit PtNaive(const IntegratorOptions& o) : rules_(o) {}
+    explicit PtNaive(const IntegratorOptions& o) : rules_(o), hide_(o.hide_emitters) {}
 
     Rgb radiance(const Scene& scene, const Ray& camera_ray, Sampler& sampler) const override {
         Rgb L(0.0f), beta(1.0f);
         Ray ray = camera_ray;
         for (int bounces = 0;; ++bounces) {
             Intersection hit;
-            if (!scene.intersect(ray, hit)) return L + beta * scene.escaped_radiance(ray.d);
-            L += beta * emitted_radiance(scene, hit, -normalize(ray.d));
+            const bool seen = bounces > 0 || !hide_;
+            if (!scene.intersect(ray, hit)) return seen ? L + beta * scene.escaped_radiance(ray.d) : L;
+            if (seen) L += beta * emitted_radiance(scene, hit, -normalize(ray.d));
             const ShadingPoint sp = make_shading_point(scene, hit, normalize(ray.d));
             if (sp.material->is_black() || !rules_.may_bounce(bounces)) return L;
             const auto s = sp.material->sample(sp, sp.wi, sampler.next2d());
@@ -33,6 +34,7 @@ public:
 
 private:
     PathRules rules_;
+    bool hide_;
 };
 
 }  // namespace

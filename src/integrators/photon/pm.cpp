@@ -85,7 +85,9 @@ Rgb PhotonMapper::estimate(const PhotonKdTree& map, size_t k, const ShadingPoint
 }
 
 Rgb PhotonMapper::radiance(const Scene& scene, const Ray& camera_ray, Sampler& sampler) const {
-    const auto counts = [&](int length) { return options_.only_length < 0 || options_.only_length == length; };
+    const auto counts = [&](int length) {
+        return (options_.only_length < 0 || options_.only_length == length) && !(options_.hide_emitters && length == 0);
+    };
     Rgb L(0.0f);
     const auto x = trace_to_visible_point(scene, camera_ray, sampler, max_bounces_, kMaxDiracChain, counts, L);
     if (!x) return L;
@@ -120,7 +122,7 @@ Rgb PhotonMapper::radiance(const Scene& scene, const Ray& camera_ray, Sampler& s
 }
 
 const IntegratorInfo& pm_integrator() {
-    static const IntegratorInfo info{"pm", {}, "photon mapping (Jensen): global and caustic maps, k-nearest estimates, final gathering", false,
+    static const IntegratorInfo info{"pm", {"photonmapper"}, "photon mapping (Jensen): global and caustic maps, k-nearest estimates, final gathering", false,
                                      true,
                                      [] {
                                          std::vector<ParamInfo> p = path_params();

@@ -62,7 +62,9 @@ Rgb Sppm::camera_sample(const RenderContext& ctx, size_t pixel, uint64_t pass, f
     const float px = float(pixel % size_t(ctx.width)), py = float(pixel / size_t(ctx.width));
     Ray ray = ctx.camera.generate(px + jitter.x, py + jitter.y);
     Rgb L(0.0f);
-    const auto counts = [&](int length) { return options_.only_length < 0 || options_.only_length == length; };
+    const auto counts = [&](int length) {
+        return (options_.only_length < 0 || options_.only_length == length) && !(options_.hide_emitters && length == 0);
+    };
     const auto x = trace_to_visible_point(scene, ray, sampler, max_bounces_, max_bounces_ + 1, counts, L);
     if (!x) return L;
     const ShadingPoint& sp = x->sp;
@@ -131,7 +133,7 @@ std::vector<ParamInfo> progressive_photon_params() {
 const IntegratorInfo& sppm_integrator() {
     static const IntegratorInfo info{
         "sppm", {}, "stochastic progressive photon mapping (Knaus-Zwicker iterations): photons + next-event estimation", false, true,
-        progressive_photon_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> { return std::make_unique<Sppm>(o); }};
+        progressive_photon_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> { return std::make_unique<Sppm>(o); }, false, false};
     return info;
 }
 
@@ -140,7 +142,7 @@ const IntegratorInfo& ppm_integrator() {
         "ppm", {}, "progressive photon mapping (Hachisuka 2008): fixed hit points through the pixel centres, photon passes, shrinking radius",
         false, true, progressive_photon_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
             return std::make_unique<Sppm>(o, SppmFaults{}, CameraRays::PixelCentres);
-        }};
+        }, false, false};
     return info;
 }
 

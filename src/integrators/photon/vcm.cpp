@@ -138,6 +138,8 @@ PassCounters Vcm::render_passes(const RenderContext& ctx, Film& film, uint64_t f
         if (vm.merging) grid_.build(photons_, r);
         if (progress) progress((double(k) + 0.25) / count);
         pass_.begin(pixels, chunks);
+        const bool filtered = ctx.filter && !ctx.filter->is_box();
+        const Vec2f shift = filtered ? filter_shift(ctx, pass) : Vec2f(0.0f, 0.0f);
         std::atomic<int> chunks_done{0};
         tbb::parallel_for(tbb::blocked_range<int>(0, chunks, 1), [&](const tbb::blocked_range<int>& range) {
             auto& [camera, light] = subpaths_.local();
@@ -147,12 +149,13 @@ PassCounters Vcm::render_passes(const RenderContext& ctx, Film& film, uint64_t f
                 SplatList& splats = pass_.chunk(c);
                 const auto add = [&](const Rgb& value, bool splat, const Vec2f& raster, size_t pixel) {
                     if (!is_finite(value)) return void(++chunk_invalid);
-                    if (splat) splats.add(uint32_t(ctx.camera.pixel_of(raster)), value);
+                    if (splat && filtered) splats.add_at(raster, value);
+                    else if (splat) splats.add(uint32_t(ctx.camera.pixel_of(raster)), value);
                     else pass_.pixel(pixel) += Vec3d(value);
                 };
                 for (size_t pixel = size_t(c) * per_chunk; pixel < std::min(pixels, size_t(c + 1) * per_chunk); ++pixel) {
                     Sampler camera_sampler(ctx.seed, pixel, pass, ctx.sampler);
-                    bdpt_.camera_subpath(ctx, pixel, camera_sampler, camera);
+                    bdpt_.camera_subpath(ctx, pixel, camera_sampler, camera, filtered ? &shift : nullptr);
                     // This pixel's light subpath, copied: connections modify it for a moment,
                     // while other threads read the stored one to merge.
                     const PathVertex* stored = chunk_vertices_[pixel / per_chunk].data() + path_begin_[pixel];
@@ -174,7 +177,7 @@ PassCounters Vcm::render_passes(const RenderContext& ctx, Film& film, uint64_t f
                 if (progress) progress((double(k) + 0.25 + 0.75 * double(++chunks_done) / chunks) / count);
             }
         });
-        pass_.finish(film);
+        pass_.finish(film, ctx.filter, shift);
     }
     return {rays.load(), invalid.load()};
 }
@@ -193,7 +196,7 @@ const IntegratorInfo& vcm_integrator() {
     static const IntegratorInfo info{"vcm", {}, "vertex connection and merging: bdpt's connections and photon merging, combined by MIS",
                                      false, true, vcm_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
                                          return std::make_unique<Vcm>(o);
-                                     }};
+                                     }, false, true};
     return info;
 }
 
@@ -203,7 +206,7 @@ const IntegratorInfo& bpm_integrator() {
                                          o.vcm_connections = false;
                                          o.vcm_merging = true;
                                          return std::make_unique<Vcm>(o);
-                                     }};
+                                     }, false, true};
     return info;
 }
 

@@ -1,0 +1,246 @@
+#include "geometry/mesh_files.hpp"
+
+#include <assimp/Importer.hpp>
+#include <assimp/mesh.h>
+#include <assimp/scene.h>
+#include <zlib.h>
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+#include <fmt/format.h>
+
+namespace pathlab {
+namespace {
+
+// Meshes larger than this are refused (a header claiming billions of vertices).
+constexpr uint64_t kMaxElements = uint64_t(1) << 28;
+
+void require_regular_file(const std::string& path) {
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec)) throw MeshLoadError(fmt::format("cannot read mesh '{}': no such file", path));
+    if (!std::filesystem::is_regular_file(path, ec)) throw MeshLoadError(fmt::format("cannot read mesh '{}': not a regular file", path));
+}
+
+void check_finite(const MeshDesc& m, const std::string& path) {
+    for (const Vec3f& p : m.positions)
+        if (!is_finite(p)) throw MeshLoadError(fmt::format("mesh '{}' has a non-finite vertex", path));
+    for (const Vec3f& n : m.normals)
+        if (!is_finite(n)) throw MeshLoadError(fmt::format("mesh '{}' has a non-finite normal", path));
+    for (const Vec2f& t : m.uvs)
+        if (!std::isfinite(t.x) || !std::isfinite(t.y)) throw MeshLoadError(fmt::format("mesh '{}' has a non-finite texture coordinate", path));
+    if (m.triangles.empty()) throw MeshLoadError(fmt::format("mesh '{}' has no faces", path));
+}
+
+}  // namespace
+
+MeshDesc load_ply_mesh(const std::string& path) {
+    require_regular_file(path);
+    Assimp::Importer importer;
+    // No post-processing: Assimp's own steps would triangulate differently, join identical
+    // vertices or reorder; the fan below is Mitsuba's.
+    const aiScene* scene = importer.ReadFile(path, 0);
+    if (!scene || !scene->mRootNode)
+        throw MeshLoadError(fmt::format("cannot read mesh '{}': {}", path, importer.GetErrorString()));
+    MeshDesc m;
+    m.name = path;
+    bool normals = true, uvs = true;
+    for (unsigned k = 0; k < scene->mNumMeshes; ++k) {
+        normals = normals && scene->mMeshes[k]->HasNormals();
+        uvs = uvs && scene->mMeshes[k]->HasTextureCoords(0);
+    }
+    for (unsigned k = 0; k < scene->mNumMeshes; ++k) {
+        const aiMesh* a = scene->mMeshes[k];
+        const uint32_t base = uint32_t(m.positions.size());
+        if (uint64_t(base) + a->mNumVertices > kMaxElements) throw MeshLoadError(fmt::format("mesh '{}' is too large", path));
+        for (unsigned v = 0; v < a->mNumVertices; ++v) {
+            m.positions.push_back({a->mVertices[v].x, a->mVertices[v].y, a->mVertices[v].z});
+            if (normals) m.normals.push_back({a->mNormals[v].x, a->mNormals[v].y, a->mNormals[v].z});
+            if (uvs) m.uvs.push_back({a->mTextureCoords[0][v].x, a->mTextureCoords[0][v].y});
+        }
+        for (unsigned f = 0; f < a->mNumFaces; ++f) {
+            const aiFace& face = a->mFaces[f];
+            for (unsigned i = 0; i < face.mNumIndices; ++i)
+                if (face.mIndices[i] >= a->mNumVertices) throw MeshLoadError(fmt::format("mesh '{}' refers to a vertex that does not exist", path));
+            for (unsigned i = 1; i + 1 < face.mNumIndices; ++i)
+                m.triangles.push_back({base + face.mIndices[0], base + face.mIndices[i], base + face.mIndices[i + 1]});
+        }
+    }
+    check_finite(m, path);
+    return m;
+}
+
+namespace {
+
+// The inflated bytes of one shape, read incrementally (never more than `limit` bytes).
+class Inflater {
+public:
+    Inflater(const unsigned char* data, size_t size, const std::string& path) : path_(path) {
+        std::memset(&z_, 0, sizeof z_);
+        if (inflateInit(&z_) != Z_OK) throw MeshLoadError(fmt::format("mesh '{}': zlib failed to start", path));
+        z_.next_in = const_cast<unsigned char*>(data);
+        z_.avail_in = uInt(std::min<size_t>(size, 0xffffffffu));
+    }
+    ~Inflater() { inflateEnd(&z_); }
+    void read(void* out, size_t bytes) {
+        z_.next_out = static_cast<unsigned char*>(out);
+        z_.avail_out = uInt(bytes);
+        while (z_.avail_out > 0) {
+            const int r = inflate(&z_, Z_NO_FLUSH);
+            if (r == Z_STREAM_END && z_.avail_out > 0) throw MeshLoadError(fmt::format("mesh '{}': the compressed data ends early", path_));
+            if (r != Z_OK && r != Z_STREAM_END) throw MeshLoadError(fmt::format("mesh '{}': corrupt compressed data (zlib error {})", path_, r));
+        }
+    }
+    template <typename T>
+    T get() {
+        T v;
+        read(&v, sizeof v);
+        return v;
+    }
+
+private:
+    z_stream z_;
+    std::string path_;
+};
+
+enum SerializedFlags : uint32_t {
+    kHasNormals = 0x0001,
+    kHasUvs = 0x0002,
+    kHasColors = 0x0008,
+    kFaceNormals = 0x0010,
+    kSinglePrecision = 0x1000,
+    kDoublePrecision = 0x2000,
+};
+
+}  // namespace
+
+MeshDesc load_serialized_mesh(const std::string& path, int shape_index) {
+    require_regular_file(path);
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw MeshLoadError(fmt::format("cannot read mesh '{}': cannot open the file", path));
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
+    const size_t size = bytes.size();
+    const auto bad = [&](const std::string& why) { return MeshLoadError(fmt::format("mesh '{}' is not a valid serialized file: {}", path, why)); };
+    if (size < 8) throw bad("too short");
+    uint16_t magic, version;
+    std::memcpy(&magic, data, 2);
+    std::memcpy(&version, data + 2, 2);
+    if (magic != 0x041C) throw bad("no 0x041C header");
+    if (version != 3 && version != 4) throw bad(fmt::format("format version {} (3 and 4 are read)", version));
+    // The end of the file: the shapes' offsets, then their count.
+    uint32_t count;
+    std::memcpy(&count, data + size - 4, 4);
+    const size_t offset_size = version == 4 ? 8 : 4;
+    if (count == 0 || count > (size - 4) / offset_size) throw bad(fmt::format("a shape count of {}", count));
+    if (shape_index < 0 || uint32_t(shape_index) >= count)
+        throw MeshLoadError(fmt::format("mesh '{}' has {} shapes (shape_index 0 to {}), not shape {}", path, count, count - 1, shape_index));
+    const size_t table = size - 4 - size_t(count) * offset_size;
+    const auto offset_of = [&](uint32_t i) -> uint64_t {
+        uint64_t o = 0;
+        std::memcpy(&o, data + table + size_t(i) * offset_size, offset_size);
+        return o;
+    };
+    const uint64_t begin = offset_of(uint32_t(shape_index));
+    const uint64_t end = uint32_t(shape_index) + 1 < count ? offset_of(uint32_t(shape_index) + 1) : table;
+    if (begin + 4 > end || end > table) throw bad(fmt::format("shape {}'s offset {} is outside the file", shape_index, begin));
+    uint16_t shape_magic, shape_version;
+    std::memcpy(&shape_magic, data + begin, 2);
+    std::memcpy(&shape_version, data + begin + 2, 2);
+    if (shape_magic != 0x041C || shape_version != version) throw bad(fmt::format("shape {} has no valid header", shape_index));
+
+    Inflater z(data + begin + 4, size_t(end - begin - 4), path);
+    const uint32_t flags = z.get<uint32_t>();
+    MeshDesc m;
+    if (version == 4) {
+        std::string name;
+        for (char c; (c = z.get<char>()) != 0;) {
+            if (name.size() > 4096) throw bad("a shape name longer than 4096 bytes");
+            name += c;
+        }
+        m.name = name;
+    }
+    const uint64_t vertices = z.get<uint64_t>(), triangles = z.get<uint64_t>();
+    if (vertices == 0 || triangles == 0 || vertices > kMaxElements || triangles > kMaxElements)
+        throw bad(fmt::format("{} vertices and {} triangles", vertices, triangles));
+    const bool dbl = (flags & kDoublePrecision) != 0;
+    if (dbl == ((flags & kSinglePrecision) != 0)) throw bad("neither (or both) single and double precision flagged");
+    const auto read_floats = [&](size_t n, float* out) {
+        if (!dbl) return z.read(out, n * sizeof(float));
+        std::vector<double> tmp(n);
+        z.read(tmp.data(), n * sizeof(double));
+        for (size_t i = 0; i < n; ++i) out[i] = float(tmp[i]);
+    };
+    m.positions.resize(size_t(vertices));
+    read_floats(size_t(vertices) * 3, &m.positions[0].x);
+    if (flags & kHasNormals) {
+        m.normals.resize(size_t(vertices));
+        read_floats(size_t(vertices) * 3, &m.normals[0].x);
+    }
+    if (flags & kHasUvs) {
+        m.uvs.resize(size_t(vertices));
+        read_floats(size_t(vertices) * 2, &m.uvs[0].x);
+    }
+    if (flags & kHasColors) {
+        std::vector<float> colors(size_t(vertices) * 3);
+        read_floats(colors.size(), colors.data());  // vertex colours: not used by pathlab
+    }
+    m.triangles.resize(size_t(triangles));
+    if (vertices > 0xffffffffull) {
+        std::vector<uint64_t> idx(size_t(triangles) * 3);
+        z.read(idx.data(), idx.size() * 8);
+        for (size_t i = 0; i < idx.size(); ++i) m.triangles[i / 3][i % 3] = uint32_t(idx[i]);
+    } else {
+        z.read(m.triangles.data(), size_t(triangles) * 12);
+    }
+    for (const auto& t : m.triangles)
+        for (uint32_t v : t)
+            if (v >= vertices) throw bad(fmt::format("a vertex index {} out of range ({} vertices)", v, vertices));
+    if (flags & kFaceNormals) m.normals.clear();
+    check_finite(m, path);
+    return m;
+}
+
+std::string serialized_mesh_bytes(const MeshDesc& mesh, bool double_precision) {
+    std::string raw;
+    const auto put = [&](const void* p, size_t n) { raw.append(static_cast<const char*>(p), n); };
+    const uint32_t flags = (mesh.normals.empty() ? 0u : uint32_t(kHasNormals)) | (mesh.uvs.empty() ? 0u : uint32_t(kHasUvs)) |
+                           (double_precision ? uint32_t(kDoublePrecision) : uint32_t(kSinglePrecision));
+    put(&flags, 4);
+    put(mesh.name.c_str(), mesh.name.size() + 1);
+    const uint64_t v = mesh.positions.size(), t = mesh.triangles.size();
+    put(&v, 8);
+    put(&t, 8);
+    const auto floats = [&](const float* p, size_t n) {
+        for (size_t i = 0; i < n; ++i) {
+            if (double_precision) {
+                const double d = p[i];
+                put(&d, 8);
+            } else {
+                put(&p[i], 4);
+            }
+        }
+    };
+    floats(&mesh.positions[0].x, mesh.positions.size() * 3);
+    if (!mesh.normals.empty()) floats(&mesh.normals[0].x, mesh.normals.size() * 3);
+    if (!mesh.uvs.empty()) floats(&mesh.uvs[0].x, mesh.uvs.size() * 2);
+    put(mesh.triangles.data(), mesh.triangles.size() * 12);
+    uLongf packed_size = compressBound(uLong(raw.size()));
+    std::string packed(packed_size, '\0');
+    compress(reinterpret_cast<Bytef*>(packed.data()), &packed_size, reinterpret_cast<const Bytef*>(raw.data()), uLong(raw.size()));
+    packed.resize(packed_size);
+    std::string out;
+    const uint16_t magic = 0x041C, version = 4;
+    out.append(reinterpret_cast<const char*>(&magic), 2);
+    out.append(reinterpret_cast<const char*>(&version), 2);
+    out += packed;
+    const uint64_t offset = 0;
+    const uint32_t count = 1;
+    out.append(reinterpret_cast<const char*>(&offset), 8);
+    out.append(reinterpret_cast<const char*>(&count), 4);
+    return out;
+}
+
+}  // namespace pathlab

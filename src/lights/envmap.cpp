@@ -1,0 +1,140 @@
+#include "lights/envmap.hpp"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "image/image_io.hpp"
+
+namespace pathlab {
+namespace {
+
+// The largest sin(theta) over the rows' band theta in [y pi / H, (y + 1) pi / H].
+float row_max_sin_theta(int y, int height) {
+    const double t0 = double(y) / height, t1 = double(y + 1) / height;
+    if (t0 <= 0.5 && t1 >= 0.5) return 1.0f;
+    return float(std::max(std::sin(t0 * M_PI), std::sin(t1 * M_PI)));
+}
+
+}  // namespace
+
+EnvMap::EnvMap(int width, int height, std::vector<Rgb> texels, const Frame& to_world)
+    : width_(width), height_(height), texels_(std::move(texels)), frame_(to_world) {
+    // Luminance with the lookup's boundary rules: u wraps, v is held at the first and last rows.
+    std::vector<float> lum(texels_.size());
+    for (size_t i = 0; i < texels_.size(); ++i) lum[i] = luminance(texels_[i]);
+    const auto L = [&](int x, int y) {
+        x = (x % width_ + width_) % width_;
+        y = std::clamp(y, 0, height_ - 1);
+        return lum[size_t(y) * size_t(width_) + size_t(x)];
+    };
+    std::vector<float> f(texels_.size());
+    double mean = 0;
+    for (int y = 0; y < height_; ++y) {
+        const float sin_max = row_max_sin_theta(y, height_);
+        // The texel's solid angle, for the mean radiance.
+        const double omega = 2 * M_PI / width_ * (std::cos(M_PI * y / height_) - std::cos(M_PI * (y + 1) / height_));
+        for (int x = 0; x < width_; ++x) {
+            // The bilinear function's maximum over the cell: the texel itself, the midpoints of
+            // its edges (averages of two texels) and its corners (averages of four).
+            const float c = L(x, y), l = L(x - 1, y), r = L(x + 1, y), up = L(x, y - 1), dn = L(x, y + 1);
+            float m = c;
+            for (const float e : {l, r, up, dn}) m = std::max(m, 0.5f * (c + e));
+            m = std::max(m, 0.25f * (c + l + up + L(x - 1, y - 1)));
+            m = std::max(m, 0.25f * (c + r + up + L(x + 1, y - 1)));
+            m = std::max(m, 0.25f * (c + l + dn + L(x - 1, y + 1)));
+            m = std::max(m, 0.25f * (c + r + dn + L(x + 1, y + 1)));
+            f[size_t(y) * size_t(width_) + size_t(x)] = m * sin_max;
+            mean += double(pathlab::mean(texel(x, y))) * omega;
+        }
+    }
+    distribution_ = Distribution2D(f, width_, height_);
+    mean_radiance_ = float(mean / (4 * M_PI));
+}
+
+Rgb EnvMap::lookup(Vec2f uv) const {
+    const float s = uv.x * float(width_) - 0.5f, t = uv.y * float(height_) - 0.5f;
+    const float fs = std::floor(s), ft = std::floor(t);
+    const float wx = s - fs, wy = t - ft;
+    // u in [0, 1): fs in [-1, W - 1]; other u wrap by a modulo.
+    int x0 = int(fs);
+    if (x0 < 0 || x0 >= width_) x0 = ((x0 % width_) + width_) % width_;
+    const int x1 = x0 + 1 == width_ ? 0 : x0 + 1;
+    const int y0 = std::clamp(int(ft), 0, height_ - 1), y1 = std::clamp(int(ft) + 1, 0, height_ - 1);
+    return (texel(x0, y0) * (1 - wx) + texel(x1, y0) * wx) * (1 - wy) + (texel(x0, y1) * (1 - wx) + texel(x1, y1) * wx) * wy;
+}
+
+Vec3f EnvMap::uv_to_direction(Vec2f uv) {
+    const float theta = uv.y * kPi, phi = uv.x * (2 * kPi);
+    const float sin_theta = std::sin(theta);
+    return {std::sin(phi) * sin_theta, std::cos(theta), -std::cos(phi) * sin_theta};
+}
+
+Vec2f EnvMap::direction_to_uv(const Vec3f& d) {
+    float u = std::atan2(d.x, -d.z) * (0.5f * kInvPi);
+    if (u < 0) u += 1;
+    if (u >= 1) u = 0;
+    // v = 1 (straight down, or rounded to it) belongs to the last row, as the sampler's v < 1 does.
+    return {u, std::min(std::acos(std::clamp(d.y, -1.0f, 1.0f)) * kInvPi, 0x1.fffffep-1f)};
+}
+
+std::pair<int, int> EnvMap::texel_of(const Vec3f& w) const {
+    const Vec2f uv = direction_to_uv(frame_.to_local(w));
+    return {std::min(int(uv.x * float(width_)), width_ - 1), std::min(int(uv.y * float(height_)), height_ - 1)};
+}
+
+std::optional<EnvMap::Sample> EnvMap::sample(Vec2f u) const {
+    Sample s;
+    float pdf_uv;
+    s.uv = distribution_.sample_continuous(u, pdf_uv, &s.x, &s.y);
+    const Vec3f local = uv_to_direction(s.uv);
+    const float sin_theta = std::sqrt(local.x * local.x + local.z * local.z);
+    s.pdfW = uv_density_to_solid_angle(pdf_uv, sin_theta);
+    if (!(s.pdfW > 0)) return std::nullopt;
+    s.wi = frame_.to_world(local);
+    s.Le = lookup(s.uv);
+    return s;
+}
+
+float EnvMap::pdf(const Vec3f& w) const {
+    const Vec3f local = frame_.to_local(normalize(w));
+    const float sin_theta = std::sqrt(local.x * local.x + local.z * local.z);
+    const Vec2f uv = direction_to_uv(local);
+    return uv_density_to_solid_angle(distribution_.pdf(uv), sin_theta);
+}
+
+const PluginInfo& envmap_plugin() {
+    static const PluginInfo info{
+        "emitter", "envmap", "an environment map: radiance from every direction, from a latitude-longitude image",
+        {{"filename", ParamType::String, "", "the image (.exr, .hdr or .pfm; linear RGB), relative to the scene file"},
+         {"scale", ParamType::Float, "1", "multiplies the image's radiance"},
+         {"to_world", ParamType::Transform, "", "orientation (a rotation); the image's top looks along +y, its centre along +z"}},
+        "Mitsuba 3's latitude-longitude convention; importance-sampled by luminance x sin(theta), bilinear lookup "
+        "(docs/lights.md). Negative texels (from some resampling filters) are read as 0; NaN or infinite ones are an error."};
+    return info;
+}
+
+EnvMapLight read_envmap_light(Properties& p, const EmitterContext& ctx) {
+    const std::string path = emitter_file(p, ctx, "envmap");
+    const float scale = p.get_float("scale");
+    if (!(scale >= 0)) p.fail("scale", "an envmap's scale must not be negative");
+    const Frame frame = rotation_frame(p, "envmap");
+    Image img;
+    try {
+        // 2^25 pixels (8192 x 4096): the texels and their distribution take about 1 GiB.
+        img = read_image(path, ImageReadLimits{uint64_t(1) << 25});
+    } catch (const ImageIoError& e) {
+        p.fail("filename", e.what());
+    }
+    if (img.pixel_count() == 0) p.fail("filename", fmt::format("{}: the image has no pixels", path));
+    std::vector<Rgb> texels(img.pixel_count());
+    for (int y = 0; y < img.height(); ++y)
+        for (int x = 0; x < img.width(); ++x) {
+            const Rgb& v = img.at(x, y);
+            if (!is_finite(v)) p.fail("filename", fmt::format("{}: texel ({}, {}) is NaN or infinite", path, x, y));
+            texels[size_t(y) * size_t(img.width()) + size_t(x)] = max(v, Rgb(0.0f)) * scale;
+        }
+    return EnvMapLight{std::make_shared<const EnvMap>(img.width(), img.height(), std::move(texels), frame)};
+}
+
+}  // namespace pathlab

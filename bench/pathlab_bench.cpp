@@ -7,7 +7,8 @@
 //   pathlab_bench lt       light tracing: paths/s next to pt-mis, and splat accumulation
 //   pathlab_bench bdpt     bdpt against pt-mis: equal-time RMSE, and samples per second
 //   pathlab_bench pm       photons per second; hashed grid against k-d tree (build, query)
-//   pathlab_bench ic       irradiance caching against pt-mis and bdpt at short budgets
+//   pathlab_bench ic       irradiance caching and pbgi against pt-mis and bdpt at short budgets
+//   pathlab_bench pbgi-gather  pbgi's gather against a ray-traced truth per cutoff and micro-buffer
 //   pathlab_bench volumes  volpath: samples/s, equal-time RMSE with and without MIS, optical thickness
 //   pathlab_bench distributed  2 MPI ranks against 1 process, film reduction, checkpoints
 //   pathlab_bench lights   an environment map's cost per sample against the constant environment; spot and IES
@@ -78,7 +79,7 @@ int main(int argc, char** argv) {
     pmc->add_option("--size", pm.size, "Queries: one per pixel of a size x size image")->capture_default_str();
     pmc->add_option("--repeats", pm.repeats, "Timed repeats (median reported)")->capture_default_str();
     IrradianceCachingOptions icopt;
-    CLI::App* icc = app.add_subcommand("ic", "Irradiance caching against pt-mis and bdpt at short budgets");
+    CLI::App* icc = app.add_subcommand("ic", "Irradiance caching and pbgi against pt-mis and bdpt at short budgets");
     icc->add_option("--size", icopt.size, "Image width and height")->capture_default_str();
     icc->add_option("--budgets", icopt.budgets, "Seconds per render")->delimiter(',')->capture_default_str();
     icc->add_option("--repeats", icopt.repeats, "Rounds (median reported)")->capture_default_str();
@@ -92,6 +93,13 @@ int main(int argc, char** argv) {
     vol->add_option("--scenes", vo.scenes, "Scene files of scenes/ with media")->delimiter(',')->capture_default_str();
     vol->add_option("--plain-scenes", vo.plain_scenes, "Scene files of scenes/ without media")->delimiter(',')->capture_default_str();
     vol->add_option("--fixed-spp", vo.fixed_spp, "Samples per pixel of the renders without media")->capture_default_str();
+    GatherAccuracyOptions gopt;
+    CLI::App* gat = app.add_subcommand("pbgi-gather", "pbgi's gather against brute force: error and time per cutoff and micro-buffer");
+    gat->add_option("--scenes", gopt.scenes, "Course scene indices")->delimiter(',')->capture_default_str();
+    gat->add_option("--points", gopt.points, "First hits per scene")->capture_default_str();
+    gat->add_option("--surfels", gopt.surfels, "Surfels (about)")->capture_default_str();
+    gat->add_option("--cutoffs", gopt.cutoffs, "Cutoff solid angles")->delimiter(',')->capture_default_str();
+    gat->add_option("--resolutions", gopt.resolutions, "Micro-buffer sides")->delimiter(',')->capture_default_str();
     LightsOptions lo;
     CLI::App* lic = app.add_subcommand("lights", "An environment map's cost per sample against the constant environment; spot and IES");
     lic->add_option("--size", lo.size, "Image width and height")->capture_default_str();
@@ -130,6 +138,7 @@ int main(int argc, char** argv) {
         distributed_reduce_worker(dopt.film_sizes, dopt.repeats, argc, argv);
         return 0;
     }
+    if (*gat) pbgi_gather_suite(gopt);
     if (*dist) distributed_suite(dopt, args[0]);
     if (*dfc) differentiable_suite(dfo);
     if (*lic) lights_suite(lo);

@@ -426,8 +426,9 @@ TEST_F(Distributed, PlainBinaryRunsWithoutMpirunAndForcedSingletonMpiToo) {
 TEST_F(Distributed, TwoRanksOfOneThreadEqualOneProcessOfTwoThreadsForEveryIntegrator) {
     // One scene file per integrator (the course's scene 3 with its <integrator>; volpath: scene 2
     // in fog, whose file names volpath), all rendered by one command: one mpirun start instead of
-    // one per integrator.
-    const std::vector<std::string> algorithms = {"pt-mis", "lt", "bdpt", "sppm", "ppm", "pm", "vcm", "bpm", "ic", "volpath"};
+    // one per integrator. pbgi with a small cloud: its surfels and corner gathers are made by
+    // every rank alike.
+    const std::vector<std::string> algorithms = {"pt-mis", "lt", "bdpt", "sppm", "ppm", "pm", "vcm", "bpm", "ic", "pbgi", "volpath"};
     fs::create_directory_symlink(fs::path(PATHLAB_SOURCE_DIR) / "scenes/meshes", dir_ / "meshes");
     const std::string scene = file_bytes(std::string(PATHLAB_SOURCE_DIR) + "/scenes/3-ceiling-glossy.xml");
     const std::string open = "<scene version=\"3.0.0\">";
@@ -437,7 +438,9 @@ TEST_F(Distributed, TwoRanksOfOneThreadEqualOneProcessOfTwoThreadsForEveryIntegr
     ASSERT_NE(fog.find("<integrator type=\"volpath\"/>"), std::string::npos);
     for (const std::string& a : algorithms) {
         std::string text = a == "volpath" ? fog : scene;
-        if (a != "volpath") text.insert(text.find(open) + open.size(), "<integrator type=\"" + a + "\"/>");
+        if (a != "volpath")
+            text.insert(text.find(open) + open.size(), a == "pbgi" ? "<integrator type=\"pbgi\"><integer name=\"surfels\" value=\"1500\"/></integrator>"
+                                                                   : "<integrator type=\"" + a + "\"/>");
         std::ofstream(path(a + ".xml")) << text;
         list += (list.empty() ? "" : ",") + path(a + ".xml");
     }

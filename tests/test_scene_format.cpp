@@ -594,7 +594,7 @@ TEST(SceneFileSensors, WindowsClippingLensAndOrthographicRays) {
     // Integrators that connect to the pinhole refuse the other sensors.
     SceneDescription d = load_scene_file(source_path("scenes/example.xml"));
     d.camera.kind = CameraKind::ThinLens;
-    for (const char* name : {"lt", "bdpt", "vcm", "sppm"}) {
+    for (const char* name : {"lt", "bdpt", "vcm", "sppm", "ic", "pbgi"}) {
         JobRequest req;
         req.algorithm = name;
         EXPECT_THROW(RenderJob(scene_choice_of(d), req), UsageError) << name;

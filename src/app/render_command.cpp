@@ -105,10 +105,17 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
     app.add_option("--alpha", o.photon_alpha, "sppm, ppm, vcm, bpm: the radius reduction, in (0, 1] (default 2/3)");
     app.add_flag("--no-merging", o.no_merging, "vcm: connections only (then it is bdpt)");
     app.add_flag("--no-connections", o.no_connections, "vcm: merging only (then it is bpm)");
-    app.add_option("--ic-rays", o.ic_rays, "ic: rays per irradiance record (stratified)")->capture_default_str();
-    app.add_option("--ic-error", o.ic_error, "ic: the error threshold a (0: no cache, every point gathers for itself)")->capture_default_str();
+    app.add_option("--ic-rays", o.ic_rays, "ic: rays per irradiance record (stratified; default 256)");
+    app.add_option("--ic-error", o.ic_error, "ic: the error threshold a (0: no cache, every point gathers for itself; default 0.2)");
     app.add_flag("--ic-no-gradients", o.ic_no_gradients, "ic: interpolate without the irradiance gradients");
     app.add_option("--ic-records", o.ic_records, "ic: write an image of the cached light with the records as red dots (placeholders as for -o)");
+    app.add_option("--pbgi-surfels", o.pbgi_surfels, "pbgi: about this many surfels over the scene's surfaces (default 8000)");
+    app.add_option("--pbgi-cutoff", o.pbgi_cutoff,
+                   "pbgi: the solid angle (sr) above which a cluster is opened (default 0.05; 0: every surfel, brute force)");
+    app.add_option("--pbgi-bounces", o.pbgi_bounces, "pbgi: surfel bounces (1: the surfels' direct light only; default 3)");
+    app.add_option("--pbgi-resolution", o.pbgi_resolution, "pbgi: the micro-buffer's side in pixels (default 16)");
+    app.add_option("--pbgi-direct-samples", o.pbgi_direct_samples, "pbgi: MIS pairs for each surfel side's direct light (default 16)");
+    app.add_option("--pbgi-spacing", o.pbgi_spacing, "pbgi: pixels between the gathers at the first hits, interpolated between (default 2)");
     app.add_option("--checkpoint", o.checkpoint,
                    "Save the render's whole state to this file (atomically) every --checkpoint-every seconds, at the end and "
                    "when interrupted, to continue it with --resume (placeholders as for -o)");
@@ -157,11 +164,26 @@ std::vector<RenderJob> make_jobs(const RenderCommandOptions& o, bool check_paths
     request.photon_alpha = o.photon_alpha;
     request.vcm_merging = !o.no_merging;
     request.vcm_connections = !o.no_connections;
-    if (o.ic_rays < 4 || o.ic_rays > 65536) throw UsageError(fmt::format("--ic-rays must be 4 to 65536, got {}", o.ic_rays));
-    if (!(o.ic_error >= 0 && o.ic_error <= 10)) throw UsageError(fmt::format("--ic-error must be 0 to 10, got {}", o.ic_error));
+    if (o.ic_rays && (*o.ic_rays < 4 || *o.ic_rays > 65536)) throw UsageError(fmt::format("--ic-rays must be 4 to 65536, got {}", *o.ic_rays));
+    if (o.ic_error && !(*o.ic_error >= 0 && *o.ic_error <= 10)) throw UsageError(fmt::format("--ic-error must be 0 to 10, got {}", *o.ic_error));
     request.ic_rays = o.ic_rays;
     request.ic_error = o.ic_error;
-    request.ic_gradients = !o.ic_no_gradients;
+    if (o.ic_no_gradients) request.ic_gradients = false;
+    const auto in_range = [](const char* name, const auto& v, double lo, double hi) {
+        if (v && !(double(*v) >= lo && double(*v) <= hi)) throw UsageError(fmt::format("{} must be {:g} to {:g}, got {}", name, lo, hi, *v));
+    };
+    in_range("--pbgi-surfels", o.pbgi_surfels, 1, 1e7);
+    in_range("--pbgi-cutoff", o.pbgi_cutoff, 0, 4 * kPi);
+    in_range("--pbgi-bounces", o.pbgi_bounces, 1, 64);
+    in_range("--pbgi-resolution", o.pbgi_resolution, 2, 256);
+    in_range("--pbgi-direct-samples", o.pbgi_direct_samples, 1, 65536);
+    in_range("--pbgi-spacing", o.pbgi_spacing, 1, 64);
+    request.pbgi_surfels = o.pbgi_surfels;
+    request.pbgi_cutoff = o.pbgi_cutoff;
+    request.pbgi_bounces = o.pbgi_bounces;
+    request.pbgi_resolution = o.pbgi_resolution;
+    request.pbgi_direct_samples = o.pbgi_direct_samples;
+    request.pbgi_spacing = o.pbgi_spacing;
     if (o.no_merging && o.no_connections) throw UsageError("--no-merging and --no-connections together leave vcm no strategy");
 
     std::vector<RenderJob> jobs;
@@ -237,9 +259,15 @@ std::vector<RenderJob> make_jobs(const RenderCommandOptions& o, bool check_paths
             throw UsageError(fmt::format("--alpha is the radius reduction of sppm, ppm, vcm and bpm, not {}'s", algorithm));
         if (o.mis == "power" && !one_of({"bdpt", "vcm", "bpm"}))
             throw UsageError(fmt::format("--mis chooses the heuristic of bdpt, vcm and bpm; {} has its own", algorithm));
-        const bool ic_options = o.ic_rays != 256 || o.ic_error != 0.2f || o.ic_no_gradients || !o.ic_records.empty();
+        const bool ic_options = o.ic_rays || o.ic_error || o.ic_no_gradients || !o.ic_records.empty();
         if (ic_options && algorithm != "ic")
             throw UsageError(fmt::format("--ic-rays, --ic-error, --ic-no-gradients and --ic-records are ic's, not {}'s", algorithm));
+        const bool pbgi_options =
+            o.pbgi_surfels || o.pbgi_cutoff || o.pbgi_bounces || o.pbgi_resolution || o.pbgi_direct_samples || o.pbgi_spacing;
+        if (pbgi_options && algorithm != "pbgi")
+            throw UsageError(fmt::format(
+                "--pbgi-surfels, --pbgi-cutoff, --pbgi-bounces, --pbgi-resolution, --pbgi-direct-samples and --pbgi-spacing are pbgi's, not {}'s",
+                algorithm));
         if (!o.ic_records.empty()) {
             const std::string p = jobs[j].expand(o.ic_records);
             paths.output(p, "--ic-records", /*image=*/true);

@@ -39,10 +39,16 @@ struct RenderCommandOptions {
     std::optional<double> photon_alpha;
     bool no_merging = false;      // vcm: connections only (= bdpt)
     bool no_connections = false;  // vcm: merging only (= bpm)
-    int ic_rays = 256;
-    float ic_error = 0.2f;
+    std::optional<int> ic_rays;
+    std::optional<float> ic_error;
     bool ic_no_gradients = false;
     std::string ic_records;
+    std::optional<int> pbgi_surfels;
+    std::optional<float> pbgi_cutoff;
+    std::optional<int> pbgi_bounces;
+    std::optional<int> pbgi_resolution;
+    std::optional<int> pbgi_direct_samples;
+    std::optional<int> pbgi_spacing;
     std::string checkpoint;          // --checkpoint FILE
     double checkpoint_every = 300;   // --checkpoint-every SECONDS
     std::string resume;              // --resume FILE

@@ -66,7 +66,18 @@ struct IntegratorOptions {
     int ic_rays = 256;
     float ic_error = 0.2f;
     bool ic_gradients = true;
+    bool ic_clamp_screen = true;      // radii within 1.5 to 20 pixel footprints (Tabellion and Lamorlette)
+    bool ic_clamp_neighbours = true;  // neighbour clamping (Krivanek et al.)
     std::string ic_records_path;
+    // pbgi: surfels (about), the cutoff solid angle (0: brute force), surfel bounces, the
+    // micro-buffer's side, the MIS pairs of each surfel side's direct light, and the pixels
+    // between the gathers at the camera's first hits.
+    int pbgi_spacing = 2;
+    int pbgi_surfels = 8000;
+    float pbgi_cutoff = 0.05f;
+    int pbgi_bounces = 3;
+    int pbgi_resolution = 16;
+    int pbgi_direct_samples = 16;
     // Paths of no bounce (emitters and the environment seen directly) are left out (Mitsuba's hide_emitters).
     bool hide_emitters = false;
 };

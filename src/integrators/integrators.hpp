@@ -20,6 +20,7 @@ const IntegratorInfo& bdpt_integrator();
 const IntegratorInfo& sppm_integrator();
 const IntegratorInfo& pm_integrator();
 const IntegratorInfo& ic_integrator();
+const IntegratorInfo& pbgi_integrator();
 const IntegratorInfo& ppm_integrator();
 const IntegratorInfo& vcm_integrator();
 const IntegratorInfo& bpm_integrator();

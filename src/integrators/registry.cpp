@@ -10,7 +10,7 @@ const std::vector<IntegratorInfo>& integrators() {
     static const std::vector<IntegratorInfo> table = {
         eyelight_integrator(),       direct_light_integrator(), direct_uniform_integrator(), direct_cosine_integrator(),
         direct_brdf_integrator(),    direct_mis_integrator(),   pt_naive_integrator(),       pt_mis3_integrator(),
-        pt_mis_integrator(),         light_tracer_integrator(), bdpt_integrator(), pm_integrator(), ppm_integrator(), sppm_integrator(), bpm_integrator(), vcm_integrator(), ic_integrator(),
+        pt_mis_integrator(),         light_tracer_integrator(), bdpt_integrator(), pm_integrator(), ppm_integrator(), sppm_integrator(), bpm_integrator(), vcm_integrator(), ic_integrator(), pbgi_integrator(),
         volpath_integrator(),
     };
     return table;

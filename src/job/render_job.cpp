@@ -71,9 +71,17 @@ RenderJob::RenderJob(SceneChoice scene, const JobRequest& r) : choice_(std::move
     options_.photon_alpha = r.photon_alpha ? *r.photon_alpha : d.photon_alpha.value_or(2.0 / 3.0);
     options_.vcm_merging = r.vcm_merging;
     options_.vcm_connections = r.vcm_connections;
-    options_.ic_rays = r.ic_rays;
-    options_.ic_error = r.ic_error;
-    options_.ic_gradients = r.ic_gradients;
+    options_.ic_rays = r.ic_rays ? *r.ic_rays : d.ic_rays.value_or(options_.ic_rays);
+    options_.ic_error = r.ic_error ? *r.ic_error : d.ic_error.value_or(options_.ic_error);
+    options_.ic_gradients = r.ic_gradients ? *r.ic_gradients : d.ic_gradients.value_or(options_.ic_gradients);
+    options_.ic_clamp_screen = d.ic_clamp_screen.value_or(true);
+    options_.ic_clamp_neighbours = d.ic_clamp_neighbours.value_or(true);
+    options_.pbgi_surfels = r.pbgi_surfels ? *r.pbgi_surfels : d.pbgi_surfels.value_or(options_.pbgi_surfels);
+    options_.pbgi_cutoff = r.pbgi_cutoff ? *r.pbgi_cutoff : d.pbgi_cutoff.value_or(options_.pbgi_cutoff);
+    options_.pbgi_bounces = r.pbgi_bounces ? *r.pbgi_bounces : d.pbgi_bounces.value_or(options_.pbgi_bounces);
+    options_.pbgi_resolution = r.pbgi_resolution ? *r.pbgi_resolution : d.pbgi_resolution.value_or(options_.pbgi_resolution);
+    options_.pbgi_direct_samples = r.pbgi_direct_samples ? *r.pbgi_direct_samples : d.pbgi_direct_samples.value_or(options_.pbgi_direct_samples);
+    options_.pbgi_spacing = r.pbgi_spacing ? *r.pbgi_spacing : d.pbgi_spacing.value_or(options_.pbgi_spacing);
     options_.hide_emitters = d.hide_emitters.value_or(false);
     // What the integrator cannot do with this scene's sensor and film.
     if (!info_->any_camera && d.camera.kind != CameraKind::Perspective)

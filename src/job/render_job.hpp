@@ -41,9 +41,15 @@ struct JobRequest {
     std::optional<double> photon_alpha;   // --alpha A (sppm, vcm, bpm)
     bool vcm_merging = true;              // not --no-merging (vcm)
     bool vcm_connections = true;          // not --no-connections (vcm)
-    int ic_rays = 256;                    // --ic-rays (ic)
-    float ic_error = 0.2f;                // --ic-error (ic)
-    bool ic_gradients = true;             // not --ic-no-gradients (ic)
+    std::optional<int> ic_rays;           // --ic-rays (ic)
+    std::optional<float> ic_error;        // --ic-error (ic)
+    std::optional<bool> ic_gradients;     // false: --ic-no-gradients (ic)
+    std::optional<int> pbgi_surfels;          // --pbgi-surfels (pbgi)
+    std::optional<float> pbgi_cutoff;         // --pbgi-cutoff (pbgi)
+    std::optional<int> pbgi_bounces;          // --pbgi-bounces (pbgi)
+    std::optional<int> pbgi_resolution;       // --pbgi-resolution (pbgi)
+    std::optional<int> pbgi_direct_samples;   // --pbgi-direct-samples (pbgi)
+    std::optional<int> pbgi_spacing;          // --pbgi-spacing (pbgi)
 };
 
 // The integrator `name` (or an alias); a UsageError listing them all otherwise.

@@ -40,6 +40,11 @@ struct SceneDescription {
     std::optional<int64_t> photons;               // sppm, pm: light paths (per iteration for sppm)
     std::optional<float> photon_radius;           // sppm: the first iteration's radius
     std::optional<double> photon_alpha;           // sppm: the radius reduction
+    std::optional<int> pbgi_surfels, pbgi_bounces, pbgi_resolution, pbgi_direct_samples, pbgi_spacing;  // pbgi
+    std::optional<float> pbgi_cutoff;                                                     // pbgi
+    std::optional<int> ic_rays;                                                            // ic
+    std::optional<float> ic_error;
+    std::optional<bool> ic_gradients, ic_clamp_screen, ic_clamp_neighbours;
     std::optional<bool> hide_emitters;            // paths of no bounce (emitters seen directly) left out
     // The film: its reconstruction filter, the format of the default output (hdrfilm's
     // file_format: "openexr", "rgbe" or "pfm"), and extra outputs an integrator asks for

@@ -80,6 +80,45 @@ void read_plain_integrator(XmlSource& xml, const pugi::xml_node& n, SceneBuilder
             if (!(a > 0 && a <= 1)) p.fail("alpha", fmt::format("alpha must be in (0, 1], got {}", a));
             b.desc.photon_alpha = a;
         }
+        // ic (Mitsuba 0.6's irrcache: resolution R means R x 3R rays; gradients, clampNeighbor and
+        // clampScreen switch the same things; its quality, a weight of Tabellion and Lamorlette's
+        // error with another radius, has no counterpart and is refused as unknown).
+        if (plugin.find("rays") && p.has("rays")) {
+            if (p.has("resolution")) p.fail("resolution", "give rays or resolution (Mitsuba's 3 R^2 rays), not both");
+            const int n = p.get_int("rays");
+            if (n < 4 || n > 65536) p.fail("rays", fmt::format("rays must be 4 to 65536, got {}", n));
+            b.desc.ic_rays = n;
+        }
+        if (plugin.find("resolution") && p.has("resolution")) {
+            const int r = p.get_int("resolution");
+            if (r < 2 || r > 147) p.fail("resolution", fmt::format("resolution must be 2 to 147 (3 R^2 rays, at most 65536), got {}", r));
+            b.desc.ic_rays = 3 * r * r;
+        }
+        if (plugin.find("error") && p.has("error")) {
+            const float a = p.get_float("error");
+            if (!(a >= 0 && a <= 10)) p.fail("error", fmt::format("error must be 0 to 10, got {}", a));
+            b.desc.ic_error = a;
+        }
+        if (plugin.find("gradients") && p.has("gradients")) b.desc.ic_gradients = p.get_bool("gradients");
+        if (plugin.find("clamp_neighbor") && p.has("clamp_neighbor")) b.desc.ic_clamp_neighbours = p.get_bool("clamp_neighbor");
+        if (plugin.find("clamp_screen") && p.has("clamp_screen")) b.desc.ic_clamp_screen = p.get_bool("clamp_screen");
+        // pbgi.
+        const auto positive = [&](const char* name, int lo, int hi, std::optional<int>& out) {
+            if (!plugin.find(name) || !p.has(name)) return;
+            const int v = p.get_int(name);
+            if (v < lo || v > hi) p.fail(name, fmt::format("{} must be {} to {}, got {}", name, lo, hi, v));
+            out = v;
+        };
+        positive("surfels", 1, 10000000, b.desc.pbgi_surfels);
+        positive("bounces", 1, 64, b.desc.pbgi_bounces);
+        positive("buffer_resolution", 2, 256, b.desc.pbgi_resolution);
+        positive("direct_samples", 1, 65536, b.desc.pbgi_direct_samples);
+        positive("gather_spacing", 1, 64, b.desc.pbgi_spacing);
+        if (plugin.find("cutoff") && p.has("cutoff")) {
+            const float c = p.get_float("cutoff");
+            if (!(c >= 0 && c <= 4 * kPi)) p.fail("cutoff", fmt::format("cutoff must be a solid angle from 0 to 4 pi, got {}", c));
+            b.desc.pbgi_cutoff = c;
+        }
         p.check_all_used();
         return 0;
     });

@@ -9,22 +9,12 @@
 
 #include "core/sampling.hpp"
 #include "image/image_io.hpp"
-#include "integrators/common/direct_lighting.hpp"
+#include "integrators/cache/first_hit.hpp"
 #include "integrators/integrators.hpp"
 #include "integrators/path/pt_mis.hpp"
 
 namespace pathlab {
 namespace {
-
-// The Phong material of sp (at its uv, for a textured one), if it has a diffuse part the cache
-// can serve.
-std::optional<PhongMaterial> cached_diffuse(const ShadingPoint& sp) {
-    if (!std::holds_alternative<PhongMaterial>(sp.material->model)) return std::nullopt;
-    const PhongMaterial phong = sp.material->varies ? std::get<PhongMaterial>(sp.material->model_at(sp.uv))
-                                                    : std::get<PhongMaterial>(sp.material->model);
-    if (is_black(phong.diffuse)) return std::nullopt;
-    return phong;
-}
 
 // Random-number streams: the records' gathers, apart from every pixel's own.
 uint64_t record_stream(size_t pixel) { return uint64_t(pixel) + (uint64_t(5) << 41); }
@@ -40,13 +30,16 @@ IrradianceCaching::IrradianceCaching(const IntegratorOptions& options)
 
 float IrradianceCaching::footprint(const Vec3f& p) const { return std::max(1e-6f, length(p - camera_position_) * pixel_angle_); }
 
-void IrradianceCaching::clamp_radius(IrradianceRecord& r) const {
+void IrradianceCaching::clamp_radius(IrradianceRecord& r, float scene_radius) const {
     const float a = std::max(cache_.error_threshold(), 1e-6f), f = footprint(r.p);
-    float R = std::clamp(r.harmonic, 1.5f * f / a, 20.0f * f / a);
+    // Without the screen-space clamps: the harmonic mean distance, at most the scene's radius
+    // (a record whose rays all escaped would otherwise cover everything).
+    const float lo = options_.ic_clamp_screen ? 1.5f * f / a : 0.0f, hi = options_.ic_clamp_screen ? 20.0f * f / a : scene_radius;
+    float R = std::clamp(r.harmonic, lo, hi);
     // The translational gradient's limit: R <= E / |grad_t E| (in luminance).
     const Vec3f g = r.grad_t[0] * 0.2126f + r.grad_t[1] * 0.7152f + r.grad_t[2] * 0.0722f;
     const float E = luminance(r.E), gl = length(g);
-    if (gl > 0 && E > 0) R = std::max(std::min(R, E / gl), 1.5f * f / a);
+    if (gl > 0 && E > 0) R = std::max(std::min(R, E / gl), lo);
     r.R = R;
 }
 
@@ -57,7 +50,7 @@ IrradianceRecord IrradianceCaching::make_record(const Scene& scene, const Shadin
         distance = length(hit.p - sp.p);
         return pt_mis_from_hit(scene, hit, d, 1, sampler, rules_);
     });
-    clamp_radius(r);
+    clamp_radius(r, scene.bounds_radius());
     return r;
 }
 
@@ -119,31 +112,13 @@ void IrradianceCaching::prepare(const RenderContext& ctx, const PassProgress& pr
         }
         if (progress) progress(double(level + 1) / double(strides.size()));
     }
-    cache_.clamp_to_neighbours();
+    if (options_.ic_clamp_neighbours) cache_.clamp_to_neighbours();
     build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 Rgb IrradianceCaching::radiance(const Scene& scene, const Ray& ray, Sampler& sampler) const {
-    Intersection hit;
-    if (!scene.intersect(ray, hit)) return options_.hide_emitters ? Rgb(0.0f) : scene.escaped_radiance(ray.d);
-    Rgb L = options_.hide_emitters ? Rgb(0.0f) : emitted_radiance(scene, hit, -ray.d);
-    const ShadingPoint sp = make_shading_point(scene, hit, ray.d);
-    const std::optional<PhongMaterial> phong = sp.material->is_black() ? std::nullopt : cached_diffuse(sp);
-    if (!phong) return pt_mis_from_hit(scene, hit, ray.d, 0, sampler, rules_, false, -1, L);
-    if (!rules_.may_bounce(0)) return L;
-    // Direct light: pt-mis's MIS pair.
-    L += estimate_light_sample(scene, sp, sampler, /*mis=*/true);
-    const auto s = sp.material->sample(sp, sp.wi, sampler.next2d());
-    EmitterHit found;
-    if (s) L += estimate_bsdf_sample_mis(scene, sp, *s, found);
-    if (!rules_.may_bounce(1)) return L;
-    // Indirect diffuse light from the cache.
-    L += phong->diffuse * kInvPi * indirect_irradiance(scene, sp, sampler);
-    // The Phong lobe's indirect light: the BSDF sample, weighted by the lobe alone.
-    if (!s || s->delta || !found.hit) return L;
-    Rgb beta = max(s->f - phong->diffuse * kInvPi, Rgb(0.0f)) * (std::abs(s->wo.z) / s->pdfW);
-    if (is_black(beta) || !rules_.survive_roulette(1, beta, sampler)) return L;
-    return L + beta * pt_mis_from_hit(scene, found.isect, sp.frame.to_world(s->wo), 1, sampler, rules_);
+    return first_hit_radiance(scene, ray, sampler, rules_, options_.hide_emitters,
+                              [&](const ShadingPoint& sp, Sampler& s) { return indirect_irradiance(scene, sp, s); });
 }
 
 void IrradianceCaching::finish(const RenderContext& ctx) {
@@ -172,9 +147,27 @@ std::vector<IntegratorStatistic> IrradianceCaching::statistics() const {
     return {{"records", double(cache_.size())}, {"records_gathered", double(gathered_)}, {"cache_seconds", build_seconds_}};
 }
 
+namespace {
+
+// pathlab's names, and Mitsuba 0.6's irrcache names where they mean the same thing.
+std::vector<ParamInfo> ic_params() {
+    std::vector<ParamInfo> p = path_params();
+    p.push_back({"rays", ParamType::Integer, "256", "rays per record, stratified (--ic-rays wins)"});
+    p.push_back({"resolution", ParamType::Integer, "",
+                 "Mitsuba 0.6's elevational resolution R of the gather hemisphere: 3 R^2 rays (R x 3R in Mitsuba; instead of rays)"});
+    p.push_back({"error", ParamType::Float, "0.2", "the error threshold a (0: no cache; --ic-error wins)"});
+    p.push_back({"gradients", ParamType::Boolean, "true", "interpolate with the irradiance gradients (--ic-no-gradients wins)"});
+    p.push_back({"clamp_neighbor", ParamType::Boolean, "true", "neighbour clamping of the radii", "clampNeighbor"});
+    p.push_back({"clamp_screen", ParamType::Boolean, "true", "radii between 1.5 and 20 pixel footprints (else at most the scene's radius)",
+                 "clampScreen"});
+    return p;
+}
+
+}  // namespace
+
 const IntegratorInfo& ic_integrator() {
     static const IntegratorInfo info{"ic", {"irrcache"}, "irradiance caching with gradients (Ward): cached indirect diffuse light at first hits, pt-mis elsewhere",
-                                     false, true, path_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
+                                     false, true, ic_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
                                          return std::make_unique<IrradianceCaching>(o);
                                      }, false, true};
     return info;

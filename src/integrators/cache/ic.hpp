@@ -1,14 +1,9 @@
 // ic: irradiance caching (Ward, Rubinstein and Clear 1988) with irradiance gradients (Ward and
 // Heckbert 1992), for the indirect diffuse light at the camera rays' first hits.
 //
-// At a camera ray's first hit x on a Phong surface (the course's material: Lambertian rho_d plus
-// a Phong lobe) with rho_d > 0:
-//   L = emission + direct light (pt-mis's MIS pair: a light sample and a BSDF sample)
-//     + rho_d / pi E_indirect(x)                                    from the cache
-//     + the Phong lobe's indirect light: the same BSDF sample, weighted by f - rho_d/pi, continued
-//       as pt-mis continues a path.
-// Elsewhere (other materials, mirrors and glass first, everything after the first hit) it is
-// pt-mis. E_indirect excludes light arriving straight from emitters (the direct light's).
+// At a camera ray's first hit x on a Phong surface with rho_d > 0 it adds the emission, the direct
+// light by pt-mis's MIS pair, rho_d / pi E_indirect(x) from the cache, and the Phong lobe's
+// indirect light by the same BSDF sample (first_hit.hpp); elsewhere it is pt-mis.
 //
 // The cache is built before the first pass (prepare), deterministically: the pixel centres are
 // visited coarse to fine (every 8th pixel, then every 4th, 2nd, each), and at each level the
@@ -50,7 +45,7 @@ public:
 
 private:
     float footprint(const Vec3f& p) const;  // a pixel's width at p
-    void clamp_radius(IrradianceRecord& r) const;
+    void clamp_radius(IrradianceRecord& r, float scene_radius) const;
 
     IntegratorOptions options_;
     PathRules rules_;

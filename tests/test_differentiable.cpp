@@ -225,7 +225,7 @@ TEST(DiffBsdf, JacobianMatchesDifferencesOfEval) {
     // Materials only (set_values copies the description per evaluation).
     for (SceneDescription* full : {&d, &beck}) full->meshes.clear(), full->spheres.clear(), full->lights.clear();
     for (const SceneDescription* desc : {&d, &beck})
-        for (const std::string& name : {"back.diffuse_reflectance.value", "back.specular_reflectance.value", "back.exponent", "blue.alpha",
+        for (const std::string name : {"back.diffuse_reflectance.value", "back.specular_reflectance.value", "back.exponent", "blue.alpha",
                                         "blue.specular_reflectance.value", "yellow.diffuse_reflectance.value",
                                         "green.diffuse_reflectance.value"}) {
             const ParameterSet set = ParameterSet::choose(*desc, {name});

@@ -1,12 +1,15 @@
 // stb_image's allocations held to a budget (included only by src/image's stb decoders:
 // stb_png.cpp, stb_jpeg.cpp). Each decoder's translation unit defines STBI_MALLOC, STBI_REALLOC
-// and STBI_FREE as these functions before it includes stb_image.h, and sets t_budget around a
-// decode, so that corrupt data cannot make stb allocate without bound.
+// and STBI_FREE as these functions before it includes stb_image.h and decodes through
+// decode_rgb8_within_budget, which sets t_budget around the decode, so that corrupt data cannot
+// make stb allocate without bound.
 #pragma once
 
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
+
+#include "image/stb_png.hpp"
 
 namespace {
 
@@ -65,6 +68,40 @@ constexpr size_t kHeader = 16;
     }
     std::memcpy(base, &n, sizeof n);
     return base + kHeader;
+}
+
+// One decode of `size` bytes into 8-bit RGB under `budget`, by the stb_image compiled into the
+// calling translation unit (its functions are static there, so they are passed in: stb's
+// load_from_memory, image_free and failure_reason).
+template <typename Load, typename Release, typename Reason>
+pathlab::io::PngDecodeResult decode_rgb8_within_budget(const uint8_t* data, size_t size, size_t budget, pathlab::Image8& out,
+                                                      Load load, Release release, Reason reason) {
+    pathlab::io::PngDecodeResult result;
+    Budget b;
+    b.limit = budget;
+    t_budget = &b;
+    int w = 0, h = 0, n = 0;
+    unsigned char* pixels = load(data, int(size), &w, &h, &n, 3);
+    if (!pixels) {
+        t_budget = nullptr;
+        result.over_budget = b.exceeded;
+        const char* why = reason();
+        result.error = why ? why : "unknown error";
+        return result;
+    }
+    const size_t bytes = size_t(w) * size_t(h) * 3;
+    try {
+        out.width = w, out.height = h;
+        out.rgb.assign(pixels, pixels + bytes);
+    } catch (...) {
+        release(pixels);
+        t_budget = nullptr;
+        throw;
+    }
+    release(pixels);
+    t_budget = nullptr;
+    result.ok = true;
+    return result;
 }
 
 }  // namespace

@@ -37,32 +37,7 @@
 namespace pathlab::io {
 
 JpegDecodeResult decode_jpeg_rgb8(const uint8_t* data, size_t size, size_t budget, Image8& out) {
-    JpegDecodeResult result;
-    Budget b;
-    b.limit = budget;
-    t_budget = &b;
-    int w = 0, h = 0, n = 0;
-    stbi_uc* pixels = stbi_load_from_memory(data, int(size), &w, &h, &n, 3);
-    if (!pixels) {
-        t_budget = nullptr;
-        result.over_budget = b.exceeded;
-        const char* why = stbi_failure_reason();
-        result.error = why ? why : "unknown error";
-        return result;
-    }
-    const size_t bytes = size_t(w) * size_t(h) * 3;
-    try {
-        out.width = w, out.height = h;
-        out.rgb.assign(pixels, pixels + bytes);
-    } catch (...) {
-        stbi_image_free(pixels);
-        t_budget = nullptr;
-        throw;
-    }
-    stbi_image_free(pixels);
-    t_budget = nullptr;
-    result.ok = true;
-    return result;
+    return decode_rgb8_within_budget(data, size, budget, out, stbi_load_from_memory, stbi_image_free, stbi_failure_reason);
 }
 
 }  // namespace pathlab::io

@@ -38,7 +38,9 @@ TEST(Textures, SrgbDecodeIsTheStandardCurveAndInvertsTheEncoder) {
     EXPECT_NEAR(t[128], 0.2158605f, 1e-6f);
     for (int v = 0; v < 256; ++v) {
         EXPECT_EQ(encode_srgb8(t[size_t(v)]), v) << v;  // pathlab's PNG writer's curve, inverted
-        if (v > 0) EXPECT_GT(t[size_t(v)], t[size_t(v - 1)]);
+        if (v > 0) {
+            EXPECT_GT(t[size_t(v)], t[size_t(v - 1)]);
+        }
     }
 }
 

@@ -2,7 +2,7 @@
 // declares its parameters once, next to its code, as a PluginInfo (names as Mitsuba 3 spells
 // them, the value type, the default and one line of documentation). The scene-file reader
 // fills a Properties with what a file gives; the plugin reads it through its declaration, so
-// the default written in the declaration is the only one there is, and the README's tables
+// the default written in the declaration is the only one there is, and the tables of docs/scene-files.md
 // and `pathlab plugins` print the same declarations.
 //
 // Reading a parameter that the plugin did not declare is a programming error (std::logic_error);
@@ -44,7 +44,7 @@ enum class ParamType {
     Transform,      // <transform>
     FloatOrString,  // <float> or <string> (an index of refraction by value or by name)
 };
-const char* param_type_name(ParamType t);  // "float", "rgb", ... as README's tables show them
+const char* param_type_name(ParamType t);  // "float", "rgb", ... as docs/scene-files.md shows them
 
 struct ParamInfo {
     std::string name;           // Mitsuba 3's name
@@ -62,7 +62,7 @@ struct PluginInfo {
     std::string type;     // the type attribute, e.g. "roughconductor"
     std::string summary;  // one line
     std::vector<ParamInfo> params;
-    std::string notes = {};  // what README adds below the table (may be empty)
+    std::string notes = {};  // what docs/scene-files.md adds below the table (may be empty)
 
     const ParamInfo* find(const std::string& name) const;
     std::string param_names() const;  // "a, b, c" for error messages

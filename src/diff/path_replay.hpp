@@ -44,7 +44,7 @@ struct DiffSettings {
     int max_depth = -1;       // bounces, as IntegratorOptions
     int rr_depth = 3;
     bool hide_emitters = false;
-    DiffFaults faults;  // none, except in tests
+    DiffFaults faults = {};  // none, except in tests
 };
 
 // pt-mis's image (the mean of spp samples per pixel; box filter, pinhole or any camera).

@@ -41,7 +41,7 @@ struct MeshDesc {
     MediumInterface media{};
     UvMap uv_map = UvMap::Vertices;
     Transform to_world, to_object;  // UvMap::Disk: the unit disk's placement and its inverse
-    std::string id;      // the shape's id ("" for none): names its emitter's parameters (diff/)
+    std::string id = {}; // the shape's id ("" for none): names its emitter's parameters (diff/)
 };
 
 struct SphereDesc {
@@ -54,7 +54,7 @@ struct SphereDesc {
     // The world directions of the sphere's own x, y, z axes (its to_world's rotation), which
     // its uv parameterisation (the poles on z, u = 0 towards x) follows.
     std::array<Vec3f, 3> axes{{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
-    std::string id;             // the shape's id ("" for none): names its emitter's parameters (diff/)
+    std::string id = {};        // the shape's id ("" for none): names its emitter's parameters (diff/)
 };
 
 // A shapegroup: meshes that instances place, each instance by its own transform (Embree

@@ -1,5 +1,5 @@
 // The reference of every scene-file plugin and its parameters, printed from the declarations
-// next to each plugin (`pathlab plugins`; README's "Scene files" tables are this text, and a
+// next to each plugin (`pathlab plugins`; the tables of docs/scene-files.md are this text, and a
 // test keeps them equal).
 #pragma once
 

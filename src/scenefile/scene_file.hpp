@@ -1,4 +1,4 @@
-// Scene files: a documented subset of Mitsuba 3's XML format (README, "Scene files").
+// Scene files: a documented subset of Mitsuba 3's XML format (docs/scene-files.md).
 //
 //   <scene version="3.0.0">
 //     <default name="spp" value="64"/>

@@ -39,7 +39,7 @@ inline const PluginInfo& directional_plugin() {
     static const PluginInfo info{"emitter", "directional", "a light infinitely far away, along one direction (the sun)",
                                  {{"direction", ParamType::Point, "0, 0, 1", "the direction the light travels in (turned by to_world)"},
                                   {"irradiance", ParamType::Rgb, "1", "irradiance E on a surface facing the light, W/m^2"},
-                                  {"to_world", ParamType::Transform, "", "orientation"}}};
+                                  {"to_world", ParamType::Transform, "", "orientation", "toWorld"}}};
     return info;
 }
 inline DirectionalLight read_directional_light(Properties& p) {

@@ -108,7 +108,7 @@ const PluginInfo& envmap_plugin() {
         "emitter", "envmap", "an environment map: radiance from every direction, from a latitude-longitude image",
         {{"filename", ParamType::String, "", "the image (.exr, .hdr or .pfm; linear RGB), relative to the scene file"},
          {"scale", ParamType::Float, "1", "multiplies the image's radiance"},
-         {"to_world", ParamType::Transform, "", "orientation (a rotation); the image's top looks along +y, its centre along +z"}},
+         {"to_world", ParamType::Transform, "", "orientation (a rotation); the image's top looks along +y, its centre along +z", "toWorld"}},
         "Mitsuba 3's latitude-longitude convention; importance-sampled by luminance x sin(theta), bilinear lookup "
         "(docs/lights.md). Negative texels (from some resampling filters) are read as 0; NaN or infinite ones are an error."};
     return info;

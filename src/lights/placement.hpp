@@ -2,6 +2,7 @@
 // found, and the rotation of a to_world.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -10,7 +11,9 @@
 
 namespace pathlab {
 
-// Where scene-file emitters find their files.
+class Texture;
+
+// Where scene-file emitters find their files, and the texture nested in the emitter.
 struct EmitterContext {
     std::string base_dir = ".";  // relative file names are resolved against it
     bool allow_files = true;     // false: emitters that read files are an error (the fuzzer)
@@ -19,6 +22,8 @@ struct EmitterContext {
     std::vector<std::string> search_dirs = {};
     // If set, every file found is appended (the scene's identity hashes the files it read).
     std::vector<std::string>* files_read = nullptr;
+    // A nested <texture name="texture"> (or a <ref> to one): spot's projected texture.
+    std::shared_ptr<const Texture> texture = {};
 };
 
 // The path of the emitter's required `filename`, resolved against the search folders;

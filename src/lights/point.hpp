@@ -42,7 +42,7 @@ inline const PluginInfo& point_plugin() {
     static const PluginInfo info{"emitter", "point", "an isotropic point light",
                                  {{"position", ParamType::Point, "0, 0, 0", "where it is (moved by to_world)"},
                                   {"intensity", ParamType::Rgb, "1", "radiant intensity I, W/sr (power 4 pi I)"},
-                                  {"to_world", ParamType::Transform, "", "placement"}}};
+                                  {"to_world", ParamType::Transform, "", "placement", "toWorld"}}};
     return info;
 }
 inline PointLight read_point_light(Properties& p) {

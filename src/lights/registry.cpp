@@ -19,7 +19,7 @@ FreeLight free_light_with_files(Properties& p, const EmitterContext& ctx) {
 const std::vector<EmitterPlugin>& emitter_plugins() {
     static const std::vector<EmitterPlugin> table = {
         {point_plugin, free_light<PointLight, read_point_light>},
-        {spot_plugin, free_light<SpotLight, read_spot_light>},
+        {spot_plugin, free_light_with_files<SpotLight, read_spot_light>},
         {ies_plugin, free_light_with_files<IesLight, read_ies_light>},
         {constant_plugin, free_light<EnvironmentLight, read_constant_light>},
         {envmap_plugin, free_light_with_files<EnvMapLight, read_envmap_light>},

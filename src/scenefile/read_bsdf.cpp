@@ -16,12 +16,6 @@ constexpr int kMaxNesting = 16;  // wrappers of wrappers (also bounds the recurs
 
 Material read_bsdf_at(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b, int depth);
 
-// A <texture> child, or a <ref> to a declared texture.
-std::shared_ptr<const Texture> texture_child(XmlSource& xml, const pugi::xml_node& c, SceneBuilder& b) {
-    if (std::string(c.name()) == "texture") return read_texture(xml, c, b);
-    return std::any_cast<std::shared_ptr<const Texture>>(b.resolve(xml, c, "texture").value);
-}
-
 // The kind of object a <ref> child names ("" when its id is not declared).
 std::string ref_kind(XmlSource& xml, const pugi::xml_node& c, const SceneBuilder& b) {
     if (std::string(c.name()) != "ref" || !c.attribute("id")) return "";

@@ -9,11 +9,17 @@ namespace pathlab {
 void read_free_emitter(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b) {
     xml.check_attributes(n, {"type", "id", "name"});
     const std::string type = xml.attr(n, "type");
+    // Mitsuba 3's spot takes a projected texture: a nested <texture name="texture"> or a <ref> to one.
+    std::shared_ptr<const Texture> texture;
     for (const pugi::xml_node& c : xml.plugin_children(n)) {
-        // Mitsuba 3's spot takes a projected texture: a nested <texture name="texture">.
-        if (type == "spot" && (std::string(c.name()) == "texture" || std::string(c.attribute("name").value()) == "texture"))
-            xml.fail(c, "a spot's projected texture is not supported yet (pathlab's spot has a uniform beam)");
-        xml.fail(c, "an <emitter> has no nested plugins");
+        const bool is_texture = std::string(c.name()) == "texture" || std::string(c.name()) == "ref";
+        if (type != "spot" || !is_texture)
+            xml.fail(c, type == "spot" ? "a spot emitter's only nested plugin is its <texture name=\"texture\">"
+                                       : "an <emitter> has no nested plugins");
+        if (std::string(c.attribute("name").value()) != "texture")
+            xml.fail(c, "a spot's projected texture must be named \"texture\" (<texture name=\"texture\" ...>)");
+        if (texture) xml.fail(c, "a spot takes one projected texture");
+        texture = texture_child(xml, c, b);
     }
     const EmitterPlugin* plugin = find_emitter_plugin(type);
     if (plugin && !plugin->read) xml.fail(n, "an area emitter belongs inside a <shape>");
@@ -22,7 +28,7 @@ void read_free_emitter(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b)
                                 "area inside a shape)",
                                 type));
     Properties p = xml.properties(n, plugin->info());
-    EmitterContext files{b.shapes.base_dir, b.shapes.allow_files, {}, b.shapes.files_read};
+    EmitterContext files{b.shapes.base_dir, b.shapes.allow_files, {}, b.shapes.files_read, texture};
     if (files.allow_files) files.search_dirs = xml.search_dirs();
     const FreeLight light = reading([&] {
         FreeLight l = plugin->read(p, files);

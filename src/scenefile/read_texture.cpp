@@ -25,6 +25,11 @@ std::shared_ptr<const Texture> read_texture(XmlSource& xml, const pugi::xml_node
     });
 }
 
+std::shared_ptr<const Texture> texture_child(XmlSource& xml, const pugi::xml_node& c, SceneBuilder& b) {
+    if (std::string(c.name()) == "texture") return read_texture(xml, c, b);
+    return std::any_cast<std::shared_ptr<const Texture>>(b.resolve(xml, c, "texture").value);
+}
+
 void read_named_texture(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b) {
     if (!n.attribute("id")) xml.fail(n, "a top-level <texture> needs an id (BSDFs refer to it with <ref name=\"PARAMETER\" id=\"...\"/>)");
     const std::string id = xml.attr(n, "id");

@@ -66,6 +66,8 @@ Material read_bsdf(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b);   
 void read_named_bsdf(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b);
 std::shared_ptr<const Texture> read_texture(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b);  // read_texture.cpp
 void read_named_texture(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b);
+// A <texture> child, or a <ref> to a declared texture (read_texture.cpp).
+std::shared_ptr<const Texture> texture_child(XmlSource& xml, const pugi::xml_node& c, SceneBuilder& b);
 void read_shape(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b);       // read_shape.cpp
 std::vector<PluginInfo> group_shape_plugins();  // shapegroup, instance
 void read_free_emitter(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b);  // read_emitter.cpp

@@ -301,7 +301,7 @@ std::unique_ptr<Integrator> make_volpath(const IntegratorOptions& options, Volpa
 }
 
 const IntegratorInfo& volpath_integrator() {
-    static const IntegratorInfo info{"volpath", {}, "volumetric path tracing: participating media, delta tracking, MIS",
+    static const IntegratorInfo info{"volpath", {"volpathmis"}, "volumetric path tracing: participating media, delta tracking, MIS",
                                      false, true, path_params(), [](const IntegratorOptions& o) { return make_volpath(o); }};
     return info;
 }

@@ -31,13 +31,17 @@ double sample_visible_wavelength(double u) {
 }
 
 SampledWavelengths SampledWavelengths::sample_visible(double u) {
+    // With x = tanh(a (lambda - mu)) = t0 + u S, lambda = mu + atanh(x) / a and, since
+    // 1 / cosh^2 = 1 - tanh^2, p(lambda) = a (1 - x^2) / S: one logarithm per lane, no cosh.
     SampledWavelengths w;
+    const Cdf& c = cdf();
     for (int i = 0; i < kSpectrumLanes; ++i) {
         double ui = u + double(i) / kSpectrumLanes;
         if (ui >= 1) ui -= 1;
-        const double l = sample_visible_wavelength(ui);
+        const double x = c.t0 + ui * c.s;
+        const double l = std::clamp(kMu + 0.5 * std::log((1 + x) / (1 - x)) / kA, kVisibleMinWavelength, kVisibleMaxWavelength);
         w.lambda_[size_t(i)] = float(l);
-        w.pdf_[i] = float(visible_wavelength_pdf(w.lambda_[size_t(i)]));
+        w.pdf_[i] = float(kA * (1 - x * x) / c.s);
     }
     return w;
 }

@@ -15,7 +15,9 @@ BlackbodySpectrum::BlackbodySpectrum(double kelvin)
 
 double BlackbodySpectrum::peak_wavelength() const { return kWien / kelvin_ * 1e9; }
 
-float BlackbodySpectrum::operator()(float lambda) const { return float(planck(lambda, kelvin_) * normalisation_); }
+float BlackbodySpectrum::operator()(float lambda) const {
+    return lambda > 0 ? float(planck(lambda, kelvin_) * normalisation_) : 0.0f;
+}
 
 Spectrum4 BlackbodySpectrum::sample(const SampledWavelengths& wl) const {
     Spectrum4 s;

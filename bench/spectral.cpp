@@ -43,7 +43,7 @@ void spectral_suite(const SpectralOptions& o) {
     struct Figure {
         const char* name;
         std::function<void()> body;
-        std::vector<double> ns;
+        std::vector<double> ns = {};
     };
     std::vector<Figure> figures = {
         {"SampledWavelengths::sample_visible", [&] {

@@ -189,6 +189,34 @@ TEST(SpectralFilm, MonteCarloMeanMatchesQuadrature) {
     }
 }
 
+// An RGB emitter end to end: RgbIlluminantSpectrum at the sampled wavelengths, the film's
+// estimator, sRGB. Its mean is the rgb up to the table's round-trip error (a bias, bounded by
+// 2 max(rgb) round_trip_bound()), so the test is |mean - rgb| <= z se + bias bound, z at the
+// Sidak level of 6 tests for a 1% family false-alarm rate: the form phase 2's spectral-vs-RGB
+// agreement test on the course scenes takes.
+TEST(SpectralFilm, RgbEmitterThroughTheEstimatorGivesItsRgb) {
+    const double z_max = z_critical(test::sidak_alpha(6, 0.01));
+    constexpr int kSamples = 40000;
+    for (const Vec3f& rgb : {Vec3f(0.2f, 0.5f, 0.9f), Vec3f(1.0f, 0.3f, 0.05f)}) {
+        const RgbIlluminantSpectrum emitter(RgbToSpectrumTable::srgb(), rgb);
+        const float m = std::max(std::max(rgb.x, rgb.y), rgb.z);
+        Vec3d sum(0.0), sum2(0.0);
+        Pcg32 rng(5, 0);
+        for (int s = 0; s < kSamples; ++s) {
+            const SampledWavelengths wl = SampledWavelengths::sample_visible(rng.next_float());
+            const Vec3d c = spectral_sample_to_linear_srgb(emitter.sample(wl), wl);
+            sum += c;
+            sum2 += c * c;
+        }
+        for (int c = 0; c < 3; ++c) {
+            const double mean = sum[c] / kSamples;
+            const double se = std::sqrt((sum2[c] / kSamples - mean * mean) / (kSamples - 1));
+            EXPECT_LE(std::abs(mean - rgb[c]), z_max * se + 2 * m * round_trip_bound())
+                << "channel " << c << ": mean " << mean << " se " << se;
+        }
+    }
+}
+
 TEST(SpectralFilm, ConstantSpectrumOfValueOneHasUnitLuminance) {
     // Y of a flat 1 is 1 by the normalisation: the estimator's Y is ybar(l) / (pdf(l) int ybar),
     // exactly 1 in the mean; checked here at the quadrature level.

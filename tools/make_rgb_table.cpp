@@ -2,7 +2,9 @@
 // table (src/spectral/rgb_optimiser.hpp) at resolution RES, writes its floats to OUT.bin and a
 // source that embeds them (.incbin) and defines RgbToSpectrumTable::srgb() to OUT.cpp. Run by
 // the build (CMakeLists.txt); prints the fit's time and its worst residual.
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -60,7 +62,25 @@ int main(int argc, char** argv) {
     cpp.close();
     if (!cpp) return 1;
     std::rename((std::string(argv[3]) + ".tmp").c_str(), argv[3]);
-    std::printf("pathlab_make_rgb_table: resolution %d, %zu coefficients, %.2f s on %d threads\n", res, table.size() / 3,
-                seconds, threads);
+    // The fits' own error at the nodes (the table's error between them adds interpolation):
+    // the largest channel difference between a node's colour and its coefficients' colour,
+    // over the nodes brighter than 1e-3 (the darkest need c2 -> -infinity and stop early).
+    const std::vector<float> z = pathlab::rgb_table_z_nodes(res);
+    double worst = 0;
+    for (int m = 0; m < 3; ++m)
+        for (int k = 0; k < res; ++k)
+            for (int j = 0; j < res; ++j)
+                for (int i = 0; i < res; ++i) {
+                    if (z[size_t(k)] < 1e-3f) continue;
+                    const size_t at = (((size_t(m) * res + k) * res + j) * res + i) * 3;
+                    pathlab::Vec3d rgb;
+                    rgb[m] = z[size_t(k)];
+                    rgb[(m + 1) % 3] = double(i) / (res - 1) * z[size_t(k)];
+                    rgb[(m + 2) % 3] = double(j) / (res - 1) * z[size_t(k)];
+                    const pathlab::Vec3d back = pathlab::sigmoid_reflectance_rgb({table[at], table[at + 1], table[at + 2]});
+                    for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(back[c] - rgb[c]));
+                }
+    std::printf("pathlab_make_rgb_table: resolution %d, %zu coefficients, %.2f s on %d threads; largest fit error at a node %.2g\n",
+                res, table.size() / 3, seconds, threads, worst);
     return 0;
 }

@@ -16,6 +16,7 @@
 #include "core/rng.hpp"
 #include "core/spectrum.hpp"
 #include "spectral/blackbody.hpp"
+#include "spectral/dense_spectrum.hpp"
 #include "spectral/dispersion.hpp"
 #include "spectral/metals.hpp"
 #include "spectral/rgb_optimiser.hpp"
@@ -318,6 +319,25 @@ TEST(SpectralUpsampling, UnboundedAndIlluminantSpectraKeepTheirColour) {
             EXPECT_NEAR(eb[c], rgb[c], 2 * m * round_trip_bound());
         }
     }
+}
+
+// --- Dense spectra ---------------------------------------------------------------------------
+
+TEST(SpectralDense, ReproducesTablesAndSmoothSpectra) {
+    // D65 (5 nm knots): the same function to float rounding, everywhere.
+    const DenseSpectrum d65([](double l) { return cie_d65(l); });
+    // A black body: within max |B''| / 8 nm^2. At 2000 K and 360 nm (the steepest place, Wien's
+    // regime), B' / B = c2 / (lambda^2 T) - 5 / lambda < 0.055 / nm, so B'' / B < 3.1e-3 / nm^2:
+    // a relative bound of 4e-4.
+    const BlackbodySpectrum bb(2000);
+    const DenseSpectrum dense_bb([&](double l) { return double(bb(float(l))); });
+    for (float l = 360; l <= 830; l += 0.37f) {
+        EXPECT_NEAR(d65(l), cie_d65(l), 2e-5 * cie_d65(l)) << l;
+        EXPECT_NEAR(dense_bb(l), bb(l), 4e-4 * bb(l)) << l;
+    }
+    EXPECT_EQ(d65(830.0f), float(cie_d65(830)));
+    EXPECT_EQ(d65(359.0f), 0.0f);
+    EXPECT_EQ(d65(831.0f), 0.0f);
 }
 
 // --- Black bodies --------------------------------------------------------------------------

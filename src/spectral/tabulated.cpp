@@ -1,6 +1,6 @@
 #include "spectral/tabulated.hpp"
 
-#include <vector>
+#include "spectral/dense_spectrum.hpp"
 
 namespace pathlab {
 
@@ -16,23 +16,10 @@ double d65_unit_luminance(double lambda) {
 }
 
 Spectrum4 sample_d65_unit_luminance(const SampledWavelengths& wl) {
-    // At every nm of [360, 830] (core's 5 nm table is linear between samples that are among
-    // these, so linear interpolation of these is the same function), one index per lane.
-    static const std::vector<float> dense = [] {
-        std::vector<float> v;
-        for (int l = int(kCieMinWavelength); l <= int(kCieMaxWavelength); ++l) v.push_back(float(d65_unit_luminance(l)));
-        v.push_back(v.back());
-        return v;
-    }();
-    Spectrum4 out;
-    for (int i = 0; i < kSpectrumLanes; ++i) {
-        const float l = wl[i] - float(kCieMinWavelength);
-        if (!(l >= 0 && l <= float(kCieMaxWavelength - kCieMinWavelength))) continue;
-        const size_t k = size_t(l);
-        const float f = l - float(k);
-        out[i] = (1 - f) * dense[k] + f * dense[k + 1];
-    }
-    return out;
+    // At every nm (core's 5 nm table is linear between knots that are among them, so this is the
+    // same function to float rounding), one index per lane.
+    static const DenseSpectrum dense([](double l) { return d65_unit_luminance(l); });
+    return dense.sample(wl);
 }
 
 }  // namespace pathlab

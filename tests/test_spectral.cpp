@@ -251,6 +251,20 @@ TEST(SpectralUpsampling, OptimiserFitsThePrimariesExactly) {
     }
 }
 
+TEST(SpectralUpsampling, OutOfRangeInputsAreClamped) {
+    const RgbToSpectrumTable& t = RgbToSpectrumTable::srgb();
+    for (const Vec3f& rgb : {Vec3f(-1, 0.5f, 2), Vec3f(NAN, 0.5f, 0.2f), Vec3f(INFINITY, 0, 0)}) {
+        const SigmoidPolynomial p = t(rgb);
+        for (float l = 360; l <= 830; l += 10) {
+            EXPECT_GE(p(l), 0.0f);
+            EXPECT_LE(p(l), 1.0f);
+        }
+    }
+    const SigmoidPolynomial a = t(Vec3f(-1, 0.5f, 2)), b = t(Vec3f(0, 0.5f, 1));
+    EXPECT_EQ(a.c0, b.c0);
+    EXPECT_EQ(a.c2, b.c2);
+}
+
 TEST(SpectralUpsampling, FlatGreyRoundTripsToItsValue) {
     for (int i = 0; i <= 10; ++i) {
         const float v = i / 10.0f;

@@ -12,7 +12,7 @@ RgbToSpectrumTable::RgbToSpectrumTable(int res, const float* coefficients)
 
 SigmoidPolynomial RgbToSpectrumTable::operator()(const Vec3f& in) const {
     Vec3f rgb;
-    for (int c = 0; c < 3; ++c) rgb[c] = std::clamp(in[c], 0.0f, 1.0f);
+    for (int c = 0; c < 3; ++c) rgb[c] = in[c] > 0 ? std::min(in[c], 1.0f) : 0.0f;  // NaN -> 0
     if (rgb.x == rgb.y && rgb.y == rgb.z) {
         const float r = rgb.x;
         if (r <= 0) return {0, 0, -INFINITY};

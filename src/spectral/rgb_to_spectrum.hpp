@@ -22,7 +22,8 @@ public:
     // `coefficients`: 3 * res^3 triples laid out as fit_rgb_table() writes them (not copied).
     RgbToSpectrumTable(int res, const float* coefficients);
 
-    // The coefficients of the reflectance whose colour is `rgb` (each channel clamped to [0, 1]).
+    // The coefficients of the reflectance whose colour is `rgb` (each channel clamped to [0, 1],
+    // NaN taken as 0).
     SigmoidPolynomial operator()(const Vec3f& rgb) const;
     int resolution() const { return res_; }
 

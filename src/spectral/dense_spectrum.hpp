@@ -18,7 +18,7 @@ namespace pathlab {
 
 class DenseSpectrum {
 public:
-    static constexpr int kFirst = 360, kLast = 830;
+    static constexpr int kFirst = int(kCieMinWavelength), kLast = int(kCieMaxWavelength);
 
     DenseSpectrum() = default;
     explicit DenseSpectrum(const std::function<double(double)>& f);

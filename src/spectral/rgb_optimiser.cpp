@@ -5,6 +5,7 @@
 #include <thread>
 
 #include "core/spectrum.hpp"
+#include "spectral/sigmoid_polynomial.hpp"
 
 namespace pathlab {
 namespace {
@@ -27,7 +28,7 @@ const Quadrature& quadrature() {
         for (int k = 0; k < kSteps; ++k) {
             const double l = kCieMinWavelength + (k + 0.5) * h;
             const Vec3d bar = cie1931_xyz_bar(l) * (cie_d65(l) * h);
-            q.t[k] = (l - 360.0) / 470.0;
+            q.t[k] = (l - kSigmoidLambdaMin) / kSigmoidLambdaRange;
             for (int c = 0; c < 3; ++c) q.w[c][k] = bar[c];
             n += bar.y;
         }

@@ -18,11 +18,13 @@
 
 #include <array>
 
+#include "core/spectrum.hpp"
 #include "spectral/spectrum4.hpp"
 
 namespace pathlab {
 
-inline constexpr double kVisibleMinWavelength = 360, kVisibleMaxWavelength = 830;
+// The visible range: core/spectrum.hpp's CIE tables' range.
+inline constexpr double kVisibleMinWavelength = kCieMinWavelength, kVisibleMaxWavelength = kCieMaxWavelength;
 
 // The visible-wavelength density above (per nm; 0 outside [360, 830]) and its inverse CDF.
 double visible_wavelength_pdf(double lambda);

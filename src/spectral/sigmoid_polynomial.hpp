@@ -6,11 +6,14 @@
 // stay of the coefficients' own magnitude in float; docs/spectral.md).
 #pragma once
 
+#include <algorithm>
 #include <cmath>
+
+#include "core/spectrum.hpp"
 
 namespace pathlab {
 
-inline constexpr double kSigmoidLambdaMin = 360, kSigmoidLambdaRange = 470;
+inline constexpr double kSigmoidLambdaMin = kCieMinWavelength, kSigmoidLambdaRange = kCieMaxWavelength - kCieMinWavelength;
 
 inline float sigmoid(float x) {
     if (std::isinf(x)) return x > 0 ? 1.0f : 0.0f;

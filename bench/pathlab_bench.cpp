@@ -14,6 +14,7 @@
 //   pathlab_bench lights   an environment map's cost per sample against the constant environment; spot and IES
 //   pathlab_bench textures textured against constant materials per sample; texture lookups
 //   pathlab_bench diff     a gradient's cost (path replay) relative to a primal render, its memory vs spp and depth
+//   pathlab_bench spectral the spectral layer's building blocks: wavelength sampling, RGB upsampling, the XYZ film estimator
 #include <CLI/CLI.hpp>
 
 #include "bidirectional.hpp"
@@ -25,6 +26,7 @@
 #include "lights.hpp"
 #include "photon_mapping.hpp"
 #include "performance.hpp"
+#include "spectral.hpp"
 #include "volumes.hpp"
 #include "textures.hpp"
 
@@ -131,6 +133,10 @@ int main(int argc, char** argv) {
     dfc->add_option("--spp", dfo.spp, "Samples per pixel")->capture_default_str();
     dfc->add_option("--repeats", dfo.repeats, "Interleaved rounds (median reported)")->capture_default_str();
     dfc->add_option("--scenes", dfo.scenes, "Course scene indices")->delimiter(',')->capture_default_str();
+    SpectralOptions spo;
+    CLI::App* spc = app.add_subcommand("spectral", "ns per call of the spectral layer's building blocks (docs/spectral.md)");
+    spc->add_option("--count", spo.count, "Calls per timing")->capture_default_str();
+    spc->add_option("--repeats", spo.repeats, "Timings per figure (median reported)")->capture_default_str();
     // Under mpirun this program is one rank of the reduction benchmark.
     std::vector<std::string> args(argv, argv + argc);
     CLI11_PARSE(app, argc, argv);
@@ -144,6 +150,7 @@ int main(int argc, char** argv) {
     if (*lic) lights_suite(lo);
     if (*vol) volumes_suite(vo);
     if (*txc) textures_suite(tx);
+    if (*spc) spectral_suite(spo);
     if (*icc) irradiance_caching_suite(icopt);
     if (*pmc) photon_mapping_suite(pm);
     if (*bd) bidirectional_suite(b);

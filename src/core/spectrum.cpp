@@ -188,14 +188,20 @@ Vec3d spectrum_to_linear_srgb(const SampledSpectrum& s, SpectrumUse use, bool* c
     return out;
 }
 
-SampledSpectrum blackbody_spectrum(double kelvin) {
-    // Planck: B(lambda, T) = 2 h c^2 / lambda^5 / (exp(h c / (lambda k T)) - 1), per metre, so 1e-9 per nm.
+double spectrum_value(const SampledSpectrum& s, double lambda) { return interpolate(s, lambda); }
+
+double planck(double lambda, double kelvin) {
+    // B(lambda, T) = 2 h c^2 / lambda^5 / (exp(h c / (lambda k T)) - 1), per metre, so 1e-9 per nm.
     constexpr double h = 6.62607015e-34, c = 299792458.0, k = 1.380649e-23;
+    const double m = lambda * 1e-9;
+    return 1e-9 * 2 * h * c * c / std::pow(m, 5) / std::expm1(h * c / (m * k * kelvin));
+}
+
+SampledSpectrum blackbody_spectrum(double kelvin) {
     SampledSpectrum s;
     for (double l = kCieMinWavelength; l <= kCieMaxWavelength; l += 1) {
-        const double m = l * 1e-9;
         s.wavelengths.push_back(l);
-        s.values.push_back(1e-9 * 2 * h * c * c / std::pow(m, 5) / std::expm1(h * c / (m * k * kelvin)));
+        s.values.push_back(planck(l, kelvin));
     }
     return s;
 }

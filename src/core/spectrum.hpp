@@ -60,7 +60,11 @@ std::string parse_spectrum_file(const std::string& text, SampledSpectrum& out);
 // set when a channel was clamped (an out-of-gamut colour).
 Vec3d spectrum_to_xyz(const SampledSpectrum& s, SpectrumUse use);
 Vec3d spectrum_to_linear_srgb(const SampledSpectrum& s, SpectrumUse use, bool* clamped = nullptr);
-// A black body of `kelvin` (Planck's law, W / (m^2 sr nm)), sampled each nm over the CIE range.
+// The spectrum's value at `lambda` nm: linear between its samples, 0 outside them.
+double spectrum_value(const SampledSpectrum& s, double lambda);
+// Planck's law: a black body's spectral radiance at `lambda` nm and `kelvin`, W / (m^2 sr nm).
+double planck(double lambda, double kelvin);
+// A black body of `kelvin` (planck() above), sampled each nm over the CIE range.
 SampledSpectrum blackbody_spectrum(double kelvin);
 
 }  // namespace pathlab

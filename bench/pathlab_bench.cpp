@@ -131,6 +131,7 @@ int main(int argc, char** argv) {
     dfc->add_option("--spp", dfo.spp, "Samples per pixel")->capture_default_str();
     dfc->add_option("--repeats", dfo.repeats, "Interleaved rounds (median reported)")->capture_default_str();
     dfc->add_option("--scenes", dfo.scenes, "Course scene indices")->delimiter(',')->capture_default_str();
+    dfc->add_option("--texture-scene", dfo.texture_scene, "A scene file with a bitmap texture: a row with its texels bound (\"\": none)");
     // Under mpirun this program is one rank of the reduction benchmark.
     std::vector<std::string> args(argv, argv + argc);
     CLI11_PARSE(app, argc, argv);

@@ -1,5 +1,6 @@
 #include "app/diff_commands.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -86,27 +87,41 @@ uint64_t parse_seed(const std::string& text) {
 }
 
 // The chosen parameters, with --set start values applied (and clamped) to the description.
-// `texel`: for each chosen name, the texel it names (`name.data[k]`, gradient's forward images
-// only) or -1.
-ParameterSet choose_parameters(SceneDescription& d, const DiffCommonOptions& o, std::vector<long>* texel = nullptr) {
+// What gradient's forward mode was asked for: a parameter of the set, and one of its texels
+// (`name.data[k]`) or -1 for all of it.
+struct ForwardItem {
+    size_t param;
+    long texel;
+};
+
+// `items` (gradient only): the names as given, several texels of one texture allowed.
+ParameterSet choose_parameters(SceneDescription& d, const DiffCommonOptions& o, std::vector<ForwardItem>* items = nullptr) {
     std::vector<std::string> names = split_comma_list(o.params);
     if (o.params.empty()) throw UsageError("--params: give at least one parameter (`pathlab params SCENE` lists them)");
-    if (texel) {
-        texel->clear();
-        for (std::string& n : names) {
-            const auto [base, k] = split_texel_index(n);
-            n = base;
-            texel->push_back(k);
+    std::vector<std::pair<std::string, long>> asked;
+    if (items) {
+        // The set takes each texture once, whichever of its texels are named.
+        std::vector<std::string> unique;
+        for (const std::string& n : names) {
+            const auto item = split_texel_index(n);
+            if (std::find(asked.begin(), asked.end(), item) != asked.end()) throw UsageError(fmt::format("parameter '{}' is given twice", n));
+            asked.push_back(item);
+            if (std::find(unique.begin(), unique.end(), item.first) == unique.end()) unique.push_back(item.first);
         }
+        names = unique;
     }
     const ParameterSet set = usage_on_invalid([&] { return ParameterSet::choose(d, names); });
-    if (texel)
-        for (size_t i = 0; i < names.size(); ++i) {
+    if (items) {
+        items->clear();
+        for (const auto& [name, k] : asked) {
+            const size_t i = size_t(std::find(names.begin(), names.end(), name) - names.begin());
             const SceneParameter& p = set.params[i];
-            if ((*texel)[i] >= 0 && !p.is_texels()) throw UsageError(fmt::format("{}: only a texture's texels (.data) take an index", p.name));
-            if ((*texel)[i] >= long(p.width) * p.height)
-                throw UsageError(fmt::format("{}[{}]: the texture has {}x{} = {} texels", p.name, (*texel)[i], p.width, p.height, p.width * p.height));
+            if (k >= 0 && !p.is_texels()) throw UsageError(fmt::format("{}: only a texture's texels (.data) take an index", p.name));
+            if (k >= long(p.width) * p.height)
+                throw UsageError(fmt::format("{}[{}]: the texture has {}x{} = {} texels", p.name, k, p.width, p.height, p.width * p.height));
+            items->push_back({i, k});
         }
+    }
     const std::vector<SceneParameter> all = scene_parameters(d);
     for (const std::string& item : o.initial) {
         const size_t eq = item.find('=');
@@ -245,8 +260,8 @@ CLI::App* add_gradient_command(CLI::App& app, GradientOptions& o) {
 
 int run_gradient_command(const GradientOptions& o) {
     SceneChoice scene = one_scene(o.common.scene);
-    std::vector<long> texel;
-    const ParameterSet set = choose_parameters(scene.description, o.common, &texel);
+    std::vector<ForwardItem> items;
+    const ParameterSet set = choose_parameters(scene.description, o.common, &items);
     int w = 64, h = 64;
     Image target;
     if (!o.target.empty()) {
@@ -265,15 +280,15 @@ int run_gradient_command(const GradientOptions& o) {
     DiffSettings gs = s;
     gs.seed = s.seed + 1;  // independent of the primal image that made the adjoint
     const std::vector<double> g = gradient(*built, set, gs, adjoint);
-    for (size_t i = 0; i < set.params.size(); ++i) {
+    for (const auto& [i, texel] : items) {
         const SceneParameter& p = set.params[i];
         // A texel named by index: the tangent moves its three channels; a whole texture: all texels.
         std::vector<float> t = parameter_tangent(set, i);
         std::string name = p.name;
-        if (texel[i] >= 0) {
+        if (texel >= 0) {
             std::fill(t.begin(), t.end(), 0.0f);
-            for (int c = 0; c < 3; ++c) t[size_t(set.offsets[i] + 3 * texel[i] + c)] = 1;
-            name += fmt::format("[{}]", texel[i]);
+            for (int c = 0; c < 3; ++c) t[size_t(set.offsets[i] + 3 * texel + c)] = 1;
+            name += fmt::format("[{}]", texel);
         }
         const Image d = forward_gradient(*built, set, s, t);
         const std::string base = o.out_dir + "/d_" + name;
@@ -281,8 +296,8 @@ int run_gradient_command(const GradientOptions& o) {
         const Image zero(d.width(), d.height());
         write_png8(false_colour_difference(d, zero, difference_scale(d, zero)), base + ".png");
         std::vector<double> gi(g.begin() + set.offsets[i], g.begin() + set.offsets[i] + p.size);
-        if (texel[i] >= 0) gi = std::vector<double>(gi.begin() + 3 * texel[i], gi.begin() + 3 * texel[i] + 3);
-        if (p.is_texels() && texel[i] < 0) {
+        if (texel >= 0) gi = std::vector<double>(gi.begin() + 3 * texel, gi.begin() + 3 * texel + 3);
+        if (p.is_texels() && texel < 0) {
             // Texels: the gradient as an image beside the forward one (written, not printed).
             Image gimg(p.width, p.height);
             for (size_t k = 0; k < gimg.pixel_count(); ++k) gimg[k] = Rgb(float(gi[3 * k]), float(gi[3 * k + 1]), float(gi[3 * k + 2]));

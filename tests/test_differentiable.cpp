@@ -594,6 +594,43 @@ TEST(DiffTexels, WorkedExampleRecoversTexture) {
     EXPECT_LT(end, 0.1 * start);
 }
 
+// A texture that two BSDFs share (a top-level <texture id> given by <ref>) is one parameter,
+// listed under the first BSDF, bound for both, and moved for both; the rewritten scene file
+// points the top-level texture at the written EXR.
+TEST(DiffTexels, SharedTextureIsOneParameter) {
+    namespace fs = std::filesystem;
+    const fs::path dir = fs::temp_directory_path() / ("pathlab-shared-texels-" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    const std::string scenes = std::string(PATHLAB_SOURCE_DIR) + "/scenes";
+    const std::string file = (dir / "shared.xml").string();
+    std::ofstream(file) << "<scene version=\"3.0.0\">\n<path value=\"" << scenes << "\"/>\n"
+                        << R"(<texture type="bitmap" id="pic"><string name="filename" value="textures/letters.png"/></texture>
+<bsdf type="diffuse" id="left"><ref name="reflectance" id="pic"/></bsdf>
+<bsdf type="twosided" id="right"><bsdf type="diffuse"><ref name="reflectance" id="pic"/></bsdf></bsdf>
+<shape type="rectangle"><ref id="left"/></shape>
+<shape type="rectangle"><transform name="to_world"><translate x="3"/></transform><ref id="right"/></shape>
+<shape type="sphere" id="lamp"><point name="center" value="0, 0, 4"/><emitter type="area"><rgb name="radiance" value="2"/></emitter></shape>
+</scene>)";
+    SceneDescription d = load_scene_file(file);
+    std::vector<std::string> names;
+    for (const auto& p : scene_parameters(d)) names.push_back(p.name);
+    EXPECT_EQ(names, (std::vector<std::string>{"left.reflectance.data", "lamp.emitter.radiance.value"}));
+    const ParameterSet set = ParameterSet::choose(d, {"left.reflectance.data"});
+    int bound = 0;
+    for (const MaterialBinding& b : set.materials) bound += b.diffuse_texels.offset == 0;
+    EXPECT_EQ(bound, 2);
+    std::vector<float> theta(size_t(set.size), 0.3f);
+    set.set_values(d, theta);
+    int moved = 0;
+    for (const Material& m : d.materials)
+        if (m.textures) moved += std::get<BitmapTexture>(m.textures->bindings[0].texture->model()).texels()[0] == Rgb(0.3f);
+    EXPECT_EQ(moved, 2);
+    const std::string written = scene_file_with_values(file, set, theta, {{"left.reflectance.data", "left.reflectance.data.exr"}});
+    EXPECT_NE(written.find("value=\"left.reflectance.data.exr\""), std::string::npos) << written;
+    EXPECT_EQ(written.find("letters.png"), std::string::npos) << written;
+    fs::remove_all(dir);
+}
+
 // The command line: params lists the texels (compactly; --json with their shape), optimize
 // accepts them and writes the texture as an EXR that the written scene file reads, gradient
 // takes one texel by index.

@@ -55,4 +55,8 @@ for a in ax.flat:
     a.axis("off")
 plt.tight_layout()
 plt.savefig(f"{out}/texture-progress.png", dpi=80)
+# 256 colours: the noisy renders compress poorly otherwise.
+from PIL import Image
+
+Image.open(f"{out}/texture-progress.png").convert("RGB").quantize(256).save(f"{out}/texture-progress.png", optimize=True)
 shutil.copy(f"{opt}/loss.svg", f"{out}/texture-loss.svg")

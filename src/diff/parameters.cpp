@@ -44,6 +44,21 @@ const TextureBinding& binding_of(const SceneDescription& d, const SceneParameter
     return d.materials.at(p.index).textures->bindings.at(size_t(p.binding));
 }
 
+// The textures that are also used where no derivative flows (a scalar parameter, a normal or
+// bump map, a material nested in blendbsdf or mask): their texels are not parameters, since
+// moving them would change the image in ways the gradient does not see.
+void collect_undifferentiated(const Material& m, bool nested, std::vector<const Texture*>& out) {
+    if (m.textures) {
+        if (m.textures->perturbation_texture) out.push_back(m.textures->perturbation_texture.get());
+        for (const TextureBinding& tb : m.textures->bindings) {
+            const std::optional<ParamField> f = textured_field(m.model, tb.slot);
+            if (nested || tb.scalar || !f || !is_reflectance(*f)) out.push_back(tb.texture.get());
+        }
+    }
+    if (const auto* b = std::get_if<BlendMaterial>(&m.model)) collect_undifferentiated(*b->first, true, out), collect_undifferentiated(*b->second, true, out);
+    if (const auto* k = std::get_if<MaskMaterial>(&m.model)) collect_undifferentiated(*k->inner, true, out);
+}
+
 // Which of a material binding's texel slots field f fills (a diffuse or a specular one).
 bool is_diffuse_field(ParamField f) {
     return f == ParamField::PhongDiffuse || f == ParamField::PlasticDiffuse || f == ParamField::RoughPlasticDiffuse;
@@ -66,6 +81,7 @@ std::string SceneParameter::range() const {
 std::vector<SceneParameter> scene_parameters(const SceneDescription& d) {
     std::vector<SceneParameter> out;
     std::vector<const Texture*> listed;  // textures shared by several materials are listed once
+    for (const Material& m : d.materials) collect_undifferentiated(m, false, listed);  // and these never
     for (size_t i = 0; i < d.materials.size(); ++i) {
         const std::string& id = id_at(d.material_ids, i);
         const Material& m = d.materials[i];
@@ -194,7 +210,7 @@ void set_texels(SceneDescription& d, const SceneParameter& p, const std::vector<
         for (TextureBinding& tb : t.bindings)
             if (tb.texture == old) {
                 tb.texture = fresh;
-                const Rgb hi = fresh->max_value();
+                const Rgb hi = tb.scalar ? Rgb(scalar_value(fresh->max_value())) : fresh->max_value();  // as the reader sets it
                 std::visit(
                     [&](auto& x) {
                         if constexpr (requires { x.set_texel(tb.slot, hi); }) x.set_texel(tb.slot, hi);

@@ -66,7 +66,8 @@ struct SceneParameter {
 // meshes, spheres and free lights). A reflectance given by a bitmap texture is listed as its
 // texels (`.data`), once for a texture that several materials share (at the first); other
 // textured parameters (checkerboards, scalar textures of an exponent or a roughness) are not
-// differentiable and not listed.
+// differentiable and not listed, nor is a bitmap that is also used where no derivative flows
+// (a scalar parameter, a normal or bump map, a BSDF inside blendbsdf or mask).
 std::vector<SceneParameter> scene_parameters(const SceneDescription& d);
 
 // The parameter named `name`; a std::invalid_argument listing the valid names otherwise.

@@ -11,6 +11,7 @@
 #include "diff/path_replay.hpp"
 #include "instrument/allocation_counter.hpp"
 #include "scene/builtin_scenes.hpp"
+#include "scenefile/scene_file.hpp"
 
 namespace pathlab::bench {
 namespace {
@@ -41,10 +42,23 @@ void differentiable_suite(const DifferentiableOptions& o) {
     fmt::print("CPU seconds of the process, median of {} interleaved rounds, {}x{} pixels, {} spp, every parameter of the "
                "scene bound; ratios to the primal render (pt-mis's estimator) of the same spp.\n\n",
                o.repeats, o.size, o.size, o.spp);
-    fmt::print("| scene | parameters | pt-mis render (s) | primal (s) | gradient (s) | gradient / primal | iteration / primal |\n");
+    fmt::print("| scene | parameters (floats) | pt-mis render (s) | primal (s) | gradient (s) | gradient / primal | iteration / primal |\n");
     fmt::print("|---|---|---|---|---|---|---|\n");
-    for (int index : o.scenes) {
-        const SceneDescription d = make_builtin_scene(index);
+    // A row per scene: the course scenes by index, then the texture example (its texels bound too).
+    struct Row {
+        std::string name;
+        SceneDescription d;
+    };
+    std::vector<Row> rows;
+    for (int index : o.scenes) rows.push_back({fmt::format("{} {}", index, builtin_scenes()[size_t(index)].name), make_builtin_scene(index)});
+    if (!o.texture_scene.empty()) {
+        SceneDescription d = load_scene_file(o.texture_scene);
+        int texels = 0;
+        for (const SceneParameter& p : scene_parameters(d)) texels += p.is_texels() ? p.size / 3 : 0;
+        rows.push_back({fmt::format("diff-texture ({} texels)", texels), std::move(d)});
+    }
+    for (const Row& row : rows) {
+        const SceneDescription& d = row.d;
         const ParameterSet set = ParameterSet::choose(d, all_names(d));
         const auto scene = Scene::build(d);
         DiffSettings s;
@@ -60,7 +74,7 @@ void differentiable_suite(const DifferentiableOptions& o) {
             primal.push_back(p), grad.push_back(g);
             ratio_g.push_back(g / p), ratio_it.push_back((p + g) / p);
         }
-        fmt::print("| {} {} | {} | {:.3f} | {:.3f} | {:.3f} | {:.2f} | {:.2f} |\n", index, builtin_scenes()[size_t(index)].name, set.params.size(),
+        fmt::print("| {} | {} ({} floats) | {:.3f} | {:.3f} | {:.3f} | {:.2f} | {:.2f} |\n", row.name, set.params.size(), set.size,
                    median(pt), median(primal), median(grad), median(ratio_g), median(ratio_it));
     }
 
@@ -85,6 +99,25 @@ void differentiable_suite(const DifferentiableOptions& o) {
         const double vertices = double(o.size) * o.size * spp * (depth < 0 ? 5.0 : double(depth));
         fmt::print("| {} | {} | {} | {:.2g} | {:.0f} |\n", spp, depth < 0 ? std::string("unlimited (RR)") : std::to_string(depth), allocations,
                    vertices, peak_rss_mib());
+    }
+    if (!o.texture_scene.empty()) {
+        // The texels: one gradient buffer of the texture's size per sum in flight, whatever spp and depth.
+        const SceneDescription t = load_scene_file(o.texture_scene);
+        const ParameterSet ts = ParameterSet::choose(t, all_names(t));
+        const auto tscene = Scene::build(t);
+        fmt::print("\nThe same for scenes/diff-texture.xml with its {} floats bound (the texels among them):\n\n", ts.size);
+        fmt::print("| spp | max depth | heap allocations | peak RSS (MiB) |\n|---|---|---|---|\n");
+        for (const auto& [spp, depth] : std::vector<std::pair<int, int>>{{1, 1}, {16, 1}, {64, 1}, {16, 16}, {16, -1}}) {
+            DiffSettings s;
+            s.width = s.height = o.size;
+            s.spp = spp;
+            s.max_depth = depth;
+            s.rr_depth = depth < 0 ? 3 : -1;
+            const uint64_t before = allocations_by_all_threads();
+            gradient(*tscene, ts, s, adjoint);
+            fmt::print("| {} | {} | {} | {:.0f} |\n", spp, depth < 0 ? std::string("unlimited (RR)") : std::to_string(depth),
+                       allocations_by_all_threads() - before, peak_rss_mib());
+        }
     }
     fmt::print("\n");
 }

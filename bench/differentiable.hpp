@@ -1,5 +1,6 @@
 #pragma once
 
+#include <string>
 #include <vector>
 
 namespace pathlab::bench {
@@ -9,6 +10,7 @@ struct DifferentiableOptions {
     int spp = 16;           // samples per pixel of every render
     int repeats = 5;        // interleaved rounds (medians reported)
     std::vector<int> scenes{2, 3, 5};
+    std::string texture_scene = PATHLAB_SOURCE_DIR "/scenes/diff-texture.xml";  // a row with texels ("": none)
 };
 
 // `pathlab_bench diff`: the CPU cost of one gradient evaluation (path replay: primal + replay per

@@ -6,6 +6,8 @@
   scenes/textures/dimples.png        a tangent-space normal map of a grid of round dimples
                                      (RGB = (n + 1) / 2, linear: raw = true)
   scenes/textures/uvgrid.png         a uv test grid: u in red, v in green, lines every 1/8
+  scenes/textures/letters.png        32 x 32: "PL" in dark letters on four coloured quadrants, the
+                                     texture that docs/differentiable.md recovers (scenes/diff-texture.xml)
 Run from the repository's root: python3 scripts/make_texture_images.py"""
 import math
 import os
@@ -85,6 +87,26 @@ def dimples(x, y, size=256, cells=8):
     return tuple(255 * (a / L + 1) / 2 for a in n)
 
 
+# A 5 x 7 pixel font, just the letters used.
+GLYPHS = {
+    "P": ["11110", "10001", "10001", "11110", "10000", "10000", "10000"],
+    "L": ["10000", "10000", "10000", "10000", "10000", "10000", "11111"],
+}
+
+
+def letters(x, y, size=32):
+    """Four quadrants of sRGB colours, "PL" in 2 x 2 texel strokes across the middle."""
+    quadrant = [[(214, 96, 77), (92, 168, 96)], [(84, 120, 200), (230, 200, 90)]][y * 2 // size][x * 2 // size]
+    text, scale, gap = "PL", 2, 2
+    width = len(text) * 5 * scale + (len(text) - 1) * gap
+    x0, y0 = (size - width) // 2, (size - 7 * scale) // 2
+    for i, ch in enumerate(text):
+        gx, gy = (x - x0 - i * (5 * scale + gap)) // scale, (y - y0) // scale
+        if 0 <= gx < 5 and 0 <= gy < 7 and x - x0 - i * (5 * scale + gap) >= 0 and y >= y0 and GLYPHS[ch][gy][gx] == "1":
+            return (30, 30, 36)
+    return quadrant
+
+
 def uvgrid(x, y, size=256):
     u, v = (x + 0.5) / size, (y + 0.5) / size
     line = (x % (size // 8) in (0, size // 8 - 1)) or (y % (size // 8) in (0, size // 8 - 1))
@@ -99,3 +121,4 @@ if __name__ == "__main__":
     write_png(os.path.join(OUT, "bricks-height.png"), 256, 256, bricks_height)
     write_png(os.path.join(OUT, "dimples.png"), 256, 256, dimples)
     write_png(os.path.join(OUT, "uvgrid.png"), 256, 256, uvgrid)
+    write_png(os.path.join(OUT, "letters.png"), 32, 32, letters)

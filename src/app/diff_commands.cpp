@@ -1,9 +1,11 @@
 #include "app/diff_commands.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <map>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -34,6 +36,40 @@ std::string value_text(const std::vector<float>& v) {
     return v.size() == 1 ? fmt::format("{:.6g}", v[0]) : fmt::format("{:.6g}, {:.6g}, {:.6g}", v[0], v[1], v[2]);
 }
 
+// The mean of an rgb parameter's components per channel (of texels: over the texels).
+std::vector<float> channel_means(const std::vector<float>& v) {
+    if (v.size() <= 3) return v;
+    double m[3] = {0, 0, 0};
+    for (size_t i = 0; i < v.size(); ++i) m[i % 3] += v[i];
+    const double n = double(v.size() / 3);
+    return {float(m[0] / n), float(m[1] / n), float(m[2] / n)};
+}
+
+// A parameter's value in a line: texels as their size and mean colour.
+std::string value_text(const SceneParameter& p, const std::vector<float>& v) {
+    if (!p.is_texels()) return value_text(v);
+    return fmt::format("{}x{} texels, mean {:.4g}, {:.4g}, {:.4g}", p.width, p.height, channel_means(v)[0], channel_means(v)[1],
+                       channel_means(v)[2]);
+}
+
+// The texels of a parameter as an image (linear values).
+Image texel_image(const SceneParameter& p, const std::vector<float>& v) {
+    Image img(p.width, p.height);
+    for (size_t i = 0; i < img.pixel_count(); ++i) img[i] = Rgb(v[3 * i], v[3 * i + 1], v[3 * i + 2]);
+    return img;
+}
+
+// `name.data[k]`: texel k (row-major, top row first) of a texture; k = -1 for other names.
+std::pair<std::string, long> split_texel_index(const std::string& name) {
+    const size_t open = name.rfind('[');
+    if (open == std::string::npos || name.back() != ']') return {name, -1};
+    const std::string digits = name.substr(open + 1, name.size() - open - 2);
+    char* end = nullptr;
+    const long k = std::strtol(digits.c_str(), &end, 10);
+    if (digits.empty() || *end || k < 0) throw UsageError(fmt::format("'{}': the texel index in [] must be a non-negative whole number", name));
+    return {name.substr(0, open), k};
+}
+
 template <typename F>
 auto usage_on_invalid(F&& f) {
     try {
@@ -51,10 +87,41 @@ uint64_t parse_seed(const std::string& text) {
 }
 
 // The chosen parameters, with --set start values applied (and clamped) to the description.
-ParameterSet choose_parameters(SceneDescription& d, const DiffCommonOptions& o) {
-    const std::vector<std::string> names = split_comma_list(o.params);
+// What gradient's forward mode was asked for: a parameter of the set, and one of its texels
+// (`name.data[k]`) or -1 for all of it.
+struct ForwardItem {
+    size_t param;
+    long texel;
+};
+
+// `items` (gradient only): the names as given, several texels of one texture allowed.
+ParameterSet choose_parameters(SceneDescription& d, const DiffCommonOptions& o, std::vector<ForwardItem>* items = nullptr) {
+    std::vector<std::string> names = split_comma_list(o.params);
     if (o.params.empty()) throw UsageError("--params: give at least one parameter (`pathlab params SCENE` lists them)");
+    std::vector<std::pair<std::string, long>> asked;
+    if (items) {
+        // The set takes each texture once, whichever of its texels are named.
+        std::vector<std::string> unique;
+        for (const std::string& n : names) {
+            const auto item = split_texel_index(n);
+            if (std::find(asked.begin(), asked.end(), item) != asked.end()) throw UsageError(fmt::format("parameter '{}' is given twice", n));
+            asked.push_back(item);
+            if (std::find(unique.begin(), unique.end(), item.first) == unique.end()) unique.push_back(item.first);
+        }
+        names = unique;
+    }
     const ParameterSet set = usage_on_invalid([&] { return ParameterSet::choose(d, names); });
+    if (items) {
+        items->clear();
+        for (const auto& [name, k] : asked) {
+            const size_t i = size_t(std::find(names.begin(), names.end(), name) - names.begin());
+            const SceneParameter& p = set.params[i];
+            if (k >= 0 && !p.is_texels()) throw UsageError(fmt::format("{}: only a texture's texels (.data) take an index", p.name));
+            if (k >= long(p.width) * p.height)
+                throw UsageError(fmt::format("{}[{}]: the texture has {}x{} = {} texels", p.name, k, p.width, p.height, p.width * p.height));
+            items->push_back({i, k});
+        }
+    }
     const std::vector<SceneParameter> all = scene_parameters(d);
     for (const std::string& item : o.initial) {
         const size_t eq = item.find('=');
@@ -67,8 +134,12 @@ ParameterSet choose_parameters(SceneDescription& d, const DiffCommonOptions& o) 
             if (x.empty() || *end || !std::isfinite(f)) throw UsageError(fmt::format("--set '{}': '{}' is not a number", item, x));
             v.push_back(f);
         }
-        if (v.size() == 1 && p.size == 3) v.assign(3, v[0]);
-        if (int(v.size()) != p.size) throw UsageError(fmt::format("--set '{}': {} takes {} values", item, p.name, p.size));
+        if (v.size() == 1 && p.size >= 3) v.assign(3, v[0]);
+        if (p.is_texels() && v.size() == 3)  // one colour for every texel
+            for (int k = 1; k < p.width * p.height; ++k) v.insert(v.end(), {v[0], v[1], v[2]});
+        if (int(v.size()) != p.size)
+            throw UsageError(fmt::format("--set '{}': {} takes {} values{}", item, p.name, p.size,
+                                         p.is_texels() ? " (or one value or one colour for every texel)" : ""));
         clamp_parameter_value(p, v);
         set_parameter_value(d, p, v);
     }
@@ -107,10 +178,36 @@ Image read_target(const std::string& path) {
 
 void write_json(const std::string& path, const nlohmann::json& j) { write_text_file(path, j.dump(2) + "\n"); }
 
-nlohmann::json parameters_json(const ParameterSet& set, const std::vector<float>& theta) {
+std::vector<float> slice(const ParameterSet& set, size_t i, const std::vector<float>& theta) {
+    return std::vector<float>(theta.begin() + set.offsets[i], theta.begin() + set.offsets[i] + set.params[i].size);
+}
+
+// The parameters by name; texels in full, or (`compact`, per iteration) as their mean colour.
+nlohmann::json parameters_json(const ParameterSet& set, const std::vector<float>& theta, bool compact = false) {
     nlohmann::json j = nlohmann::json::object();
-    for (size_t i = 0; i < set.params.size(); ++i)
-        j[set.params[i].name] = std::vector<float>(theta.begin() + set.offsets[i], theta.begin() + set.offsets[i] + set.params[i].size);
+    for (size_t i = 0; i < set.params.size(); ++i) {
+        const std::vector<float> v = slice(set, i, theta);
+        j[set.params[i].name] = compact && set.params[i].is_texels() ? nlohmann::json{{"mean", channel_means(v)}} : nlohmann::json(v);
+    }
+    return j;
+}
+
+// The gradient: in full, or (with texels) by name, texels as the gradient's norm.
+nlohmann::json gradient_json(const ParameterSet& set, const std::vector<double>& g) {
+    bool texels = false;
+    for (const SceneParameter& p : set.params) texels = texels || p.is_texels();
+    if (!texels) return g;
+    nlohmann::json j = nlohmann::json::object();
+    for (size_t i = 0; i < set.params.size(); ++i) {
+        const std::vector<double> gi(g.begin() + set.offsets[i], g.begin() + set.offsets[i] + set.params[i].size);
+        if (!set.params[i].is_texels()) {
+            j[set.params[i].name] = gi;
+            continue;
+        }
+        double n2 = 0;
+        for (double x : gi) n2 += x * x;
+        j[set.params[i].name] = {{"norm", std::sqrt(n2)}};
+    }
     return j;
 }
 
@@ -131,8 +228,12 @@ int run_params_command(const ParamsOptions& o) {
     if (o.json) {
         nlohmann::json j = nlohmann::json::array();
         for (const SceneParameter& p : params)
-            j.push_back({{"name", p.name}, {"kind", p.kind()}, {"value", parameter_value(scene.description, p)}, {"size", p.size},
-                         {"range", p.range()}});
+        {
+            nlohmann::json e = {{"name", p.name}, {"kind", p.kind()}, {"value", parameter_value(scene.description, p)}, {"size", p.size},
+                                {"range", p.range()}};
+            if (p.is_texels()) e["shape"] = {p.height, p.width, 3};  // as Mitsuba 3's TensorXf: rows, columns, channels
+            j.push_back(e);
+        }
         fmt::print("{}\n", j.dump(2));
         return 0;
     }
@@ -140,8 +241,8 @@ int run_params_command(const ParamsOptions& o) {
     for (const SceneParameter& p : params) width = std::max(width, p.name.size());
     fmt::print("{:<{}}  {:<7}  {:<34}  {:>4}  {}\n", "name", width, "kind", "value", "size", "range");
     for (const SceneParameter& p : params)
-        fmt::print("{:<{}}  {:<7}  {:<34}  {:>4}  {}\n", p.name, width, p.kind(), value_text(parameter_value(scene.description, p)), p.size,
-                   p.range());
+        fmt::print("{:<{}}  {:<7}  {:<34}  {:>4}  {}\n", p.name, width, p.kind(), value_text(p, parameter_value(scene.description, p)),
+                   p.size, p.range());
     if (params.empty()) fmt::print("(none: differentiable parameters need ids on the scene's <bsdf>, <shape> and <emitter> elements)\n");
     return 0;
 }
@@ -159,7 +260,8 @@ CLI::App* add_gradient_command(CLI::App& app, GradientOptions& o) {
 
 int run_gradient_command(const GradientOptions& o) {
     SceneChoice scene = one_scene(o.common.scene);
-    const ParameterSet set = choose_parameters(scene.description, o.common);
+    std::vector<ForwardItem> items;
+    const ParameterSet set = choose_parameters(scene.description, o.common, &items);
     int w = 64, h = 64;
     Image target;
     if (!o.target.empty()) {
@@ -178,14 +280,32 @@ int run_gradient_command(const GradientOptions& o) {
     DiffSettings gs = s;
     gs.seed = s.seed + 1;  // independent of the primal image that made the adjoint
     const std::vector<double> g = gradient(*built, set, gs, adjoint);
-    for (size_t i = 0; i < set.params.size(); ++i) {
-        const Image d = forward_gradient(*built, set, s, parameter_tangent(set, i));
-        const std::string base = o.out_dir + "/d_" + set.params[i].name;
+    for (const auto& [i, texel] : items) {
+        const SceneParameter& p = set.params[i];
+        // A texel named by index: the tangent moves its three channels; a whole texture: all texels.
+        std::vector<float> t = parameter_tangent(set, i);
+        std::string name = p.name;
+        if (texel >= 0) {
+            std::fill(t.begin(), t.end(), 0.0f);
+            for (int c = 0; c < 3; ++c) t[size_t(set.offsets[i] + 3 * texel + c)] = 1;
+            name += fmt::format("[{}]", texel);
+        }
+        const Image d = forward_gradient(*built, set, s, t);
+        const std::string base = o.out_dir + "/d_" + name;
         write_image(d, base + ".exr");
         const Image zero(d.width(), d.height());
         write_png8(false_colour_difference(d, zero, difference_scale(d, zero)), base + ".png");
-        std::vector<double> gi(g.begin() + set.offsets[i], g.begin() + set.offsets[i] + set.params[i].size);
-        fmt::print("{}: dLoss/dtheta = [{:.6g}]; forward image {}.exr\n", set.params[i].name, fmt::join(gi, ", "), base);
+        std::vector<double> gi(g.begin() + set.offsets[i], g.begin() + set.offsets[i] + p.size);
+        if (texel >= 0) gi = std::vector<double>(gi.begin() + 3 * texel, gi.begin() + 3 * texel + 3);
+        if (p.is_texels() && texel < 0) {
+            // Texels: the gradient as an image beside the forward one (written, not printed).
+            Image gimg(p.width, p.height);
+            for (size_t k = 0; k < gimg.pixel_count(); ++k) gimg[k] = Rgb(float(gi[3 * k]), float(gi[3 * k + 1]), float(gi[3 * k + 2]));
+            write_image(gimg, o.out_dir + "/grad_" + name + ".exr");
+            fmt::print("{}: dLoss/dtheta per texel in {}/grad_{}.exr; forward image (all texels moved) {}.exr\n", name, o.out_dir, name, base);
+            continue;
+        }
+        fmt::print("{}: dLoss/dtheta = [{:.6g}]; forward image {}.exr\n", name, fmt::join(gi, ", "), base);
     }
     return 0;
 }
@@ -263,15 +383,18 @@ int run_optimize_command(const OptimizeOptions& o) {
         DiffSettings gs = s;
         gs.seed = s.seed + 1;
         const std::vector<double> g = gradient(*built, set, gs, loss_adjoint(image, target, loss));
-        history.push_back({{"iteration", it}, {"loss", L}, {"params", parameters_json(set, theta)}, {"gradient", g}});
+        history.push_back({{"iteration", it}, {"loss", L}, {"params", parameters_json(set, theta, true)}, {"gradient", gradient_json(set, g)}});
         series.points.push_back({double(it + 1), L});
-        if (o.save_every > 0 && it % o.save_every == 0) write_image(image, fmt::format("{}/iteration_{:04d}.png", o.out_dir, it));
+        if (o.save_every > 0 && it % o.save_every == 0) {
+            write_image(image, fmt::format("{}/iteration_{:04d}.png", o.out_dir, it));
+            for (size_t i = 0; i < set.params.size(); ++i)
+                if (set.params[i].is_texels())
+                    write_image(texel_image(set.params[i], slice(set, i, theta)), fmt::format("{}/{}_{:04d}.png", o.out_dir, set.params[i].name, it));
+        }
         if (!o.quiet) {
             std::string values;
             for (size_t i = 0; i < set.params.size(); ++i)
-                values += fmt::format("  {}=[{}]", set.params[i].name,
-                                      value_text(std::vector<float>(theta.begin() + set.offsets[i],
-                                                                    theta.begin() + set.offsets[i] + set.params[i].size)));
+                values += fmt::format("  {}=[{}]", set.params[i].name, value_text(set.params[i], slice(set, i, theta)));
             fmt::print("iteration {:4d}  loss {:.6g}{}\n", it, L, values);
         }
         opt.step(theta, g);
@@ -306,9 +429,18 @@ int run_optimize_command(const OptimizeOptions& o) {
         LogLogPlot plot{"pathlab optimize: loss per iteration", "iteration", fmt::format("{} loss", o.loss)};
         plot.slope_guide = false;
         write_text_file(o.out_dir + "/loss.svg", log_log_svg(plot, {series}));
+        // Texels: an EXR of the linear values (exactly what was optimised) and a PNG to look at.
+        std::map<std::string, std::string> texel_files;
+        for (size_t i = 0; i < set.params.size(); ++i) {
+            if (!set.params[i].is_texels()) continue;
+            const Image tex = texel_image(set.params[i], slice(set, i, result));
+            write_image(tex, o.out_dir + "/" + set.params[i].name + ".exr");
+            write_image(tex, o.out_dir + "/" + set.params[i].name + ".png");
+            texel_files[set.params[i].name] = set.params[i].name + ".exr";  // next to scene.xml
+        }
         if (!scene.file.empty()) {
             try {
-                write_text_file(o.out_dir + "/scene.xml", scene_file_with_values(scene.file, set, result));
+                write_text_file(o.out_dir + "/scene.xml", scene_file_with_values(scene.file, set, result, texel_files));
             } catch (const std::runtime_error& e) {
                 fmt::print(stderr, "pathlab: {}\n", e.what());
             }

@@ -1,6 +1,8 @@
 #include "diff/parameters.hpp"
 
 #include <algorithm>
+#include <memory>
+#include <optional>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -14,6 +16,52 @@ Rgb rgb(const std::vector<float>& v) { return Rgb(v.at(0), v.at(1), v.at(2)); }
 const std::string& id_at(const std::vector<std::string>& ids, size_t i) {
     static const std::string none;
     return i < ids.size() ? ids[i] : none;
+}
+
+// The parameter that a texture bound to `slot` of model m gives, if it is one of ours.
+std::optional<ParamField> textured_field(const MaterialModel& m, int slot) {
+    if (std::holds_alternative<PhongMaterial>(m))
+        return slot == PhongMaterial::kSlotDiffuse    ? ParamField::PhongDiffuse
+               : slot == PhongMaterial::kSlotSpecular ? ParamField::PhongSpecular
+                                                      : ParamField::PhongExponent;
+    if (std::holds_alternative<ConductorMaterial>(m)) return ParamField::ConductorSpecular;
+    if (std::holds_alternative<RoughConductorMaterial>(m))
+        return slot == RoughConductorMaterial::kSlotSpecularReflectance ? ParamField::RoughConductorSpecular : ParamField::RoughConductorAlpha;
+    if (std::holds_alternative<PlasticMaterial>(m))
+        return slot == CoatedDiffuse::kSlotDiffuse ? ParamField::PlasticDiffuse : ParamField::PlasticSpecular;
+    if (std::holds_alternative<RoughPlasticMaterial>(m) && slot == CoatedDiffuse::kSlotDiffuse) return ParamField::RoughPlasticDiffuse;
+    return std::nullopt;
+}
+
+// The rgb reflectances (the fields whose texels are differentiable).
+bool is_reflectance(ParamField f) { return f != ParamField::PhongExponent && f != ParamField::RoughConductorAlpha && f < ParamField::Texels; }
+
+const BitmapTexture* bitmap_of(const TextureBinding& b) {
+    return b.scalar || !b.texture ? nullptr : std::get_if<BitmapTexture>(&b.texture->model());
+}
+
+const TextureBinding& binding_of(const SceneDescription& d, const SceneParameter& p) {
+    return d.materials.at(p.index).textures->bindings.at(size_t(p.binding));
+}
+
+// The textures that are also used where no derivative flows (a scalar parameter, a normal or
+// bump map, a material nested in blendbsdf or mask): their texels are not parameters, since
+// moving them would change the image in ways the gradient does not see.
+void collect_undifferentiated(const Material& m, bool nested, std::vector<const Texture*>& out) {
+    if (m.textures) {
+        if (m.textures->perturbation_texture) out.push_back(m.textures->perturbation_texture.get());
+        for (const TextureBinding& tb : m.textures->bindings) {
+            const std::optional<ParamField> f = textured_field(m.model, tb.slot);
+            if (nested || tb.scalar || !f || !is_reflectance(*f)) out.push_back(tb.texture.get());
+        }
+    }
+    if (const auto* b = std::get_if<BlendMaterial>(&m.model)) collect_undifferentiated(*b->first, true, out), collect_undifferentiated(*b->second, true, out);
+    if (const auto* k = std::get_if<MaskMaterial>(&m.model)) collect_undifferentiated(*k->inner, true, out);
+}
+
+// Which of a material binding's texel slots field f fills (a diffuse or a specular one).
+bool is_diffuse_field(ParamField f) {
+    return f == ParamField::PhongDiffuse || f == ParamField::PlasticDiffuse || f == ParamField::RoughPlasticDiffuse;
 }
 
 }  // namespace
@@ -32,12 +80,30 @@ std::string SceneParameter::range() const {
 
 std::vector<SceneParameter> scene_parameters(const SceneDescription& d) {
     std::vector<SceneParameter> out;
+    std::vector<const Texture*> listed;  // textures shared by several materials are listed once
+    for (const Material& m : d.materials) collect_undifferentiated(m, false, listed);  // and these never
     for (size_t i = 0; i < d.materials.size(); ++i) {
         const std::string& id = id_at(d.material_ids, i);
         const Material& m = d.materials[i];
         if (id.empty() || m.is_black()) continue;
         const uint32_t k = uint32_t(i);
-        const auto add = [&](const std::string& what, ParamField f, int size) { out.push_back({id + "." + what, f, k, size}); };
+        const auto add = [&](const std::string& what, ParamField f, int size) {
+            // A textured parameter: a bitmap's texels (reflectances only), or nothing.
+            const std::vector<TextureBinding>* bindings = m.textures ? &m.textures->bindings : nullptr;
+            for (size_t b = 0; bindings && b < bindings->size(); ++b) {
+                const TextureBinding& tb = (*bindings)[b];
+                if (textured_field(m.model, tb.slot) != f) continue;
+                const BitmapTexture* bitmap = bitmap_of(tb);
+                if (!bitmap || !is_reflectance(f) || std::find(listed.begin(), listed.end(), tb.texture.get()) != listed.end()) return;
+                listed.push_back(tb.texture.get());
+                SceneParameter p{id + "." + what.substr(0, what.rfind(".value")) + ".data", ParamField::Texels, k,
+                                 bitmap->width() * bitmap->height() * 3};
+                p.texels_of = f, p.binding = int(b), p.width = bitmap->width(), p.height = bitmap->height();
+                out.push_back(p);
+                return;
+            }
+            out.push_back({id + "." + what, f, k, size});
+        };
         if (const auto* p = std::get_if<PhongMaterial>(&m.model)) {
             if (is_black(p->specular)) {
                 add("reflectance.value", ParamField::PhongDiffuse, 3);
@@ -93,6 +159,13 @@ std::vector<float> parameter_value(const SceneDescription& d, const SceneParamet
             default: return rgb(std::get<EnvironmentLight>(d.lights.at(p.index)).radiance);
         }
     }
+    if (p.is_texels()) {
+        const std::vector<Rgb>& texels = bitmap_of(binding_of(d, p))->texels();
+        std::vector<float> v;
+        v.reserve(texels.size() * 3);
+        for (const Rgb& t : texels) v.insert(v.end(), {t.x, t.y, t.z});
+        return v;
+    }
     const MaterialModel& m = d.materials.at(p.index).model;
     switch (p.field) {
         case ParamField::PhongDiffuse: return rgb(std::get<PhongMaterial>(m).diffuse);
@@ -117,6 +190,46 @@ CoatedDiffuse recoat(const CoatedDiffuse& c, const Rgb& diffuse, const Rgb& spec
 
 }  // namespace
 
+namespace {
+
+// A new texture with the texels v (the old one's size, filter, wrap mode and uv transform),
+// given to every binding of every material that had the old one. The model's constant, which
+// a textured parameter holds as the texture's largest value (its lobe flags follow it; see
+// scenefile/read_bsdf.cpp), follows too.
+void set_texels(SceneDescription& d, const SceneParameter& p, const std::vector<float>& v) {
+    const std::shared_ptr<const Texture> old = binding_of(d, p).texture;
+    const BitmapTexture& b = std::get<BitmapTexture>(old->model());
+    std::vector<Rgb> texels(v.size() / 3);
+    for (size_t i = 0; i < texels.size(); ++i) texels[i] = Rgb(v[3 * i], v[3 * i + 1], v[3 * i + 2]);
+    const auto fresh = std::make_shared<const Texture>(
+        BitmapTexture(b.width(), b.height(), std::move(texels), b.filter(), b.wrap_mode(), b.to_uv(), b.colour(), b.name()));
+    for (Material& m : d.materials) {
+        if (!m.textures) continue;
+        MaterialTextures t = *m.textures;
+        bool changed = false;
+        for (TextureBinding& tb : t.bindings)
+            if (tb.texture == old) {
+                tb.texture = fresh;
+                const Rgb hi = tb.scalar ? Rgb(scalar_value(fresh->max_value())) : fresh->max_value();  // as the reader sets it
+                std::visit(
+                    [&](auto& x) {
+                        if constexpr (requires { x.set_texel(tb.slot, hi); }) x.set_texel(tb.slot, hi);
+                    },
+                    m.model);
+                changed = true;
+            }
+        if (!changed) continue;
+        std::visit(
+            [](auto& x) {
+                if constexpr (requires { x.texels_changed(); }) x.texels_changed();
+            },
+            m.model);
+        m.set_textures(std::move(t));
+    }
+}
+
+}  // namespace
+
 void set_parameter_value(SceneDescription& d, const SceneParameter& p, const std::vector<float>& v) {
     if (int(v.size()) != p.size) throw std::invalid_argument(fmt::format("{} takes {} values, got {}", p.name, p.size, v.size()));
     switch (p.field) {
@@ -124,6 +237,7 @@ void set_parameter_value(SceneDescription& d, const SceneParameter& p, const std
         case ParamField::SphereRadiance: d.spheres.at(p.index).emission = rgb(v); return;
         case ParamField::PointIntensity: std::get<PointLight>(d.lights.at(p.index)).intensity = rgb(v); return;
         case ParamField::ConstantRadiance: std::get<EnvironmentLight>(d.lights.at(p.index)).radiance = rgb(v); return;
+        case ParamField::Texels: set_texels(d, p, v); return;
         default: break;
     }
     MaterialModel& m = d.materials.at(p.index).model;
@@ -184,6 +298,20 @@ ParameterSet ParameterSet::choose(const SceneDescription& d, const std::vector<s
         const int off = s.size;
         s.size += p.size;
         MaterialBinding* mb = p.is_material() ? &s.materials[p.index] : nullptr;
+        if (p.is_texels()) {
+            // Every material that reads this texture for a reflectance.
+            const Texture* tex = binding_of(d, p).texture.get();
+            for (size_t i = 0; i < d.materials.size(); ++i) {
+                const Material& m = d.materials[i];
+                for (size_t b = 0; m.textures && b < m.textures->bindings.size(); ++b) {
+                    const TextureBinding& tb = m.textures->bindings[b];
+                    const std::optional<ParamField> f = textured_field(m.model, tb.slot);
+                    if (tb.texture.get() != tex || !f || !is_reflectance(*f)) continue;
+                    (is_diffuse_field(*f) ? s.materials[i].diffuse_texels : s.materials[i].specular_texels) = {off, int(b)};
+                }
+            }
+            continue;
+        }
         switch (p.field) {
             case ParamField::PhongDiffuse:
             case ParamField::PlasticDiffuse:

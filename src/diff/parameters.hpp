@@ -7,6 +7,9 @@
 //   <shape id>.emitter.radiance.value       area emitter on a shape: radiance, rgb
 //   <emitter id>.intensity.value            point light: intensity, rgb
 //   <emitter id>.radiance.value             constant environment: radiance, rgb
+//   <bsdf id>.<reflectance>.data            a bitmap texture's texels in place of one of the rgb
+//                                           reflectances above (e.g. reflectance.data): width *
+//                                           height * 3 linear values, row-major, top row first
 // A twosided wrapper is transparent (its id names the BSDF inside). Materials without an id,
 // pure emitters' black BSDFs (paths end there) and the other models (dielectrics: only an
 // index of refraction, which moves refracted directions; blendbsdf, mask) have none; geometric
@@ -33,6 +36,7 @@ enum class ParamField {
     PlasticDiffuse,
     PlasticSpecular,
     RoughPlasticDiffuse,
+    Texels,          // a bitmap texture's texels; SceneParameter::texels_of says which reflectance
     MeshRadiance,    // index: the mesh
     SphereRadiance,  // index: the sphere
     PointIntensity,  // index: the light in SceneDescription::lights
@@ -43,24 +47,35 @@ struct SceneParameter {
     std::string name;   // e.g. "red.reflectance.value"
     ParamField field;
     uint32_t index = 0;  // material, mesh, sphere or free light, by field
-    int size = 3;        // 3 (rgb) or 1 (float)
+    int size = 3;        // 3 (rgb) or 1 (float); width * height * 3 for texels
+    // Texels: the reflectance the texture gives (one of the rgb fields above), the texture's
+    // binding in the material (Material::textures->bindings) and its size.
+    ParamField texels_of = ParamField::PhongDiffuse;
+    int binding = -1;
+    int width = 0, height = 0;
 
     bool is_material() const { return field < ParamField::MeshRadiance; }
-    // "bsdf" or "emitter".
-    std::string kind() const { return is_material() ? "bsdf" : "emitter"; }
+    bool is_texels() const { return field == ParamField::Texels; }
+    // "bsdf", "texture" or "emitter".
+    std::string kind() const { return is_texels() ? "texture" : is_material() ? "bsdf" : "emitter"; }
     // The valid range, as the optimiser clamps to it ("[0, 1]", "> 0", ">= 0").
     std::string range() const;
 };
 
 // Every differentiable parameter of the scene, in a stable order (materials by index, then
-// meshes, spheres and free lights).
+// meshes, spheres and free lights). A reflectance given by a bitmap texture is listed as its
+// texels (`.data`), once for a texture that several materials share (at the first); other
+// textured parameters (checkerboards, scalar textures of an exponent or a roughness) are not
+// differentiable and not listed, nor is a bitmap that is also used where no derivative flows
+// (a scalar parameter, a normal or bump map, a BSDF inside blendbsdf or mask).
 std::vector<SceneParameter> scene_parameters(const SceneDescription& d);
 
 // The parameter named `name`; a std::invalid_argument listing the valid names otherwise.
 const SceneParameter& find_parameter(const std::vector<SceneParameter>& all, const std::string& name);
 
 std::vector<float> parameter_value(const SceneDescription& d, const SceneParameter& p);
-// Writes `value` (p.size floats) into the description (rebuilding what a model precomputes).
+// Writes `value` (p.size floats) into the description (rebuilding what a model precomputes;
+// texels: a new texture, given to every material that shared the old one).
 void set_parameter_value(SceneDescription& d, const SceneParameter& p, const std::vector<float>& value);
 // Clamps to the valid range: reflectances to [0, 1], roughness to [1e-3, 10], the Phong
 // exponent to [0, 10^4], emission to >= 1e-6 (a zero emitter would vanish from the scene).
@@ -68,9 +83,19 @@ void clamp_parameter_value(const SceneParameter& p, std::vector<float>& value);
 
 // A set of chosen parameters laid out in one vector theta (each at its offset), and how the
 // path replay finds them: per material and per light of a built Scene, the offsets (-1: not chosen).
+// A reflectance given by texels: the offset of the texels (3 per texel) in theta and the
+// binding in the material's textures whose lookup (Texture::footprint) says which texels a hit
+// reads, with which weights.
+struct TexelBinding {
+    int offset = -1;
+    int binding = -1;
+    bool bound() const { return offset >= 0; }
+};
 struct MaterialBinding {
     int diffuse = -1, specular = -1, exponent = -1, alpha = -1;
-    bool any() const { return diffuse >= 0 || specular >= 0 || exponent >= 0 || alpha >= 0; }
+    TexelBinding diffuse_texels, specular_texels;  // in place of diffuse, specular
+    bool texels() const { return diffuse_texels.bound() || specular_texels.bound(); }
+    bool any() const { return diffuse >= 0 || specular >= 0 || exponent >= 0 || alpha >= 0 || texels(); }
 };
 struct ParameterSet {
     std::vector<SceneParameter> params;

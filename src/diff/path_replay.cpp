@@ -2,8 +2,11 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
+#include <array>
+#include <optional>
 
 #include "diff/bsdf_derivatives.hpp"
 #include "integrators/common/direct_lighting.hpp"
@@ -59,6 +62,9 @@ public:
             if (sp.material->is_black()) break;
             const size_t mat_index = size_t(sp.material - &scene_.material(0));
             const MaterialBinding& mb = mat_index < set_.materials.size() ? set_.materials[mat_index] : kNone;
+            std::optional<VertexBsdf> vb;  // the vertex's differentiable BSDF, if it has bound parameters
+            if (mb.any()) vb.emplace(vertex_bsdf(sp, mb));
+            const VertexBsdf* v = vb ? &*vb : nullptr;
 
             // Next-event estimation, as estimate_light_sample(mis = true).
             const LightChoice choice = scene_.choose_light(sampler.next1d());
@@ -80,7 +86,7 @@ public:
                             const Rgb direct = f * ls->Le * k;
                             L += beta * direct;
                             const float scale = std::holds_alternative<PointLight>(light) ? 1 / (ls->distance * ls->distance) : 1.0f;
-                            vertex_term<M>(*sp.material, mb, sp.wi, wo, false, f, ls->Le, k, choice.index, scale, beta, dbeta, c);
+                            vertex_term<M>(v, sp.wi, wo, false, f, ls->Le, k, choice.index, scale, beta, dbeta, c);
                         }
                     }
                 }
@@ -95,12 +101,12 @@ public:
                     const float k = std::abs(s->wo.z) * weight / s->pdfW;
                     L += beta * (s->f * found.Le * k);
                     const int light = found.hit ? found.isect.light : scene_.environment_light();
-                    vertex_term<M>(*sp.material, mb, sp.wi, s->wo, s->delta, s->f, found.Le, k, light, 1.0f, beta, dbeta, c);
+                    vertex_term<M>(v, sp.wi, s->wo, s->delta, s->f, found.Le, k, light, 1.0f, beta, dbeta, c);
                 }
             }
             if (!rules_.may_bounce(bounces + 1) || !s || !found.hit) break;
             const float k = std::abs(s->wo.z) / s->pdfW;
-            if constexpr (M == Mode::Forward) dbeta = dbeta * (s->f * k) + beta * (bsdf_tangent(*sp.material, mb, sp.wi, *s, c) * k);
+            if constexpr (M == Mode::Forward) dbeta = dbeta * (s->f * k) + beta * (bsdf_tangent(v, sp.wi, *s, c) * k);
             beta *= s->f * k;
             if (rules_.roulette_applies(bounces + 1)) {
                 const float q = std::clamp(max_component(beta), 0.05f, 1.0f);
@@ -110,13 +116,13 @@ public:
             }
             // Reverse: the continuation's weight f scales everything still to come, Lr.
             if constexpr (M == Mode::Reverse) {
-                if (mb.any() && !faults_.drop_continuation) {
+                if (v && !faults_.drop_continuation) {
                     Rgb W(0.0f);
                     for (int ch = 0; ch < 3; ++ch) {
                         const float f = (&s->f.x)[ch];
                         if (f > 0) (&W.x)[ch] = (&c.delta.x)[ch] * (&c.Lr.x)[ch] / f;
                     }
-                    add_bsdf_adjoint(*sp.material, mb, sp.wi, s->wo, s->delta, W, c);
+                    add_bsdf_adjoint(*v, sp.wi, s->wo, s->delta, W, c);
                 }
             }
             hit = found.isect;
@@ -128,13 +134,56 @@ public:
 private:
     static inline const MaterialBinding kNone{};
 
+    // The differentiable side of a vertex's BSDF: the model at the hit (a textured material's
+    // at its uv, so that a derivative that depends on another parameter sees its value there),
+    // the binding, and for a reflectance given by texels the texels the lookup read with their
+    // weights: df/d(texel j, channel c) = weight_j df/drho_c. The texel slots are bound to the
+    // scratch offsets set.size + c (diffuse) and set.size + 3 + c (specular) for bsdf_jacobian,
+    // and jacobian() scatters those to the texels.
+    struct VertexBsdf {
+        const Material* material = nullptr;
+        std::optional<Material> at_uv;  // a textured material's model at the hit
+        MaterialBinding binding;
+        std::array<TexelFootprint, 2> footprint{};  // diffuse, specular
+        std::array<int, 2> texel_offset{-1, -1};
+        const Material& m() const { return at_uv ? *at_uv : *material; }
+    };
+
+    VertexBsdf vertex_bsdf(const ShadingPoint& sp, const MaterialBinding& mb) const {
+        VertexBsdf v;
+        v.material = sp.material;
+        if (sp.material->varies) v.at_uv.emplace(Material{sp.material->model_at(sp.uv)});
+        v.binding = effective(*sp.material, mb);
+        for (int which = 0; which < 2; ++which) {
+            const TexelBinding& tb = which == 0 ? mb.diffuse_texels : mb.specular_texels;
+            if (!tb.bound()) continue;
+            TexelFootprint fp = sp.material->textures->bindings[size_t(tb.binding)].texture->footprint(sp.uv);
+            if (faults_.texel_weights_wrong_corner) std::reverse(fp.weight.begin(), fp.weight.begin() + fp.count);
+            v.footprint[size_t(which)] = fp;
+            v.texel_offset[size_t(which)] = tb.offset;
+            (which == 0 ? v.binding.diffuse : v.binding.specular) = set_.size + 3 * which;
+        }
+        return v;
+    }
+
+    // bsdf_jacobian of the vertex's BSDF, with the texel slots scattered to their texels.
+    template <typename Add>
+    void jacobian(const VertexBsdf& v, const Vec3f& wi, const Vec3f& wo, bool delta, Add&& add) const {
+        bsdf_jacobian(v.m(), v.binding, wi, wo, delta, [&](int off, const Rgb& df) {
+            if (off < set_.size) return add(off, df);
+            const int k = off - set_.size, which = k / 3, ch = k % 3;
+            const TexelFootprint& fp = v.footprint[size_t(which)];
+            for (int j = 0; j < fp.count; ++j) add(v.texel_offset[size_t(which)] + 3 * int(fp.index[size_t(j)]) + ch, df * fp.weight[size_t(j)]);
+        });
+    }
+
     // A term beta f Le k added at a vertex (f the BSDF towards the emitter, Le its radiance,
     // `scale` = dLe/dtheta of the emitter's parameter).
     template <Mode M>
-    void vertex_term(const Material& m, const MaterialBinding& mb, const Vec3f& wi, const Vec3f& wo, bool delta, const Rgb& f,
-                     const Rgb& Le, float k, int light, float scale, const Rgb& beta, const Rgb& dbeta, Carry& c) const {
+    void vertex_term(const VertexBsdf* v, const Vec3f& wi, const Vec3f& wo, bool delta, const Rgb& f, const Rgb& Le, float k, int light,
+                     float scale, const Rgb& beta, const Rgb& dbeta, Carry& c) const {
         if constexpr (M == Mode::Reverse) {
-            if (mb.any()) add_bsdf_adjoint(m, mb, wi, wo, delta, c.delta * beta * Le * k, c);
+            if (v) add_bsdf_adjoint(*v, wi, wo, delta, c.delta * beta * Le * k, c);
             emitter_term<M>(light, beta * f * k, scale, c);
             c.Lr -= beta * (f * Le * k);
         } else if constexpr (M == Mode::Forward) {
@@ -142,7 +191,7 @@ private:
             const int off = light >= 0 && size_t(light) < set_.lights.size() ? set_.lights[size_t(light)] : -1;
             if (off >= 0) dLe = Rgb(c.tangent[off], c.tangent[off + 1], c.tangent[off + 2]) * scale;
             Rgb df(0.0f);
-            if (mb.any()) df = jacobian_dot(m, mb, wi, wo, delta, c.tangent);
+            if (v) df = jacobian_dot(*v, wi, wo, delta, c.tangent);
             c.dL += dbeta * (f * Le * k) + beta * ((df * Le + f * dLe) * k);
         }
     }
@@ -161,17 +210,16 @@ private:
         }
     }
 
-    void add_bsdf_adjoint(const Material& m, const MaterialBinding& mb, const Vec3f& wi, const Vec3f& wo, bool delta, const Rgb& W,
-                          Carry& c) const {
-        bsdf_jacobian(m, effective(m, mb), wi, wo, delta, [&](int off, const Rgb& df) { c.grad[off] += double(dot(W, df)); });
+    void add_bsdf_adjoint(const VertexBsdf& v, const Vec3f& wi, const Vec3f& wo, bool delta, const Rgb& W, Carry& c) const {
+        jacobian(v, wi, wo, delta, [&](int off, const Rgb& df) { c.grad[off] += double(dot(W, df)); });
     }
-    Rgb jacobian_dot(const Material& m, const MaterialBinding& mb, const Vec3f& wi, const Vec3f& wo, bool delta, const float* t) const {
+    Rgb jacobian_dot(const VertexBsdf& v, const Vec3f& wi, const Vec3f& wo, bool delta, const float* t) const {
         Rgb d(0.0f);
-        bsdf_jacobian(m, effective(m, mb), wi, wo, delta, [&](int off, const Rgb& df) { d += df * t[off]; });
+        jacobian(v, wi, wo, delta, [&](int off, const Rgb& df) { d += df * t[off]; });
         return d;
     }
-    Rgb bsdf_tangent(const Material& m, const MaterialBinding& mb, const Vec3f& wi, const BsdfSample& s, const Carry& c) const {
-        return mb.any() ? jacobian_dot(m, mb, wi, s.wo, s.delta, c.tangent) : Rgb(0.0f);
+    Rgb bsdf_tangent(const VertexBsdf* v, const Vec3f& wi, const BsdfSample& s, const Carry& c) const {
+        return v ? jacobian_dot(*v, wi, s.wo, s.delta, c.tangent) : Rgb(0.0f);
     }
     // The binding with the fault switch applied (Phong's glossy lobe dropped).
     MaterialBinding effective(const Material& m, MaterialBinding mb) const {
@@ -236,11 +284,10 @@ std::vector<double> gradient(const Scene& scene, const ParameterSet& set, const 
     const PerspectiveCamera cam(scene.camera(), s.width, s.height);
     const PathReplay replay(scene, set, s);
     const int bands = (s.height + kRowsPerBand - 1) / kRowsPerBand;
-    std::vector<std::vector<double>> band_grad(static_cast<size_t>(bands));
     const uint64_t replay_shift = s.faults.replay_other_numbers ? 1 : 0;
-    for_each_band(s.height, [&](int band, int y0, int y1) {
-        std::vector<double> g(size_t(set.size), 0.0);
-        for (int y = y0; y < y1; ++y)
+    const auto add_band = [&](int band, std::vector<double>& g) {
+        const int y1 = std::min(s.height, (band + 1) * kRowsPerBand);
+        for (int y = band * kRowsPerBand; y < y1; ++y)
             for (int x = 0; x < s.width; ++x) {
                 const size_t pixel = size_t(y) * size_t(s.width) + size_t(x);
                 const Rgb delta = adjoint[pixel] / float(std::max(1, s.spp));
@@ -261,12 +308,22 @@ std::vector<double> gradient(const Scene& scene, const ParameterSet& set, const 
                     replay.trace<Mode::Reverse>(replay_ray, sampler, c);
                 }
             }
-        band_grad[size_t(band)] = std::move(g);
-    });
-    std::vector<double> total(size_t(set.size), 0.0);
-    for (const auto& g : band_grad)
-        for (size_t i = 0; i < g.size(); ++i) total[i] += g[i];
-    return total;
+    };
+    // Gradient sums per band of rows, added pairwise in a fixed tree over the bands (the same
+    // for any thread count: tbb's deterministic reduce splits the range down to single bands).
+    // Only the sums in flight are held (about the threads times the tree's depth), so memory
+    // stays small with parameters of a texture's size.
+    return tbb::parallel_deterministic_reduce(
+        tbb::blocked_range<int>(0, bands, 1), std::vector<double>(size_t(set.size), 0.0),
+        [&](const tbb::blocked_range<int>& r, std::vector<double> g) {
+            for (int b = r.begin(); b != r.end(); ++b) add_band(b, g);
+            return g;
+        },
+        [](std::vector<double> a, const std::vector<double>& b) {
+            for (size_t i = 0; i < a.size(); ++i) a[i] += b[i];
+            return a;
+        },
+        tbb::simple_partitioner());
 }
 
 Image forward_gradient(const Scene& scene, const ParameterSet& set, const DiffSettings& s, const std::vector<float>& tangent) {

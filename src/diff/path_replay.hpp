@@ -13,7 +13,8 @@
 //     and the continuation, whose weight f |cos| / pdf scales everything after it, gives
 //        dLoss/dtheta += delta . (Lr / f) df/dtheta          (Lr after subtracting vertex k's terms).
 // Nothing per path is stored: memory is independent of spp and path length. Gradients are
-// summed per band of rows, then the bands in order: the same bytes with any thread count.
+// summed per band of rows, then pairwise over the bands in a fixed tree: the same bytes with any
+// thread count.
 //
 // Forward mode carries a tangent (d beta, d L) along the path for one direction in parameter
 // space and gives one image of dI/dtheta per parameter (all its components at once, as
@@ -33,6 +34,7 @@ struct DiffFaults {
     bool drop_glossy_lobe = false;      // Phong's glossy lobe left out of df/dtheta
     bool drop_continuation = false;     // the continuation's term (Lr / f) df/dtheta left out
     bool replay_other_numbers = false;  // the replay draws another sample's random numbers
+    bool texel_weights_wrong_corner = false;  // each texel of a bilinear lookup gets the opposite corner's weight
 };
 
 struct DiffSettings {

@@ -49,9 +49,32 @@ void set_value(pugi::xml_node element, const std::vector<std::string>& names, co
     if (old) element.remove_child(old);
 }
 
+// The bitmap <texture> giving parameter `names` of a BSDF element: nested, or the top-level one
+// a <ref name="..." id="..."/> names.
+pugi::xml_node texture_of(pugi::xml_node scene, pugi::xml_node bsdf, const std::vector<std::string>& names) {
+    for (pugi::xml_node c : bsdf.children())
+        for (const std::string& n : names) {
+            if (n != c.attribute("name").value()) continue;
+            if (std::string(c.name()) == "texture") return c;
+            if (std::string(c.name()) == "ref") return find_by_id(scene, "texture", c.attribute("id").value());
+        }
+    return {};
+}
+
+void set_filename(pugi::xml_node texture, const std::string& file) {
+    pugi::xml_node f = texture.find_child_by_attribute("string", "name", "filename");
+    if (!f) {
+        f = texture.prepend_child("string");
+        f.append_attribute("name") = "filename";
+        f.append_attribute("value");
+    }
+    f.attribute("value") = file.c_str();
+}
+
 }  // namespace
 
-std::string scene_file_with_values(const std::string& scene_file, const ParameterSet& set, const std::vector<float>& theta) {
+std::string scene_file_with_values(const std::string& scene_file, const ParameterSet& set, const std::vector<float>& theta,
+                                   const std::map<std::string, std::string>& texel_files) {
     pugi::xml_document doc;
     const pugi::xml_parse_result r = doc.load_file(scene_file.c_str(), pugi::parse_default | pugi::parse_comments);
     if (!r) throw std::runtime_error(fmt::format("{}: cannot be read again: {}", scene_file, r.description()));
@@ -64,7 +87,12 @@ std::string scene_file_with_values(const std::string& scene_file, const Paramete
         std::string bsdf_type;
         if (p.is_material()) {
             element = find_by_id(scene, "bsdf", id);
-            while (element && std::string(element.attribute("type").value()) == "twosided") element = element.child("bsdf");
+            // Wrappers (twosided, normal and bump maps) hold the BSDF with the parameters.
+            while (element && element.child("bsdf")) {
+                const std::string type = element.attribute("type").value();
+                if (type != "twosided" && type != "normalmap" && type != "bumpmap") break;
+                element = element.child("bsdf");
+            }
             if (element) bsdf_type = element.attribute("type").value();
         } else if (p.field == ParamField::MeshRadiance || p.field == ParamField::SphereRadiance) {
             element = find_by_id(scene, "shape", id);
@@ -76,6 +104,17 @@ std::string scene_file_with_values(const std::string& scene_file, const Paramete
             throw std::runtime_error(fmt::format("{}: the element of parameter {} (id '{}') is not in this file (an <include>d one?); "
                                                  "its value is in the JSON output",
                                                  scene_file, p.name, id));
+        if (p.is_texels()) {
+            SceneParameter of = p;
+            of.field = p.texels_of;
+            const pugi::xml_node texture = texture_of(scene, element, xml_names(of, bsdf_type));
+            const auto file = texel_files.find(p.name);
+            if (!texture || file == texel_files.end())
+                throw std::runtime_error(fmt::format("{}: the bitmap <texture> of parameter {} is not in this file; its texels are in the "
+                                                     "JSON output", scene_file, p.name));
+            set_filename(texture, file->second);
+            continue;
+        }
         set_value(element, xml_names(p, bsdf_type), v);
     }
     // Files the scene names are found from the original folder.

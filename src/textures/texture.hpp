@@ -4,8 +4,9 @@
 // transform, the scalar value of a colour, texel footprints) in texture_common.hpp.
 //
 // A material refers to its textures (bsdfs/material.hpp); they are immutable once loaded and
-// shared by every thread. Texel values are kept as loaded (linear RGB, per texture), so that a
-// later stage may expose them by name or upsample them to spectra.
+// shared by every thread. Texel values are kept as loaded (linear RGB, per texture): they are
+// the differentiable parameters `<bsdf id>.reflectance.data` (src/diff/parameters.hpp), and a
+// later stage may upsample them to spectra.
 #pragma once
 
 #include <variant>

@@ -103,7 +103,8 @@ namespace {
 // A -D name that no scene of the list uses is a typo (`-D sp=8` for spp) or meant for another
 // scene: an error that lists what the scenes take.
 void check_defines_used(const std::vector<SceneChoice>& scenes, const SceneDefines& defines) {
-    for (const auto& [name, value] : defines) {
+    for (const auto& define : defines) {
+        const std::string& name = define.first;  // not a binding: the lambda captures it (clang 14)
         if (std::any_of(scenes.begin(), scenes.end(), [&](const SceneChoice& s) { return s.parameters.count(name) > 0; })) continue;
         std::string listing;
         bool builtin = false;
@@ -117,7 +118,7 @@ void check_defines_used(const std::vector<SceneChoice>& scenes, const SceneDefin
             listing += fmt::format("\n  {}: {}", s.file, params.empty() ? "none (no $name in it)" : fmt::format("{}", fmt::join(params, ", ")));
         }
         if (builtin) listing += "\n  the built-in scenes take no parameters";
-        throw UsageError(fmt::format("-D {}={}: no scene uses ${}. The scenes' parameters:{}", name, value, name, listing));
+        throw UsageError(fmt::format("-D {}={}: no scene uses ${}. The scenes' parameters:{}", name, define.second, name, listing));
     }
 }
 

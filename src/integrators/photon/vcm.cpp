@@ -142,7 +142,11 @@ PassCounters Vcm::render_passes(const RenderContext& ctx, Film& film, uint64_t f
         const Vec2f shift = filtered ? filter_shift(ctx, pass) : Vec2f(0.0f, 0.0f);
         std::atomic<int> chunks_done{0};
         tbb::parallel_for(tbb::blocked_range<int>(0, chunks, 1), [&](const tbb::blocked_range<int>& range) {
-            auto& [camera, light] = subpaths_.local();
+            // Named references, not a structured binding: lambdas below capture them, which C++20
+            // allows for bindings but clang before 16 (Debian 12's is 14: the fuzz build) does not.
+            auto& subpaths = subpaths_.local();
+            std::vector<PathVertex>& camera = subpaths.first;
+            std::vector<PathVertex>& light = subpaths.second;
             for (int c = range.begin(); c != range.end(); ++c) {
                 const uint64_t rays_before = Scene::rays_traced_by_this_thread();
                 uint64_t chunk_invalid = 0;

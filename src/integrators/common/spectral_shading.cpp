@@ -117,6 +117,16 @@ Spectrum4 spectral_eval(const ShadingPoint& sp, const Vec3f& wo, const Rgb& f_rg
     return eval_model(sp.material->model, sp.wi, wo, f_rgb, wl);
 }
 
+std::optional<BsdfSample> spectral_sample(const ShadingPoint& sp, const Vec2f& u, SampledWavelengths& wl) {
+    if (const auto* d = std::get_if<DielectricMaterial>(&sp.material->model); d && d->dispersion) [[unlikely]] {
+        DielectricMaterial hero = *d;
+        hero.int_ior = float((*d->dispersion)(wl[0]));
+        wl.terminate_secondary();
+        return hero.sample(sp.wi, u);
+    }
+    return sp.material->sample(sp, sp.wi, u);
+}
+
 Spectrum4 spectral_sample_value(const ShadingPoint& sp, const BsdfSample& s, const SampledWavelengths& wl) {
     if (is_black(s.f)) return Spectrum4(0.0f);
     if (!s.delta) return spectral_eval(sp, s.wo, s.f, wl);

@@ -34,6 +34,11 @@ std::string spectral_unsupported_model(const Material& m);
 // The material models spectral mode renders, for messages.
 const char* spectral_material_names();
 
+// The material's sample at the wavelengths wl: RGB mode's sample(), except at a dispersive
+// dielectric, which refracts (and reflects) the hero wavelength with its index there and keeps
+// only the hero (wl.terminate_secondary(): the other lanes' paths would part from it).
+std::optional<BsdfSample> spectral_sample(const ShadingPoint& sp, const Vec2f& u, SampledWavelengths& wl);
+
 // The BSDF value at the wavelengths for directions (sp.wi, wo) of a non-delta evaluation whose
 // RGB value was f_rgb (0 there gives 0: a perturbed frame's side test, a refused direction).
 Spectrum4 spectral_eval(const ShadingPoint& sp, const Vec3f& wo, const Rgb& f_rgb, const SampledWavelengths& wl);

@@ -14,7 +14,7 @@ Spectrum4 pt_mis_spectral_from_hit(const Scene& scene, Intersection hit, Vec3f d
         if (sp.material->is_black()) break;
         const Spectrum4 direct = estimate_light_sample_spectral(scene, sp, sampler, /*mis=*/true, wl);
         if (counts(bounces + 1)) L += beta * direct;
-        const auto s = sp.material->sample(sp, sp.wi, sampler.next2d());
+        const auto s = spectral_sample(sp, sampler.next2d(), wl);
         EmitterHit found;
         Spectrum4 f(0.0f);
         if (s) {
@@ -26,7 +26,7 @@ Spectrum4 pt_mis_spectral_from_hit(const Scene& scene, Intersection hit, Vec3f d
         if (!three_rays && !s) break;
         BsdfSample next = s ? *s : BsdfSample{};
         if (three_rays) {
-            const auto c = sp.material->sample(sp, sp.wi, sampler.next2d());
+            const auto c = spectral_sample(sp, sampler.next2d(), wl);
             if (!c) break;
             next = *c;
             f = spectral_sample_value(sp, next, wl);

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <set>
 
+#include "cli_runner.hpp"
 #include "job/usage_error.hpp"
 #include "render_helpers.hpp"
 #include "scenefile/scene_file.hpp"
@@ -205,6 +206,14 @@ TEST(SpectralMode, IntegratorsNotConvertedRefuseIt) {
     }
     const std::string names = spectral_integrator_names();
     EXPECT_NE(names.find("pt-mis3"), std::string::npos) << names;
+}
+
+TEST(SpectralMode, CommandLineRefusalExitsWithCodeTwo) {
+    const CliResult r = run({"render", "--scene", "0", "-a", "bdpt", "--spectral", "--spp", "1", "--resolution", "8x8", "-q", "-o",
+                             testing::TempDir() + "spectral-refused.exr"});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("bdpt does not render in spectral mode"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("pt-mis"), std::string::npos) << r.err;
 }
 
 TEST(SpectralMode, UnsupportedMaterialsRefuseIt) {

@@ -27,6 +27,7 @@
 #include "photon_mapping.hpp"
 #include "performance.hpp"
 #include "spectral.hpp"
+#include "spectral_mode.hpp"
 #include "volumes.hpp"
 #include "textures.hpp"
 
@@ -138,6 +139,13 @@ int main(int argc, char** argv) {
     CLI::App* spc = app.add_subcommand("spectral", "ns per call of the spectral layer's building blocks (docs/spectral.md)");
     spc->add_option("--count", spo.count, "Calls per timing")->capture_default_str();
     spc->add_option("--repeats", spo.repeats, "Timings per figure (median reported)")->capture_default_str();
+    SpectralModeOptions smo;
+    CLI::App* smc = app.add_subcommand("spectral-mode", "Spectral mode's cost per sample relative to RGB mode (docs/spectral.md)");
+    smc->add_option("--scenes", smo.scenes, "Course scene indices")->delimiter(',')->capture_default_str();
+    smc->add_option("--algorithms", smo.algorithms, "Integrators that render spectrally")->delimiter(',')->capture_default_str();
+    smc->add_option("--size", smo.size, "Image width and height")->capture_default_str();
+    smc->add_option("--spp", smo.spp, "Samples per pixel per render")->capture_default_str();
+    smc->add_option("--repeats", smo.repeats, "Interleaved rounds (medians reported)")->capture_default_str();
     // Under mpirun this program is one rank of the reduction benchmark.
     std::vector<std::string> args(argv, argv + argc);
     CLI11_PARSE(app, argc, argv);
@@ -152,6 +160,7 @@ int main(int argc, char** argv) {
     if (*vol) volumes_suite(vo);
     if (*txc) textures_suite(tx);
     if (*spc) spectral_suite(spo);
+    if (*smc) spectral_mode_suite(smo);
     if (*icc) irradiance_caching_suite(icopt);
     if (*pmc) photon_mapping_suite(pm);
     if (*bd) bidirectional_suite(b);

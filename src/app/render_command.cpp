@@ -38,6 +38,7 @@ void write_stats(const std::string& path, RenderJob& job, const RenderResult& r,
         {"spp", s.spp},
         {"seed", rs.seed},
         {"sampler", rs.sampler == SamplerKind::Sobol ? "sobol" : "independent"},
+        {"mode", rs.spectral ? "spectral" : "rgb"},
         {"threads", threads},
         {"processes", rank_count},
         {"first_sample", s.passes.begin()},
@@ -83,6 +84,9 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
                    "Random numbers: 'independent' (PCG32; the course's setting, exact per-pixel standard errors) or "
                    "'sobol' (scrambled low-discrepancy points: lower error at equal time)")
         ->capture_default_str();
+    app.add_flag("--spectral", o.spectral,
+                 "Spectral mode: paths carry 4 sampled wavelengths, RGB inputs are upsampled (docs/spectral.md); pt-mis, "
+                 "pt-mis3, pt-naive, direct-mis and direct-light only (others refuse). Also a scene file's <default name=\"mode\" value=\"spectral\"/>");
     add_threads_option(app, o.threads);
     app.add_option("-o,--output", o.outputs,
                    "Output file, repeatable; format by extension: .exr .hdr .pfm .png. Placeholders {scene} {index} "
@@ -155,6 +159,7 @@ std::vector<RenderJob> make_jobs(const RenderCommandOptions& o, bool check_paths
         throw UsageError(fmt::format("unknown sampler '{}'. Valid samplers: independent, sobol", o.sampler));
     request.sampler = o.sampler == "sobol" ? SamplerKind::Sobol : SamplerKind::Independent;
     request.default_spp = kDefaultSpp;
+    request.spectral = o.spectral;
     if (o.mis != "balance" && o.mis != "power")
         throw UsageError(fmt::format("unknown MIS heuristic '{}'. Valid heuristics: balance, power", o.mis));
     request.mis_power = o.mis == "power";
@@ -301,7 +306,8 @@ void print_messages(const std::string& messages) {
 }
 
 void print_summary(const RenderJob& job, const std::string& name, const RenderStats& s) {
-    fmt::print(stderr, "{}: {} spp{} in {:.2f}s ({:.2f} Msamples/s, {:.2f} Mrays/s){}{} -> {}\n", name, s.spp,
+    fmt::print(stderr, "{}{}: {} spp{} in {:.2f}s ({:.2f} Msamples/s, {:.2f} Mrays/s){}{} -> {}\n", name,
+               job.settings.spectral ? " (spectral)" : "", s.spp,
                s.resumed_spp ? fmt::format(" ({} resumed)", s.resumed_spp) : "", s.seconds,
                s.seconds > 0 ? double(s.samples) / s.seconds * 1e-6 : 0.0, s.seconds > 0 ? double(s.rays) / s.seconds * 1e-6 : 0.0,
                s.invalid_samples ? fmt::format(", {} NaN/Inf samples discarded", s.invalid_samples) : "",

@@ -31,6 +31,7 @@ struct RenderCommandOptions {
     int rr_depth = 3;
     bool rr_depth_given = false;
     bool quiet = false;
+    bool spectral = false;
     std::string mis = "balance";
     std::string strategies_dir;
     int strategies_depth = 4;

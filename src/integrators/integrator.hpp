@@ -42,6 +42,8 @@
 #include "render/pixel_filter.hpp"
 #include "samplers/sampler.hpp"
 #include "scene/scene.hpp"
+#include "spectral/sampled_wavelengths.hpp"
+#include "spectral/spectrum4.hpp"
 
 namespace pathlab {
 
@@ -80,6 +82,9 @@ struct IntegratorOptions {
     int pbgi_direct_samples = 16;
     // Paths of no bounce (emitters and the environment seen directly) are left out (Mitsuba's hide_emitters).
     bool hide_emitters = false;
+    // Spectral mode (docs/spectral.md): paths carry 4 sampled wavelengths instead of RGB; only
+    // integrators whose IntegratorInfo::spectral is true accept it (RenderJob refuses the rest).
+    bool spectral = false;
 };
 
 // What every pass of one render sees; fixed for the whole render.
@@ -92,6 +97,9 @@ struct RenderContext {
     int tile_size = 32;  // largest tile edge for pixel integrators (smaller when there are few tiles)
     // The reconstruction filter (render/pixel_filter.hpp); null or box: each sample in its own pixel.
     const PixelFilter* filter = nullptr;
+    // Spectral mode: each camera sample draws its wavelengths (SampledWavelengths) from a stream
+    // RGB mode never reads and the film receives the sample's XYZ estimate as linear sRGB.
+    bool spectral = false;
 
     size_t pixel_count() const { return size_t(width) * size_t(height); }
 };
@@ -131,13 +139,29 @@ public:
 class PixelIntegrator : public Integrator {
 public:
     virtual Rgb radiance(const Scene& scene, const Ray& ray, Sampler& sampler) const = 0;
+    // Spectral mode: the radiance at the 4 wavelengths `wl` (which a dispersive interface may
+    // reduce to the hero, wl.terminate_secondary()). Only integrators whose IntegratorInfo says
+    // `spectral` override it; the default is never called (RenderJob refuses --spectral first).
+    virtual Spectrum4 radiance_spectral(const Scene&, const Ray&, Sampler&, SampledWavelengths&) const { return Spectrum4(0.0f); }
     PassCounters render_passes(const RenderContext& ctx, Film& film, uint64_t first, int count,
                                const PassProgress& progress) final;
 
 private:
     PassCounters render_filtered_passes(const RenderContext& ctx, Film& film, uint64_t first, int count, const PassProgress& progress);
+    PassCounters render_spectral_passes(const RenderContext& ctx, Film& film, uint64_t first, int count, const PassProgress& progress);
+    // One camera sample's colour: radiance() in RGB mode, the XYZ film estimator of
+    // radiance_spectral() in spectral mode.
+    Rgb sample_colour(const RenderContext& ctx, const Ray& ray, Sampler& sampler) const;
     std::vector<Vec3d> lattice_, filtered_;  // a filtered pass (pixel_filter.hpp)
 };
+
+// The stream of a camera sample's wavelength number (Sampler::fork), apart from every stream
+// RGB mode reads, so spectral mode leaves RGB mode's random numbers where they are.
+inline constexpr uint64_t kWavelengthStream = 0x5ec7a1e9f00d0001ull;
+// A camera sample's wavelengths: a pure function of the sample's (seed, pixel, index).
+inline SampledWavelengths sample_camera_wavelengths(const Sampler& sampler) {
+    return SampledWavelengths::sample_visible(sampler.fork(kWavelengthStream).next1d());
+}
 
 // The lattice shift of a filtered pass: every pixel's sample of that pass is at pixel + shift.
 Vec2f filter_shift(const RenderContext& ctx, uint64_t pass);
@@ -161,6 +185,8 @@ struct IntegratorInfo {
     // (false: it adds its samples to the film without them).
     bool any_camera = true;
     bool any_filter = true;
+    // Renders in spectral mode (--spectral); the others refuse it.
+    bool spectral = false;
 
     PluginInfo plugin() const;
 };
@@ -169,5 +195,7 @@ const std::vector<IntegratorInfo>& integrators();
 const IntegratorInfo* find_integrator(const std::string& name_or_alias);
 // "a, b (alias 1), ..." for error messages and help.
 std::string integrator_names();
+// "pt-mis, pt-naive, ...": the integrators that render in spectral mode.
+std::string spectral_integrator_names();
 
 }  // namespace pathlab

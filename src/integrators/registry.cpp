@@ -36,4 +36,11 @@ std::string integrator_names() {
     return out;
 }
 
+std::string spectral_integrator_names() {
+    std::string out;
+    for (const IntegratorInfo& e : integrators())
+        if (e.spectral) out += (out.empty() ? "" : ", ") + e.name;
+    return out;
+}
+
 }  // namespace pathlab

@@ -64,7 +64,8 @@ std::string options_text(const IntegratorOptions& o) {
                        "ic_rays={} ic_error={} ic_gradients={}",
                        o.max_depth, o.rr_depth, o.only_length, o.mis_power ? "power" : "balance", o.photons, hex_float(o.photon_radius),
                        hex_float(o.photon_alpha), int(o.vcm_merging), int(o.vcm_connections), o.ic_rays, hex_float(o.ic_error),
-                       int(o.ic_gradients));
+                       int(o.ic_gradients)) +
+           (o.spectral ? " mode=spectral" : "");  // RGB mode's text as it always was
 }
 
 std::string metadata_key(const std::string& field) {
@@ -99,6 +100,7 @@ RenderIdentity render_identity(RenderJob& job, int width, int height) {
                  {"resolution", fmt::format("{}x{}", width, height)},
                  {"seed", fmt::format("{}", job.settings.seed)},
                  {"sampler", job.settings.sampler == SamplerKind::Sobol ? "sobol" : "independent"}};
+    if (job.integrator_options().spectral) id.fields.push_back({"mode", "spectral"});  // pathlab:mode (absent: RGB)
     return id;
 }
 

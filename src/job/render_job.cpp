@@ -1,3 +1,4 @@
+#include "integrators/common/spectral_shading.hpp"
 #include "job/render_job.hpp"
 
 #include <algorithm>
@@ -83,6 +84,11 @@ RenderJob::RenderJob(SceneChoice scene, const JobRequest& r) : choice_(std::move
     options_.pbgi_direct_samples = r.pbgi_direct_samples ? *r.pbgi_direct_samples : d.pbgi_direct_samples.value_or(options_.pbgi_direct_samples);
     options_.pbgi_spacing = r.pbgi_spacing ? *r.pbgi_spacing : d.pbgi_spacing.value_or(options_.pbgi_spacing);
     options_.hide_emitters = d.hide_emitters.value_or(false);
+    options_.spectral = r.spectral || d.spectral;
+    if (options_.spectral && !info_->spectral)
+        throw UsageError(fmt::format("{} does not render in spectral mode yet (--spectral, or the scene file's <default name=\"mode\" "
+                                     "value=\"spectral\"/>); the integrators that do: {}",
+                                     info_->name, spectral_integrator_names()));
     // What the integrator cannot do with this scene's sensor and film.
     if (!info_->any_camera && d.camera.kind != CameraKind::Perspective)
         throw UsageError(fmt::format("{} cannot render through a {} sensor: it connects light paths to a pinhole camera (or sizes "
@@ -107,11 +113,31 @@ RenderJob::RenderJob(SceneChoice scene, const JobRequest& r) : choice_(std::move
     settings.time_limit = r.time_limit;
     settings.seed = r.seed;
     settings.sampler = r.sampler;
+    settings.spectral = options_.spectral;
     apply_environment_caps(settings, d);
 }
 
+namespace {
+
+// Spectral mode renders only the material models it has spectral values for; a scene with
+// another one is refused (rather than rendered with RGB values).
+void check_spectral_materials(const SceneDescription& d) {
+    for (size_t i = 0; i < d.materials.size(); ++i) {
+        const std::string model = spectral_unsupported_model(d.materials[i]);
+        if (model.empty()) continue;
+        const std::string id = i < d.material_ids.size() && !d.material_ids[i].empty() ? fmt::format(" '{}'", d.material_ids[i]) : "";
+        throw UsageError(fmt::format("spectral mode does not render the bsdf{} of type {} yet; it renders {} (or render in RGB "
+                                     "mode, without --spectral)", id, model, spectral_material_names()));
+    }
+}
+
+}  // namespace
+
 const Scene& RenderJob::scene() {
-    if (!scene_) scene_ = Scene::build(choice_.description);
+    if (!scene_) {
+        if (options_.spectral) check_spectral_materials(choice_.description);
+        scene_ = Scene::build(choice_.description);
+    }
     return *scene_;
 }
 

@@ -32,6 +32,7 @@ struct JobRequest {
     double time_limit = 0;      // seconds; 0: none
     uint64_t seed = 1234;
     SamplerKind sampler = SamplerKind::Independent;
+    bool spectral = false;  // --spectral (else the scene file's <default name="mode">, else RGB)
     uint64_t default_spp = 64;
     bool mis_power = false;        // --mis power (bdpt)
     std::string strategies_dir;    // --strategies DIR (bdpt)

@@ -45,6 +45,7 @@ struct SceneDescription {
     std::optional<int> ic_rays;                                                            // ic
     std::optional<float> ic_error;
     std::optional<bool> ic_gradients, ic_clamp_screen, ic_clamp_neighbours;
+    bool spectral = false;                        // <default name="mode" value="spectral"/>: spectral mode
     std::optional<bool> hide_emitters;            // paths of no bounce (emitters seen directly) left out
     // The film: its reconstruction filter, the format of the default output (hdrfilm's
     // file_format: "openexr", "rgbe" or "pfm"), and extra outputs an integrator asks for

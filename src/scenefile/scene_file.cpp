@@ -78,7 +78,17 @@ struct Loader {
 
     void read_children(XmlSource& xml, const pugi::xml_node& scene);
     void include(XmlSource& xml, const pugi::xml_node& n);
+    void read_mode(XmlSource& xml, const pugi::xml_node& n);
 };
+
+// <default name="mode" value="spectral"/> (or "rgb"; -D mode=... wins, as for every default):
+// the render mode the scene asks for (--spectral also sets it).
+void Loader::read_mode(XmlSource& xml, const pugi::xml_node& n) {
+    const std::string mode = xml.context().defines.at("mode");
+    if (mode == "spectral") b.desc.spectral = true;
+    else if (mode == "rgb") b.desc.spectral = false;
+    else xml.fail(n, fmt::format("unknown mode '{}'. Valid modes: rgb, spectral", mode));
+}
 
 void Loader::read_children(XmlSource& xml, const pugi::xml_node& scene) {
     for (pugi::xml_node n : scene.children()) {
@@ -88,7 +98,10 @@ void Loader::read_children(XmlSource& xml, const pugi::xml_node& scene) {
         }
         if (n.type() != pugi::node_element) continue;
         const std::string tag = n.name();
-        if (tag == "default") xml.define(n);
+        if (tag == "default") {
+            xml.define(n);
+            if (xml.attr(n, "name") == "mode") read_mode(xml, n);
+        }
         else if (tag == "path") {
             xml.check_attributes(n, {"value"});
             const std::string value = xml.attr(n, "value");

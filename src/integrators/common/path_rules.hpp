@@ -12,6 +12,7 @@
 
 #include "samplers/sampler.hpp"
 #include "integrators/integrator.hpp"
+#include "spectral/spectrum4.hpp"
 
 namespace pathlab {
 
@@ -48,6 +49,15 @@ public:
     bool survive_roulette(int bounces, Rgb& beta, Sampler& sampler) const {
         if (rr_depth_ < 0 || bounces < rr_depth_) return true;
         const float q = std::clamp(max_component(beta), 0.05f, 1.0f);
+        if (sampler.next1d() >= q) return false;
+        beta /= q;
+        return true;
+    }
+
+    // The same in spectral mode: q from the largest lane of the throughput.
+    bool survive_roulette(int bounces, Spectrum4& beta, Sampler& sampler) const {
+        if (rr_depth_ < 0 || bounces < rr_depth_) return true;
+        const float q = std::clamp(beta.max_value(), 0.05f, 1.0f);
         if (sampler.next1d() >= q) return false;
         beta /= q;
         return true;

@@ -6,6 +6,7 @@
 // BSDF sampling (weight 1).
 #include "integrators/integrators.hpp"
 #include "integrators/common/direct_lighting.hpp"
+#include "integrators/common/spectral_direct_lighting.hpp"
 
 namespace pathlab {
 
@@ -38,6 +39,21 @@ public:
         }
         return L;
     }
+    // Spectral mode: the same samples, their values at the wavelengths wl (spectral_direct_lighting.hpp).
+    Spectrum4 radiance_spectral(const Scene& scene, const Ray& ray, Sampler& sampler, SampledWavelengths& wl) const override {
+        Intersection hit;
+        if (!scene.intersect(ray, hit)) return hide_ ? Spectrum4(0.0f) : illuminant_spectrum(scene.escaped_radiance(ray.d), wl);
+        Spectrum4 L = hide_ ? Spectrum4(0.0f) : illuminant_spectrum(emitted_radiance(scene, hit, -ray.d), wl);
+        const ShadingPoint sp = make_shading_point(scene, hit, ray.d);
+        if (sp.material->is_black()) return L;
+        L += estimate_light_sample_spectral(scene, sp, sampler, /*mis=*/true, wl);
+        if (!scene.has_hittable_emitters()) return L;
+        if (const auto s = spectral_sample(sp, sampler.next2d(), wl)) {
+            EmitterHit found;
+            L += estimate_bsdf_sample_mis_spectral(scene, sp, *s, spectral_sample_value(sp, *s, wl), found, wl);
+        }
+        return L;
+    }
 
 private:
     bool hide_;
@@ -46,10 +62,14 @@ private:
 }  // namespace
 
 const IntegratorInfo& direct_mis_integrator() {
-    static const IntegratorInfo info{"direct-mis", {"3", "direct"}, "light + BRDF sampling combined by MIS (balance heuristic)",
-                                     false, true, direct_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
-                                         return std::make_unique<DirectMis>(o.hide_emitters);
-                                     }};
+    static const IntegratorInfo info = [] {
+        IntegratorInfo i{"direct-mis", {"3", "direct"}, "light + BRDF sampling combined by MIS (balance heuristic)",
+                         false, true, direct_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
+                             return std::make_unique<DirectMis>(o.hide_emitters);
+                         }};
+        i.spectral = true;
+        return i;
+    }();
     return info;
 }
 

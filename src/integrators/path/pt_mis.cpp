@@ -11,6 +11,8 @@
 #include "integrators/path/pt_mis.hpp"
 
 #include "integrators/common/direct_lighting.hpp"
+#include "integrators/common/spectral_shading.hpp"
+#include "integrators/path/pt_mis_spectral.hpp"
 #include "integrators/integrators.hpp"
 #include "integrators/common/path_rules.hpp"
 
@@ -68,6 +70,14 @@ public:
         return pt_mis_from_hit(scene, hit, camera_ray.d, 0, sampler, rules_, three_rays_, only_length_, emitted);
     }
 
+    Spectrum4 radiance_spectral(const Scene& scene, const Ray& camera_ray, Sampler& sampler, SampledWavelengths& wl) const override {
+        Intersection hit;
+        if (!scene.intersect(camera_ray, hit))
+            return counts(0) ? illuminant_spectrum(scene.escaped_radiance(camera_ray.d), wl) : Spectrum4(0.0f);
+        const Spectrum4 emitted = counts(0) ? illuminant_spectrum(emitted_radiance(scene, hit, -camera_ray.d), wl) : Spectrum4(0.0f);
+        return pt_mis_spectral_from_hit(scene, hit, camera_ray.d, 0, sampler, rules_, three_rays_, only_length_, emitted, wl);
+    }
+
 private:
     bool counts(int length) const { return (only_length_ < 0 || only_length_ == length) && !(hide_ && length == 0); }
 
@@ -80,17 +90,25 @@ private:
 }  // namespace
 
 const IntegratorInfo& pt_mis3_integrator() {
-    static const IntegratorInfo info{"pt-mis3", {"4b"}, "path tracing, MIS direct lighting at every bounce + a third continuation ray",
-                                     false, true, path_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
-                                         return std::make_unique<PtMis>(o, true);
-                                     }};
+    static const IntegratorInfo info = [] {
+        IntegratorInfo i{"pt-mis3", {"4b"}, "path tracing, MIS direct lighting at every bounce + a third continuation ray",
+                         false, true, path_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
+                             return std::make_unique<PtMis>(o, true);
+                         }};
+        i.spectral = true;
+        return i;
+    }();
     return info;
 }
 const IntegratorInfo& pt_mis_integrator() {
-    static const IntegratorInfo info{"pt-mis", {"4c", "path"}, "path tracing, MIS direct lighting whose BRDF ray continues the path",
-                                     false, true, path_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
-                                         return std::make_unique<PtMis>(o, false);
-                                     }};
+    static const IntegratorInfo info = [] {
+        IntegratorInfo i{"pt-mis", {"4c", "path"}, "path tracing, MIS direct lighting whose BRDF ray continues the path",
+                         false, true, path_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
+                             return std::make_unique<PtMis>(o, false);
+                         }};
+        i.spectral = true;
+        return i;
+    }();
     return info;
 }
 

@@ -6,6 +6,7 @@
 #include "integrators/common/direct_lighting.hpp"
 #include "integrators/integrators.hpp"
 #include "integrators/common/path_rules.hpp"
+#include "integrators/common/spectral_shading.hpp"
 
 namespace pathlab {
 namespace {
@@ -32,6 +33,26 @@ public:
         }
     }
 
+    // Spectral mode: the same path (spectral_shading.hpp), its values at the wavelengths wl.
+    Spectrum4 radiance_spectral(const Scene& scene, const Ray& camera_ray, Sampler& sampler, SampledWavelengths& wl) const override {
+        Spectrum4 L(0.0f), beta(1.0f);
+        Ray ray = camera_ray;
+        for (int bounces = 0;; ++bounces) {
+            Intersection hit;
+            const bool seen = bounces > 0 || !hide_;
+            if (!scene.intersect(ray, hit))
+                return seen ? L + beta * illuminant_spectrum(scene.escaped_radiance(ray.d), wl) : L;
+            if (seen) L += beta * illuminant_spectrum(emitted_radiance(scene, hit, -normalize(ray.d)), wl);
+            const ShadingPoint sp = make_shading_point(scene, hit, normalize(ray.d));
+            if (sp.material->is_black() || !rules_.may_bounce(bounces)) return L;
+            const auto s = spectral_sample(sp, sampler.next2d(), wl);
+            if (!s) return L;
+            beta *= spectral_sample_value(sp, *s, wl) * (std::abs(s->wo.z) / s->pdfW);
+            if (!rules_.survive_roulette(bounces + 1, beta, sampler)) return L;
+            ray = sp.spawn(s->wo);
+        }
+    }
+
 private:
     PathRules rules_;
     bool hide_;
@@ -40,8 +61,12 @@ private:
 }  // namespace
 
 const IntegratorInfo& pt_naive_integrator() {
-    static const IntegratorInfo info{"pt-naive", {"4a"}, "path tracing by BRDF sampling, Russian roulette", true, true, path_params(),
-                                     [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> { return std::make_unique<PtNaive>(o); }};
+    static const IntegratorInfo info = [] {
+        IntegratorInfo i{"pt-naive", {"4a"}, "path tracing by BRDF sampling, Russian roulette", true, true, path_params(),
+                         [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> { return std::make_unique<PtNaive>(o); }};
+        i.spectral = true;
+        return i;
+    }();
     return info;
 }
 

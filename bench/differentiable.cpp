@@ -35,6 +35,21 @@ std::vector<std::string> all_names(const SceneDescription& d) {
     return names;
 }
 
+// Heap allocations (all threads) of one gradient at size x size, spp, and max depth (-1: unlimited,
+// Russian roulette from depth 3).
+uint64_t gradient_allocations(const Scene& scene, const ParameterSet& set, const Image& adjoint, int size, int spp, int depth) {
+    DiffSettings s;
+    s.width = s.height = size;
+    s.spp = spp;
+    s.max_depth = depth;
+    s.rr_depth = depth < 0 ? 3 : -1;
+    const uint64_t before = allocations_by_all_threads();
+    gradient(scene, set, s, adjoint);
+    return allocations_by_all_threads() - before;
+}
+
+std::string depth_label(int depth) { return depth < 0 ? std::string("unlimited (RR)") : std::to_string(depth); }
+
 }  // namespace
 
 void differentiable_suite(const DifferentiableOptions& o) {
@@ -88,17 +103,9 @@ void differentiable_suite(const DifferentiableOptions& o) {
     const auto scene = Scene::build(d);
     const Image adjoint(o.size, o.size, Rgb(1.0f));
     for (const auto& [spp, depth] : std::vector<std::pair<int, int>>{{1, 1}, {4, 1}, {16, 1}, {64, 1}, {16, 4}, {16, 16}, {16, -1}}) {
-        DiffSettings s;
-        s.width = s.height = o.size;
-        s.spp = spp;
-        s.max_depth = depth;
-        s.rr_depth = depth < 0 ? 3 : -1;
-        const uint64_t before = allocations_by_all_threads();
-        gradient(*scene, set, s, adjoint);
-        const uint64_t allocations = allocations_by_all_threads() - before;
+        const uint64_t allocations = gradient_allocations(*scene, set, adjoint, o.size, spp, depth);
         const double vertices = double(o.size) * o.size * spp * (depth < 0 ? 5.0 : double(depth));
-        fmt::print("| {} | {} | {} | {:.2g} | {:.0f} |\n", spp, depth < 0 ? std::string("unlimited (RR)") : std::to_string(depth), allocations,
-                   vertices, peak_rss_mib());
+        fmt::print("| {} | {} | {} | {:.2g} | {:.0f} |\n", spp, depth_label(depth), allocations, vertices, peak_rss_mib());
     }
     if (!o.texture_scene.empty()) {
         // The texels: one gradient buffer of the texture's size per sum in flight, whatever spp and depth.
@@ -108,15 +115,8 @@ void differentiable_suite(const DifferentiableOptions& o) {
         fmt::print("\nThe same for scenes/diff-texture.xml with its {} floats bound (the texels among them):\n\n", ts.size);
         fmt::print("| spp | max depth | heap allocations | peak RSS (MiB) |\n|---|---|---|---|\n");
         for (const auto& [spp, depth] : std::vector<std::pair<int, int>>{{1, 1}, {16, 1}, {64, 1}, {16, 16}, {16, -1}}) {
-            DiffSettings s;
-            s.width = s.height = o.size;
-            s.spp = spp;
-            s.max_depth = depth;
-            s.rr_depth = depth < 0 ? 3 : -1;
-            const uint64_t before = allocations_by_all_threads();
-            gradient(*tscene, ts, s, adjoint);
-            fmt::print("| {} | {} | {} | {:.0f} |\n", spp, depth < 0 ? std::string("unlimited (RR)") : std::to_string(depth),
-                       allocations_by_all_threads() - before, peak_rss_mib());
+            const uint64_t allocations = gradient_allocations(*tscene, ts, adjoint, o.size, spp, depth);
+            fmt::print("| {} | {} | {} | {:.0f} |\n", spp, depth_label(depth), allocations, peak_rss_mib());
         }
     }
     fmt::print("\n");

@@ -1,8 +1,8 @@
-// stb_image's allocations held to a budget (included only by src/image's stb decoders:
-// stb_png.cpp, stb_jpeg.cpp). Each decoder's translation unit defines STBI_MALLOC, STBI_REALLOC
-// and STBI_FREE as these functions before it includes stb_image.h and decodes through
-// decode_rgb8_within_budget, which sets t_budget around the decode, so that corrupt data cannot
-// make stb allocate without bound.
+// stb_image's allocations held to a budget (included only by src/image's stb decoders,
+// stb_png.cpp and stb_jpeg.cpp, through stb_image_unit.hpp, which defines STBI_MALLOC,
+// STBI_REALLOC and STBI_FREE as these functions before it includes stb_image.h). Each decodes
+// through decode_rgb8_within_budget, which sets t_budget around the decode, so that corrupt data
+// cannot make stb allocate without bound.
 #pragma once
 
 #include <cstdint>

@@ -10,7 +10,7 @@ namespace pathlab {
 
 // estimate_light_sample at the wavelengths wl.
 inline Spectrum4 estimate_light_sample_spectral(const Scene& scene, const ShadingPoint& sp, Sampler& sampler, bool mis,
-                                                const SampledWavelengths& wl) {
+                                                SampledWavelengths& wl) {
     const LightChoice choice = scene.choose_light(sampler.next1d());
     const Vec2f u = sampler.next2d();
     if (choice.index < 0) return Spectrum4(0.0f);
@@ -19,14 +19,14 @@ inline Spectrum4 estimate_light_sample_spectral(const Scene& scene, const Shadin
     if (dot(ls->wi, sp.ng) <= 0 && !sp.material->is_dielectric()) return Spectrum4(0.0f);
     const Vec3f wo = sp.frame.to_local(ls->wi);
     float pdf_bsdf;
-    const Rgb f_rgb = sp.material->eval_and_pdf(sp, sp.wi, wo, pdf_bsdf);
-    if (is_black(f_rgb)) return Spectrum4(0.0f);
+    const Spectrum4 f = spectral_eval_and_pdf(sp, wo, wl, pdf_bsdf);
+    if (f.is_black()) return Spectrum4(0.0f);
     const Ray shadow = std::isinf(ls->distance) ? spawn_ray(sp.p, sp.ng, ls->wi)
                                                 : spawn_segment(sp.p, sp.ng, ls->point, ls->normal);
     if (scene.occluded(shadow)) return Spectrum4(0.0f);
     const float pdf_light = choice.pmf * ls->pdfW;
     const float weight = (mis && !ls->delta) ? balance_heuristic(pdf_light, pdf_bsdf) : 1.0f;
-    return spectral_eval(sp, wo, f_rgb, wl) * illuminant_spectrum(ls->Le, wl) * (std::abs(wo.z) * weight / pdf_light);
+    return f * emission_spectrum(scene, choice.index, ls->Le, wl) * (std::abs(wo.z) * weight / pdf_light);
 }
 
 // estimate_bsdf_sample_mis at the wavelengths wl; `f` is the sample's value there.
@@ -35,7 +35,8 @@ inline Spectrum4 estimate_bsdf_sample_mis_spectral(const Scene& scene, const Sha
     found = trace_to_emitter(scene, sp.spawn(s.wo), sp.p);
     if (is_black(found.Le)) return Spectrum4(0.0f);
     const float weight = s.delta ? 1.0f : balance_heuristic(s.pdfW, found.pdf_light);
-    return f * illuminant_spectrum(found.Le, wl) * (std::abs(s.wo.z) * weight / s.pdfW);
+    const int light = found.hit ? found.isect.light : scene.environment_light();
+    return f * emission_spectrum(scene, light, found.Le, wl) * (std::abs(s.wo.z) * weight / s.pdfW);
 }
 
 }  // namespace pathlab

@@ -59,6 +59,22 @@ Spectrum4 illuminant_spectrum(const Rgb& rgb, const SampledWavelengths& wl) {
     return unbounded_spectrum(rgb, wl) * sample_d65_unit_luminance(wl);
 }
 
+Spectrum4 emission_spectrum(const Scene&, int, const Rgb& Le, const SampledWavelengths& wl) {
+    return illuminant_spectrum(Le, wl);
+}
+
+Spectrum4 escaped_spectrum(const Scene& scene, const Vec3f& d, const SampledWavelengths& wl) {
+    const int env = scene.environment_light();
+    if (env < 0) return Spectrum4(0.0f);
+    return emission_spectrum(scene, env, scene.escaped_radiance(d), wl);
+}
+
+Spectrum4 emitted_spectrum(const Scene& scene, const Intersection& hit, const Vec3f& w, const SampledWavelengths& wl) {
+    const Rgb Le = emitted_radiance(scene, hit, w);
+    if (is_black(Le)) return Spectrum4(0.0f);
+    return emission_spectrum(scene, hit.light, Le, wl);
+}
+
 const char* spectral_material_names() {
     return "diffuse, phong, conductor, roughconductor, dielectric, roughdielectric, thindielectric";
 }
@@ -115,6 +131,11 @@ Spectrum4 spectral_eval(const ShadingPoint& sp, const Vec3f& wo, const Rgb& f_rg
     if (is_black(f_rgb)) return Spectrum4(0.0f);
     if (sp.material->varies) return eval_model(sp.material->model_at(sp.uv), sp.wi, wo, f_rgb, wl);
     return eval_model(sp.material->model, sp.wi, wo, f_rgb, wl);
+}
+
+Spectrum4 spectral_eval_and_pdf(const ShadingPoint& sp, const Vec3f& wo, SampledWavelengths& wl, float& pdf) {
+    const Rgb f_rgb = sp.material->eval_and_pdf(sp, sp.wi, wo, pdf);
+    return spectral_eval(sp, wo, f_rgb, wl);
 }
 
 std::optional<BsdfSample> spectral_sample(const ShadingPoint& sp, const Vec2f& u, SampledWavelengths& wl) {

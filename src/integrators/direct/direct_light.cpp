@@ -23,8 +23,8 @@ public:
     // Spectral mode: the same samples, their values at the wavelengths wl (spectral_direct_lighting.hpp).
     Spectrum4 radiance_spectral(const Scene& scene, const Ray& ray, Sampler& sampler, SampledWavelengths& wl) const override {
         Intersection hit;
-        if (!scene.intersect(ray, hit)) return hide_ ? Spectrum4(0.0f) : illuminant_spectrum(scene.escaped_radiance(ray.d), wl);
-        Spectrum4 L = hide_ ? Spectrum4(0.0f) : illuminant_spectrum(emitted_radiance(scene, hit, -ray.d), wl);
+        if (!scene.intersect(ray, hit)) return hide_ ? Spectrum4(0.0f) : escaped_spectrum(scene, ray.d, wl);
+        Spectrum4 L = hide_ ? Spectrum4(0.0f) : emitted_spectrum(scene, hit, -ray.d, wl);
         const ShadingPoint sp = make_shading_point(scene, hit, ray.d);
         if (sp.material->is_black()) return L;
         return L + estimate_light_sample_spectral(scene, sp, sampler, /*mis=*/false, wl);

@@ -73,8 +73,8 @@ public:
     Spectrum4 radiance_spectral(const Scene& scene, const Ray& camera_ray, Sampler& sampler, SampledWavelengths& wl) const override {
         Intersection hit;
         if (!scene.intersect(camera_ray, hit))
-            return counts(0) ? illuminant_spectrum(scene.escaped_radiance(camera_ray.d), wl) : Spectrum4(0.0f);
-        const Spectrum4 emitted = counts(0) ? illuminant_spectrum(emitted_radiance(scene, hit, -camera_ray.d), wl) : Spectrum4(0.0f);
+            return counts(0) ? escaped_spectrum(scene, camera_ray.d, wl) : Spectrum4(0.0f);
+        const Spectrum4 emitted = counts(0) ? emitted_spectrum(scene, hit, -camera_ray.d, wl) : Spectrum4(0.0f);
         return pt_mis_spectral_from_hit(scene, hit, camera_ray.d, 0, sampler, rules_, three_rays_, only_length_, emitted, wl);
     }
 

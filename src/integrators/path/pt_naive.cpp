@@ -41,8 +41,8 @@ public:
             Intersection hit;
             const bool seen = bounces > 0 || !hide_;
             if (!scene.intersect(ray, hit))
-                return seen ? L + beta * illuminant_spectrum(scene.escaped_radiance(ray.d), wl) : L;
-            if (seen) L += beta * illuminant_spectrum(emitted_radiance(scene, hit, -normalize(ray.d)), wl);
+                return seen ? L + beta * escaped_spectrum(scene, ray.d, wl) : L;
+            if (seen) L += beta * emitted_spectrum(scene, hit, -normalize(ray.d), wl);
             const ShadingPoint sp = make_shading_point(scene, hit, normalize(ray.d));
             if (sp.material->is_black() || !rules_.may_bounce(bounces)) return L;
             const auto s = spectral_sample(sp, sampler.next2d(), wl);

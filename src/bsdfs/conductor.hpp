@@ -23,6 +23,7 @@ namespace pathlab {
 struct ConductorMaterial {
     Rgb eta{0.0f}, k{1.0f};
     Rgb specular_reflectance{1.0f};
+    const MeasuredConductor* measured = nullptr;  // spectral mode's eta, k of a named metal (ior.hpp)
 
     Rgb fresnel(float cos_i) const { return specular_reflectance * fresnel_conductor(cos_i, eta, k); }
 
@@ -47,7 +48,7 @@ inline const PluginInfo& conductor_plugin() {
 }
 inline ConductorMaterial read_conductor(Properties& p) {
     const ComplexIor ior = read_conductor_ior(p);
-    return ConductorMaterial{ior.eta, ior.k, p.get_rgb("specular_reflectance")};
+    return ConductorMaterial{ior.eta, ior.k, p.get_rgb("specular_reflectance"), ior.measured};
 }
 
 }  // namespace pathlab

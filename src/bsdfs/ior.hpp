@@ -10,6 +10,7 @@
 
 #include "core/properties.hpp"
 #include "core/vec.hpp"
+#include "spectral/metals.hpp"
 
 namespace pathlab {
 
@@ -26,6 +27,9 @@ inline const std::map<std::string, float>& named_iors() {
 // Complex refractive index (eta, k) of a conductor, as RGB.
 struct ComplexIor {
     Rgb eta, k;
+    // Spectral mode's eta(lambda) and k(lambda) of a metal given by name (spectral/metals.hpp:
+    // Au, Ag, Cu, Al, Cr), null otherwise; RGB mode uses eta and k.
+    const MeasuredConductor* measured = nullptr;
 };
 
 // A few metals by their chemical symbols. The values are RGB averages of measured spectral
@@ -67,8 +71,9 @@ inline ComplexIor read_conductor_ior(Properties& p) {
     if (p.has("material") && explicit_ior) p.fail("material", "give either material or eta and k, not both");
     if (explicit_ior) return ComplexIor{p.get_rgb("eta"), p.get_rgb("k")};
     const std::string name = p.get_string("material");
-    const auto ior = named_conductor(name);
+    auto ior = named_conductor(name);
     if (!ior) p.fail("material", fmt::format("unknown conductor material '{}'; known: {}", name, kNamedConductors));
+    ior->measured = measured_conductor(name);
     return *ior;
 }
 

@@ -260,11 +260,11 @@ inline Material make_mirror(const Rgb& reflectance = Rgb(1.0f)) {
     return Material{ConductorMaterial{Rgb(0.0f), Rgb(1.0f), reflectance}};
 }
 inline Material make_conductor(const ComplexIor& ior, const Rgb& reflectance = Rgb(1.0f)) {
-    return Material{ConductorMaterial{ior.eta, ior.k, reflectance}};
+    return Material{ConductorMaterial{ior.eta, ior.k, reflectance, ior.measured}};
 }
 inline Material make_rough_conductor(const MicrofacetDistribution& d, const ComplexIor& ior = {Rgb(0.0f), Rgb(1.0f)},
                                      const Rgb& reflectance = Rgb(1.0f)) {
-    return Material{RoughConductorMaterial{d, ior.eta, ior.k, reflectance}};
+    return Material{RoughConductorMaterial{d, ior.eta, ior.k, reflectance, ior.measured}};
 }
 inline Material make_dielectric(float int_ior, float ext_ior = 1.000277f) {
     return Material{DielectricMaterial{int_ior, ext_ior}, false};

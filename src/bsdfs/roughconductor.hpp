@@ -31,6 +31,7 @@ struct RoughConductorMaterial {
     MicrofacetDistribution distribution;
     Rgb eta{0.0f}, k{1.0f};
     Rgb specular_reflectance{1.0f};
+    const MeasuredConductor* measured = nullptr;  // spectral mode's eta, k of a named metal (ior.hpp)
 
     Rgb eval(const Vec3f& wi, const Vec3f& wo) const {
         float unused;
@@ -90,7 +91,7 @@ inline RoughConductorMaterial read_roughconductor(Properties& p) {
     const MicrofacetDistribution d = read_microfacet(p, /*anisotropic=*/true);
     const ComplexIor ior = read_conductor_ior(p);
     p.get_bool("sample_visible");
-    return RoughConductorMaterial{d, ior.eta, ior.k, p.get_rgb("specular_reflectance")};
+    return RoughConductorMaterial{d, ior.eta, ior.k, p.get_rgb("specular_reflectance"), ior.measured};
 }
 
 }  // namespace pathlab

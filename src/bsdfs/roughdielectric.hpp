@@ -12,6 +12,8 @@
 //   alpha_u, alpha_v  float           anisotropic roughness (instead of alpha)
 //   int_ior           float or string interior index of refraction, or a name          default bk7 (1.5046)
 //   ext_ior           float or string exterior index of refraction                     default air (1.000277)
+//   sellmeier_b/_c, cauchy, int_ior="bk7-sellmeier" or "fused silica": a dispersive interior index,
+//                     as dielectric's (spectral mode refracts each path's hero wavelength with it)
 //   sample_visible    boolean         accepted for compatibility; visible normals are always sampled
 // Like dielectric, it cannot be wrapped in twosided: both of its sides matter.
 //
@@ -41,6 +43,8 @@ struct RoughDielectricMaterial {
     MicrofacetDistribution distribution;
     float int_ior = 1.5046f;
     float ext_ior = 1.000277f;
+    // A dispersive interior index, as dielectric's (dielectric.hpp): int_ior is then its n_d.
+    std::shared_ptr<const Ior> dispersion = nullptr;
 
     // Probability of sampling reflection, given |cos_i| and eta = eta_o / eta_i.
     static float reflection_probability(float cos_i, float eta) {
@@ -132,17 +136,21 @@ inline const PluginInfo& roughdielectric_plugin() {
     static const PluginInfo info = [] {
         PluginInfo i{"bsdf", "roughdielectric", "a rough interface between two dielectrics (frosted glass): Walter et al. 2007",
                      microfacet_params(true, true)};
-        i.params.insert(i.params.end(), {kIntIorParam, kExtIorParam, kSampleVisibleParam});
+        const PluginInfo& smooth = dielectric_plugin();  // int_ior with the dispersive names, ext_ior, sellmeier_b/_c, cauchy
+        i.params.insert(i.params.end(), smooth.params.begin(), smooth.params.end());
+        i.params.push_back(kSampleVisibleParam);
         return i;
     }();
     return info;
 }
 inline RoughDielectricMaterial read_roughdielectric(Properties& p) {
     const MicrofacetDistribution d = read_microfacet(p, /*anisotropic=*/true);
-    const float int_ior = read_ior(p, "int_ior"), ext_ior = read_ior(p, "ext_ior");
+    const float ext_ior = read_ior(p, "ext_ior");
+    auto dispersion = read_dispersion(p);
+    const float int_ior = dispersion ? float((*dispersion)(kDispersionReferenceWavelength)) : read_ior(p, "int_ior");
     if (int_ior == ext_ior) p.fail("int_ior and ext_ior are equal: the interface would be invisible");
     p.get_bool("sample_visible");
-    return RoughDielectricMaterial{d, int_ior, ext_ior};
+    return RoughDielectricMaterial{d, int_ior, ext_ior, std::move(dispersion)};
 }
 
 }  // namespace pathlab

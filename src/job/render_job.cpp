@@ -126,7 +126,7 @@ void check_spectral_materials(const SceneDescription& d) {
         const std::string model = spectral_unsupported_model(d.materials[i]);
         if (model.empty()) continue;
         const std::string id = i < d.material_ids.size() && !d.material_ids[i].empty() ? fmt::format(" '{}'", d.material_ids[i]) : "";
-        throw UsageError(fmt::format("spectral mode does not render the bsdf{} of type {} yet; it renders {} (or render in RGB "
+        throw UsageError(fmt::format("spectral mode does not render the bsdf{}: {}; it renders {} (or render in RGB "
                                      "mode, without --spectral)", id, model, spectral_material_names()));
     }
 }

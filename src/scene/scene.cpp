@@ -95,9 +95,17 @@ std::unique_ptr<Scene> Scene::build(const SceneDescription& desc) {
     s->materials_ = desc.materials;
     for (Material& m : s->materials_) m.prepare();
 
-    for (const FreeLight& l : desc.lights) {
-        std::visit([&](const auto& light) { s->lights_.emplace_back(light); }, l);
+    // Light i's spectrum (null: none) from the description's vector `from` at `index`.
+    const auto add_spectrum = [&](const std::vector<std::shared_ptr<const EmissionSpectrum>>& from, size_t index) {
+        const auto spectrum = index < from.size() ? from[index] : nullptr;
+        if (!spectrum) return;
+        s->light_spectra_.resize(s->lights_.size());
+        s->light_spectra_.back() = spectrum;
+    };
+    for (size_t i = 0; i < desc.lights.size(); ++i) {
+        std::visit([&](const auto& light) { s->lights_.emplace_back(light); }, desc.lights[i]);
         if (is_environment(s->lights_.back())) s->environment_ = int(s->lights_.size()) - 1;
+        add_spectrum(desc.light_spectra, i);
     }
 
     Vec3f lo(kInf), hi(-kInf);
@@ -116,8 +124,10 @@ std::unique_ptr<Scene> Scene::build(const SceneDescription& desc) {
         if (m.media.changes_medium() || m.media.index_matched) rec.media = &s->desc_.meshes[i].media;
         if (!is_black(m.emission)) {
             rec.first_light = int32_t(s->lights_.size());
-            for (const auto& t : m.triangles)
+            for (const auto& t : m.triangles) {
                 s->lights_.emplace_back(TriangleLight(m.positions[t[0]], m.positions[t[1]], m.positions[t[2]], m.emission));
+                add_spectrum(desc.mesh_emission_spectra, i);
+            }
         }
         s->geometry_[id] = rec;
         for (const Vec3f& p : m.positions) lo = min(lo, p), hi = max(hi, p);
@@ -131,6 +141,7 @@ std::unique_ptr<Scene> Scene::build(const SceneDescription& desc) {
         if (!is_black(sp.emission)) {
             rec.first_light = int32_t(s->lights_.size());
             s->lights_.emplace_back(SphereLight{sp.center, sp.radius, sp.flip_normals, sp.emission});
+            add_spectrum(desc.sphere_emission_spectra, i);
         }
         s->geometry_[id] = rec;
         lo = min(lo, sp.center - Vec3f(sp.radius)), hi = max(hi, sp.center + Vec3f(sp.radius));

@@ -68,6 +68,11 @@ public:
     };
     SurfaceCoordinates surface_coordinates(const Intersection& hit) const;
     const std::vector<Light>& lights() const { return lights_; }
+    // Spectral mode: the spectrum of light i's emission when its scene file gave one, else null
+    // (its RGB colour is then upsampled as an illuminant).
+    const EmissionSpectrum* light_spectrum(int i) const {
+        return i >= 0 && size_t(i) < light_spectra_.size() ? light_spectra_[size_t(i)].get() : nullptr;
+    }
     bool has_delta_lights() const;
     // True when a sampled direction can find emission (an area light or the environment).
     bool has_hittable_emitters() const;
@@ -119,6 +124,7 @@ private:
     std::vector<std::vector<Vec3f>> face_normals_;  // per mesh, per triangle
     std::vector<Material> materials_;
     std::vector<Light> lights_;
+    std::vector<std::shared_ptr<const EmissionSpectrum>> light_spectra_;  // by light; empty when no emitter has one
     LightDistribution light_distribution_;
     int environment_ = -1;
     bool has_media_ = false;

@@ -2,6 +2,7 @@
 // consumed by Scene::build. Nothing here knows about Embree or sampling.
 #pragma once
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -12,6 +13,7 @@
 #include "geometry/shape.hpp"
 #include "lights/registry.hpp"
 #include "media/medium.hpp"
+#include "spectral/emission_spectrum.hpp"
 
 namespace pathlab {
 
@@ -34,6 +36,10 @@ struct SceneDescription {
     // (diff/parameters.hpp), as scene files' id attributes give them. Shapes carry their own id.
     std::vector<std::string> material_ids;
     std::vector<std::string> light_ids;
+    // Emitters whose scene file gives a spectrum (a black body, a tabulated spectrum), seen with
+    // it in spectral mode: free lights by index in `lights`, area emitters by index in `meshes`
+    // and `spheres` (each vector may be shorter than the one it follows; null: RGB only).
+    std::vector<std::shared_ptr<const EmissionSpectrum>> light_spectra, mesh_emission_spectra, sphere_emission_spectra;
     // Render settings a scene file may suggest; command-line options override them.
     std::optional<std::string> algorithm;
     std::optional<int> spp, max_depth, rr_depth;  // depths in pathlab's bounces

@@ -6,6 +6,21 @@
 
 namespace pathlab {
 
+std::shared_ptr<const EmissionSpectrum> emitter_spectrum(Properties& p) {
+    for (const char* name : {"radiance", "intensity", "irradiance"}) {
+        if (!p.plugin().find(name) || !p.has(name)) continue;
+        const Properties::Value* v = p.given(name);
+        if (!v || !v->spectrum) return nullptr;
+        const auto rgb = parse_float_list(v->text);
+        if (!rgb || rgb->size() != 3) return nullptr;  // the reader wrote "r, g, b"
+        auto s = std::make_shared<EmissionSpectrum>();
+        s->values = DenseSpectrum(*v->spectrum);
+        s->rgb = Rgb((*rgb)[0], (*rgb)[1], (*rgb)[2]);
+        return s;
+    }
+    return nullptr;
+}
+
 void read_free_emitter(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b) {
     xml.check_attributes(n, {"type", "id", "name"});
     const std::string type = xml.attr(n, "type");
@@ -42,6 +57,10 @@ void read_free_emitter(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b)
         for (const FreeLight& l : b.desc.lights)
             if (environment(l)) xml.fail(n, "a scene can have only one environment emitter (constant or envmap)");
     b.desc.lights.push_back(light);
+    if (auto spectrum = emitter_spectrum(p)) {
+        b.desc.light_spectra.resize(b.desc.lights.size());
+        b.desc.light_spectra.back() = std::move(spectrum);
+    }
     if (const auto id = xml.optional_attr(n, "id")) {
         b.desc.light_ids.resize(b.desc.lights.size());
         b.desc.light_ids.back() = *id;

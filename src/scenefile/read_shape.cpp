@@ -89,6 +89,7 @@ void read_shape_into(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b, s
     bool null_bsdf = false;
     MediumInterface media;
     Rgb emission(0.0f);
+    std::shared_ptr<const EmissionSpectrum> emission_spectrum;
     bool emitter = false;
     // A medium on one side: name="interior" or "exterior".
     const auto medium_side = [&](const pugi::xml_node& c) -> int32_t& {
@@ -152,6 +153,7 @@ void read_shape_into(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b, s
                 ep.check_all_used();
                 return L;
             });
+            emission_spectrum = emitter_spectrum(ep);
             emitter = true;
         } else {
             xml.fail(c, fmt::format("unsupported element <{}> in <shape>; supported: <bsdf>, <ref>, <emitter>, <medium>", tag));
@@ -188,6 +190,10 @@ void read_shape_into(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b, s
         sphere->media = media;
         if (const auto id = xml.optional_attr(n, "id")) sphere->id = *id;
         b.desc.spheres.push_back(*sphere);
+        if (emission_spectrum) {
+            b.desc.sphere_emission_spectra.resize(b.desc.spheres.size());
+            b.desc.sphere_emission_spectra.back() = emission_spectrum;
+        }
         return;
     }
     MeshDesc& m = std::get<MeshDesc>(shape);
@@ -197,6 +203,10 @@ void read_shape_into(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b, s
     m.emission = emission;
     m.media = media;
     (group ? *group : b.desc.meshes).push_back(std::move(m));
+    if (emission_spectrum) {  // not in a group: a group's shapes cannot emit
+        b.desc.mesh_emission_spectra.resize(b.desc.meshes.size());
+        b.desc.mesh_emission_spectra.back() = emission_spectrum;
+    }
 }
 
 }  // namespace

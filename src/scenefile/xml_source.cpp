@@ -255,8 +255,8 @@ Properties XmlSource::properties(const pugi::xml_node& plugin_node, const Plugin
             v.xyz_given = true;
             v.text = "x y z";
         } else if (v.tag == "spectrum" || v.tag == "srgb" || v.tag == "blackbody") {
-            v.text = spectrum_value(c, plugin);
-            if (v.tag != "spectrum") v.tag = "rgb";
+            v.text = spectrum_value(c, plugin, v.spectrum);
+            if (v.tag != "spectrum" || c.attribute("type")) v.tag = "rgb";
         } else {
             v.text = attr(c, "value");
             // Numbers and lists are checked here, where the element is, whatever reads them.
@@ -273,14 +273,17 @@ Properties XmlSource::properties(const pugi::xml_node& plugin_node, const Plugin
     return p;
 }
 
-std::string XmlSource::spectrum_value(const pugi::xml_node& c, const PluginInfo& plugin) const {
+std::string XmlSource::spectrum_value(const pugi::xml_node& c, const PluginInfo& plugin,
+                                      std::shared_ptr<const SampledSpectrum>& spectrum) const {
     const std::string tag = c.name(), name = attr(c, "name");
     // Mitsuba's RGB mode: an emitter's spectrum is an illuminant; an index of refraction is
     // unbounded; anything else is a reflectance under D65 (core/spectrum.hpp).
     const bool emitter = plugin.kind == "emitter";
     const bool unbounded = name == "eta" || name == "k" || name == "int_ior" || name == "ext_ior" || name == "intIOR" || name == "extIOR";
     const SpectrumUse use = emitter ? SpectrumUse::Illuminant : unbounded ? SpectrumUse::Unbounded : SpectrumUse::Reflectance;
+    // An emitter keeps its spectrum for spectral mode (docs/spectral.md); RGB mode reads the text.
     const auto convert = [&](const SampledSpectrum& s) {
+        if (emitter) spectrum = std::make_shared<const SampledSpectrum>(s);
         bool clamped = false;
         const Vec3d rgb = spectrum_to_linear_srgb(s, use, &clamped);
         if (clamped) note(c, fmt::format("the spectrum's sRGB colour was out of gamut and is clamped to {}", rgb_text(rgb)));
@@ -305,12 +308,34 @@ std::string XmlSource::spectrum_value(const pugi::xml_node& c, const PluginInfo&
         for (int i = 0; i < 3; ++i) rgb[i] = srgb_to_linear(rgb[i]);
         return rgb_text(rgb);
     }
+    // A black body of `text` kelvin ("5000" or "5000K"), Planck's law in W / (m^2 sr nm).
+    const auto kelvin_of = [&](const pugi::xml_node& at, std::string t) {
+        if (!t.empty() && (t.back() == 'K' || t.back() == 'k')) t.pop_back();
+        const double kelvin = parse_number(at, t);
+        if (!(kelvin >= 100 && kelvin <= 1e6)) fail(at, fmt::format("a black body's temperature must be 100 K to 1e6 K, got {}", kelvin));
+        return kelvin;
+    };
+    if (tag == "spectrum" && c.attribute("type")) {
+        // Mitsuba 3: <spectrum type="blackbody" name><float name="temperature" value/></spectrum>.
+        check_attributes(c, {"name", "type"});
+        const std::string type = attr(c, "type");
+        if (type != "blackbody") fail(c, fmt::format("unsupported spectrum type '{}'; supported: blackbody (or a value, or a filename)", type));
+        std::optional<double> kelvin;
+        for (const pugi::xml_node& k : c.children()) {
+            if (k.type() == pugi::node_pcdata || k.type() == pugi::node_cdata) fail(k, "unexpected text");
+            if (k.type() != pugi::node_element) continue;
+            if (std::string(k.name()) != "float" || std::string(k.attribute("name").value()) != "temperature")
+                fail(k, "a blackbody spectrum takes one parameter, <float name=\"temperature\" value=\"...\"/> (in kelvin)");
+            check_attributes(k, {"name", "value"});
+            if (kelvin) fail(k, "the temperature is given twice");
+            kelvin = kelvin_of(k, attr(k, "value"));
+        }
+        if (!kelvin) fail(c, "a blackbody spectrum needs <float name=\"temperature\" value=\"...\"/> (in kelvin)");
+        return convert(blackbody_spectrum(*kelvin));
+    }
     if (tag == "blackbody") {  // Mitsuba 0.6: <blackbody name temperature="5000K" scale="1"/>
         check_attributes(c, {"name", "temperature", "scale", "multiplier"});
-        std::string t = attr(c, "temperature");
-        if (!t.empty() && (t.back() == 'K' || t.back() == 'k')) t.pop_back();
-        const double kelvin = parse_number(c, t);
-        if (!(kelvin >= 100 && kelvin <= 1e6)) fail(c, fmt::format("a black body's temperature must be 100 K to 1e6 K, got {}", kelvin));
+        const double kelvin = kelvin_of(c, attr(c, "temperature"));
         double scale = 1;
         if (c.attribute("scale")) scale = parse_number(c, attr(c, "scale"));
         if (c.attribute("multiplier")) scale = parse_number(c, attr(c, "multiplier"));
@@ -339,7 +364,11 @@ std::string XmlSource::spectrum_value(const pugi::xml_node& c, const PluginInfo&
         const float v = parse_float(c, value);
         // Mitsuba 3 turns an emitter's uniform spectrum into the sRGB of illuminant E (a flat
         // spectrum); Mitsuba 0.6 kept it grey.
-        if (emitter && context_->version_major >= 3) return rgb_text(xyz_to_linear_srgb(Vec3d(1.0)) * double(v));
+        if (emitter && context_->version_major >= 3) {
+            spectrum = std::make_shared<const SampledSpectrum>(
+                SampledSpectrum{{kCieMinWavelength, kCieMaxWavelength}, {double(v), double(v)}});
+            return rgb_text(xyz_to_linear_srgb(Vec3d(1.0)) * double(v));
+        }
         return value;
     }
     const std::string why = parse_spectrum_pairs(value, s);

@@ -79,8 +79,9 @@ public:
     [[noreturn]] static void rethrow(const PropertyError& e);
 
 private:
-    // A <spectrum>, <srgb> or <blackbody> as the text of an rgb value.
-    std::string spectrum_value(const pugi::xml_node& c, const PluginInfo& plugin) const;
+    // A <spectrum>, <srgb> or <blackbody> as the text of an rgb value; an emitter's spectrum
+    // (not an <srgb>, nor 0.6's uniform value) is also given back as `spectrum`.
+    std::string spectrum_value(const pugi::xml_node& c, const PluginInfo& plugin, std::shared_ptr<const SampledSpectrum>& spectrum) const;
     std::string substitute(const pugi::xml_node& n, const std::string& value) const;
     Vec3f xyz_default(const pugi::xml_node& n, float fallback) const;
 

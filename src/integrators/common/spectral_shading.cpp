@@ -3,7 +3,12 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <stdexcept>
+#include <vector>
 
+#include <fmt/format.h>
+
+#include "spectral/metals.hpp"
 #include "spectral/rgb_to_spectrum.hpp"
 #include "spectral/tabulated.hpp"
 
@@ -59,8 +64,26 @@ Spectrum4 illuminant_spectrum(const Rgb& rgb, const SampledWavelengths& wl) {
     return unbounded_spectrum(rgb, wl) * sample_d65_unit_luminance(wl);
 }
 
-Spectrum4 emission_spectrum(const Scene&, int, const Rgb& Le, const SampledWavelengths& wl) {
-    return illuminant_spectrum(Le, wl);
+Spectrum4 emission_spectrum(const Scene& scene, int light, const Rgb& Le, const SampledWavelengths& wl) {
+    const EmissionSpectrum* own = scene.light_spectrum(light);
+    if (!own) [[likely]]
+        return illuminant_spectrum(Le, wl);
+    if (is_black(Le)) return Spectrum4(0.0f);
+    // Le is the emitter's colour own->rgb times what the light multiplied it by: a scale, a
+    // falloff, 1/d^2 (grey: it scales the spectrum), or a spot's projected texture (a colour:
+    // it multiplies the spectrum as its upsampled unbounded spectrum). Channels where the
+    // spectrum's colour is 0 (clamped out of the gamut) take the largest channel's factor.
+    const Rgb& c = own->rgb;
+    const int m = c.x >= c.y && c.x >= c.z ? 0 : (c.y >= c.z ? 1 : 2);
+    if (!(c[m] > 0)) return Spectrum4(0.0f);
+    const float k = Le[m] / c[m];
+    Rgb factor;
+    bool grey = true;
+    for (int i = 0; i < 3; ++i) {
+        factor[i] = c[i] > 0 ? Le[i] / c[i] : k;
+        grey = grey && std::abs(factor[i] - k) <= 1e-5f * k;
+    }
+    return own->values.sample(wl) * (grey ? Spectrum4(k) : unbounded_spectrum(factor, wl));
 }
 
 Spectrum4 escaped_spectrum(const Scene& scene, const Vec3f& d, const SampledWavelengths& wl) {
@@ -76,30 +99,89 @@ Spectrum4 emitted_spectrum(const Scene& scene, const Intersection& hit, const Ve
 }
 
 const char* spectral_material_names() {
-    return "diffuse, phong, conductor, roughconductor, dielectric, roughdielectric, thindielectric";
+    return "diffuse, phong, conductor, roughconductor, dielectric, roughdielectric, thindielectric, plastic, roughplastic, "
+           "blendbsdf (at most one of its two with Dirac lobes), mask (of a non-dispersive material)";
 }
 
+namespace {
+
+bool is_dispersive(const MaterialModel& m) {
+    if (const auto* d = std::get_if<DielectricMaterial>(&m)) return d->dispersion != nullptr;
+    if (const auto* d = std::get_if<RoughDielectricMaterial>(&m)) return d->dispersion != nullptr;
+    return false;
+}
+
+// Whether the material can sample a Dirac delta.
+bool has_delta_lobe(const Material& m) { return (m.lobes() & kLobeSpecular) != 0; }
+
+}  // namespace
+
 std::string spectral_unsupported_model(const Material& m) {
-    if (std::holds_alternative<PlasticMaterial>(m.model)) return "plastic";
-    if (std::holds_alternative<RoughPlasticMaterial>(m.model)) return "roughplastic";
-    if (std::holds_alternative<BlendMaterial>(m.model)) return "blendbsdf";
-    if (std::holds_alternative<MaskMaterial>(m.model)) return "mask";
+    // A nested material is evaluated through its parent, which cannot reduce the wavelengths
+    // (a dispersive one) nor tell which of two Dirac lobes was sampled (spectral_sample_value).
+    const auto nested = [](const Material& inner, const char* parent) -> std::string {
+        if (is_dispersive(inner.model)) return fmt::format("a dispersive dielectric inside {}", parent);
+        return spectral_unsupported_model(inner);
+    };
+    if (const auto* b = std::get_if<BlendMaterial>(&m.model)) {
+        if (has_delta_lobe(*b->first) && has_delta_lobe(*b->second)) return "blendbsdf of two materials with Dirac lobes";
+        if (auto why = nested(*b->first, "blendbsdf"); !why.empty()) return why;
+        return nested(*b->second, "blendbsdf");
+    }
+    if (const auto* k = std::get_if<MaskMaterial>(&m.model)) return nested(*k->inner, "mask");
     return "";
 }
 
 namespace {
 
-// The Fresnel reflectance of a conductor, times its specular reflectance, per lane.
-Spectrum4 conductor_reflectance(const Rgb& specular_reflectance, const Rgb& eta, const Rgb& k, float cos_i,
-                                const SampledWavelengths& wl) {
+// eta(lambda) and k(lambda) of the measured metals at every nm, built on first use.
+struct DenseMetal {
+    const MeasuredConductor* metal;
+    DenseSpectrum eta, k;
+};
+const DenseMetal& dense_metal(const MeasuredConductor* metal) {
+    static const std::vector<DenseMetal> table = [] {
+        std::vector<DenseMetal> t;
+        for (const char* name : {"Au", "Ag", "Cu", "Al", "Cr"}) {
+            const MeasuredConductor* m = measured_conductor(name);
+            t.push_back({m, DenseSpectrum(m->eta), DenseSpectrum(m->k)});
+        }
+        return t;
+    }();
+    for (const DenseMetal& d : table)
+        if (d.metal == metal) return d;
+    throw std::logic_error("a measured conductor without its table");
+}
+
+// A conductor's specular reflectance times its Fresnel reflectance at cos_i, per lane: eta and
+// k measured (a named metal) or the RGB ones upsampled.
+Spectrum4 conductor_reflectance(const Rgb& specular_reflectance, const Rgb& eta, const Rgb& k, const MeasuredConductor* measured,
+                                float cos_i, const SampledWavelengths& wl) {
     const Spectrum4 R = reflectance_spectrum(specular_reflectance, wl);
-    const Spectrum4 e = unbounded_spectrum(eta, wl), kk = unbounded_spectrum(k, wl);
+    Spectrum4 e, kk;
+    if (measured) {
+        const DenseMetal& d = dense_metal(measured);
+        e = d.eta.sample(wl), kk = d.k.sample(wl);
+    } else {
+        e = unbounded_spectrum(eta, wl), kk = unbounded_spectrum(k, wl);
+    }
     Spectrum4 F;
     for (int i = 0; i < kSpectrumLanes; ++i) F[i] = fresnel_conductor(cos_i, e[i], kk[i]);
     return R * F;
 }
 
-Spectrum4 eval_model(const MaterialModel& model, const Vec3f& wi, const Vec3f& wo, const Rgb& f_rgb, const SampledWavelengths& wl) {
+// rho' / (pi eta^2) of a coated diffuse base (plastic.hpp's CoatedDiffuse::base) per lane.
+Spectrum4 coat_base(const CoatedDiffuse& coat, const SampledWavelengths& wl) {
+    const Spectrum4 rho = reflectance_spectrum(coat.diffuse_reflectance, wl);
+    const Spectrum4 denom = coat.nonlinear ? Spectrum4(1.0f) - rho * coat.fdr : Spectrum4(1.0f - coat.fdr);
+    return rho / denom * (kInvPi / (coat.eta * coat.eta));
+}
+
+// The model's value at the wavelengths, without the shading context's factor: the RGB
+// formulas of the bsdf headers with each colour parameter replaced by its spectrum (models
+// whose value has no colour parameter give their grey RGB value). `uv`: where nested textured
+// materials are evaluated.
+Spectrum4 model_value(const MaterialModel& model, const Vec3f& wi, const Vec3f& wo, const SampledWavelengths& wl) {
     if (const auto* p = std::get_if<PhongMaterial>(&model)) {
         // rho_d / pi + rho_s (n + 2) cos^n / (2 pi), as phong.hpp.
         Spectrum4 f = reflectance_spectrum(p->diffuse, wl) * kInvPi;
@@ -118,32 +200,114 @@ Spectrum4 eval_model(const MaterialModel& model, const Vec3f& wi, const Vec3f& w
         white.k = Rgb(1.0f);
         white.specular_reflectance = Rgb(1.0f);
         const float g = white.eval(wi, wo).x;
+        if (g == 0) return Spectrum4(0.0f);
         const float cos_ih = dot(wi, normalize(wi + wo));
-        return conductor_reflectance(c->specular_reflectance, c->eta, c->k, cos_ih, wl) * g;
+        return conductor_reflectance(c->specular_reflectance, c->eta, c->k, c->measured, cos_ih, wl) * g;
     }
-    // Models without a colour parameter (the dielectrics): their RGB value is grey.
-    return Spectrum4(f_rgb.x);
+    if (const auto* p = std::get_if<PlasticMaterial>(&model)) {
+        // base (1 - F_i)(1 - F_o), as plastic.hpp.
+        if (wi.z <= 0 || wo.z <= 0) return Spectrum4(0.0f);
+        return coat_base(p->coat, wl) * ((1 - p->coat.fresnel(wi.z)) * (1 - p->coat.fresnel(wo.z)));
+    }
+    if (const auto* p = std::get_if<RoughPlasticMaterial>(&model)) {
+        // base T(cos_i) T(cos_o) + specular_reflectance F(wi.h) D G2 / (4 cos_i cos_o), as roughplastic.hpp.
+        if (wi.z <= 0 || wo.z <= 0) return Spectrum4(0.0f);
+        Spectrum4 f = coat_base(p->coat, wl) * (p->T(wi.z) * p->T(wo.z));
+        const Vec3f h = normalize(wi + wo);
+        const float c = dot(wi, h), D = p->distribution.D(h);
+        if (c > 0 && D > 0)
+            f += reflectance_spectrum(p->coat.specular_reflectance, wl) *
+                 (p->coat.fresnel(c) * D * p->distribution.G2(wi, wo) / (4 * wi.z * wo.z));
+        return f;
+    }
+    const auto nested = [&](const Material& m, const Vec2f& uv) {
+        return model_value(m.varies ? m.model_at(uv) : m.model, wi, wo, wl);
+    };
+    if (const auto* b = std::get_if<BlendMaterial>(&model))
+        return nested(*b->first, b->uv) * (1 - b->weight) + nested(*b->second, b->uv) * b->weight;
+    if (const auto* k = std::get_if<MaskMaterial>(&model)) return nested(*k->inner, k->uv) * k->opacity;
+    // The dielectrics (grey; a dispersive one is evaluated at the hero's index by the callers)
+    // and the smooth conductor (no non-delta value).
+    return Spectrum4(visit_model(model, [&](const auto& x) { return x.eval(wi, wo); }).x);
+}
+
+// The colour of the Dirac lobe that produced the delta sample s (wo) of `model`, in RGB and
+// at the wavelengths: the sample's RGB value is a multiple of the RGB one (the Fresnel factor,
+// 1 / cos, a selection probability, an opacity, the context's factor), and its spectral value
+// the same multiple of the spectral one.
+struct LobeColour {
+    Rgb rgb{1.0f};
+    Spectrum4 spectral{1.0f};
+};
+LobeColour delta_lobe_colour(const MaterialModel& model, const Vec3f& wi, const Vec3f& wo, const SampledWavelengths& wl) {
+    if (const auto* c = std::get_if<ConductorMaterial>(&model))
+        return {c->fresnel(wi.z), conductor_reflectance(c->specular_reflectance, c->eta, c->k, c->measured, wi.z, wl)};
+    if (const auto* p = std::get_if<PlasticMaterial>(&model))
+        return {p->coat.specular_reflectance, reflectance_spectrum(p->coat.specular_reflectance, wl)};
+    const auto nested = [&](const Material& m, const Vec2f& uv) {
+        return delta_lobe_colour(m.varies ? m.model_at(uv) : m.model, wi, wo, wl);
+    };
+    if (const auto* b = std::get_if<BlendMaterial>(&model))  // at most one of the two has Dirac lobes (spectral_unsupported_model)
+        return nested(has_delta_lobe(*b->first) ? *b->first : *b->second, b->uv);
+    if (const auto* k = std::get_if<MaskMaterial>(&model)) {
+        if (wo == -wi) return {};  // straight through: grey
+        return nested(*k->inner, k->uv);
+    }
+    return {};  // the smooth and thin dielectrics: grey
+}
+
+const MaterialModel& model_here(const ShadingPoint& sp, MaterialModel& storage) {
+    if (!sp.material->varies) return sp.material->model;
+    storage = sp.material->model_at(sp.uv);
+    return storage;
+}
+
+// A copy of the material whose dispersive interior index is the hero wavelength's.
+Material at_hero_index(const Material& m, const SampledWavelengths& wl) {
+    Material hero = m;
+    std::visit(
+        [&](auto& x) {
+            if constexpr (requires { x.dispersion; }) x.int_ior = float((*x.dispersion)(wl[0]));
+        },
+        hero.model);
+    return hero;
 }
 
 }  // namespace
 
 Spectrum4 spectral_eval(const ShadingPoint& sp, const Vec3f& wo, const Rgb& f_rgb, const SampledWavelengths& wl) {
     if (is_black(f_rgb)) return Spectrum4(0.0f);
-    if (sp.material->varies) return eval_model(sp.material->model_at(sp.uv), sp.wi, wo, f_rgb, wl);
-    return eval_model(sp.material->model, sp.wi, wo, f_rgb, wl);
+    MaterialModel storage;
+    const MaterialModel& model = model_here(sp, storage);
+    if (std::holds_alternative<RoughDielectricMaterial>(model)) return Spectrum4(f_rgb.x);  // grey, the context's factor included
+    Spectrum4 f = model_value(model, sp.wi, wo, wl);
+    if (sp.mode == TransportMode::Importance) f *= sp.material->importance_factor(sp, sp.wi, wo);
+    return f;
 }
 
 Spectrum4 spectral_eval_and_pdf(const ShadingPoint& sp, const Vec3f& wo, SampledWavelengths& wl, float& pdf) {
+    if (is_dispersive(sp.material->model)) [[unlikely]] {
+        // The rough dispersive dielectric: its value and density at the hero's index; the path
+        // carries the hero alone from here (as at a sampled dispersive interface).
+        wl.terminate_secondary();
+        const Material hero = at_hero_index(*sp.material, wl);
+        ShadingPoint at_hero = sp;
+        at_hero.material = &hero;
+        return Spectrum4(hero.eval_and_pdf(at_hero, sp.wi, wo, pdf).x);
+    }
     const Rgb f_rgb = sp.material->eval_and_pdf(sp, sp.wi, wo, pdf);
     return spectral_eval(sp, wo, f_rgb, wl);
 }
 
 std::optional<BsdfSample> spectral_sample(const ShadingPoint& sp, const Vec2f& u, SampledWavelengths& wl) {
-    if (const auto* d = std::get_if<DielectricMaterial>(&sp.material->model); d && d->dispersion) [[unlikely]] {
-        DielectricMaterial hero = *d;
-        hero.int_ior = float((*d->dispersion)(wl[0]));
+    if (is_dispersive(sp.material->model)) [[unlikely]] {
+        // Refraction (and reflection) of the hero wavelength with its index; the other lanes'
+        // paths would part from it, so the path keeps the hero alone.
         wl.terminate_secondary();
-        return hero.sample(sp.wi, u);
+        const Material hero = at_hero_index(*sp.material, wl);
+        ShadingPoint at_hero = sp;
+        at_hero.material = &hero;
+        return hero.sample(at_hero, sp.wi, u);
     }
     return sp.material->sample(sp, sp.wi, u);
 }
@@ -151,13 +315,11 @@ std::optional<BsdfSample> spectral_sample(const ShadingPoint& sp, const Vec2f& u
 Spectrum4 spectral_sample_value(const ShadingPoint& sp, const BsdfSample& s, const SampledWavelengths& wl) {
     if (is_black(s.f)) return Spectrum4(0.0f);
     if (!s.delta) return spectral_eval(sp, s.wo, s.f, wl);
-    const auto delta_value = [&](const MaterialModel& model) {
-        if (const auto* c = std::get_if<ConductorMaterial>(&model))
-            return conductor_reflectance(c->specular_reflectance, c->eta, c->k, sp.wi.z, wl) / s.wo.z;
-        return Spectrum4(s.f.x);  // the dielectrics' delta coefficients are grey
-    };
-    if (sp.material->varies) return delta_value(sp.material->model_at(sp.uv));
-    return delta_value(sp.material->model);
+    MaterialModel storage;
+    const LobeColour c = delta_lobe_colour(model_here(sp, storage), sp.wi, s.wo, wl);
+    const int m = c.rgb.x >= c.rgb.y && c.rgb.x >= c.rgb.z ? 0 : (c.rgb.y >= c.rgb.z ? 1 : 2);
+    if (!(c.rgb[m] > 0)) return Spectrum4(0.0f);
+    return c.spectral * (s.f[m] / c.rgb[m]);
 }
 
 }  // namespace pathlab

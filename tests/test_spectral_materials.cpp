@@ -289,6 +289,68 @@ TEST(SpectralMaterials, HeroOnlyRoughGlassAgreesWithTheConstantIndex) {
             << "channel " << c << ": hero-only " << a.mean[c] << " +- " << a.se[c] << ", constant " << b.mean[c] << " +- " << b.se[c];
 }
 
+// ---- reflectances given as spectra ----------------------------------------------------------
+
+// A diffuse sphere filling the view whose reflectance the file gives as a spectrum, under a sky of
+// a 2000 K black body, direct illumination: every pixel's expectation is the film colour of
+// rho(lambda) S(lambda) (the convex sphere sees the whole sky). The reflectance's RGB (its
+// colour under D65) upsampled would give another colour under this light (the test prints it).
+TEST(SpectralMaterials, ReflectanceSpectraAreUsedAsGiven) {
+    const std::string text = R"(<scene version="3.0.0">
+  <default name="mode" value="spectral"/>
+  <sensor type="perspective"><float name="fov" value="10"/>
+    <transform name="to_world"><lookat origin="0, 0, 5" target="0, 0, 0" up="0, 1, 0"/></transform>
+    <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/></film>
+  </sensor>
+  <emitter type="constant"><blackbody name="radiance" temperature="2000K" scale="0.2"/></emitter>
+  <shape type="sphere"><float name="radius" value="1"/>
+    <bsdf type="diffuse"><spectrum name="reflectance" value="400:0.9, 480:0.05, 560:0.9, 640:0.05, 720:0.9"/></bsdf></shape>
+</scene>)";
+    const SceneDescription d = load_scene_text(text, "reflectance.xml", ".");
+    ASSERT_TRUE(d.materials[0].spectra && d.materials[0].spectra->diffuse);
+    EXPECT_FALSE(d.materials[0].spectra->specular);
+    const auto rho = [](double l) {
+        const double knots[5][2] = {{400, 0.9}, {480, 0.05}, {560, 0.9}, {640, 0.05}, {720, 0.9}};
+        if (l < 400 || l > 720) return 0.0;
+        for (int k = 0; k < 4; ++k)
+            if (l <= knots[k + 1][0])
+                return knots[k][1] + (knots[k + 1][1] - knots[k][1]) * (l - knots[k][0]) / (knots[k + 1][0] - knots[k][0]);
+        return 0.9;
+    };
+    const auto sky = [](double l) { return 0.2 * planck(l, 2000); };
+    const Vec3d want = film_colour([&](double l) { return rho(l) * sky(l); });
+    const Rgb rho_rgb = std::get<PhongMaterial>(d.materials[0].model).diffuse;
+    const RgbAlbedoSpectrum upsampled(RgbToSpectrumTable::srgb(), rho_rgb);
+    const Vec3d rgb_way = film_colour([&](double l) { return double(upsampled(float(l))) * sky(l); });
+    const ImageMean m = image_mean(render_mode(d, true, 16, 64, 41, 1, "direct-mis"));
+    // z = 4 per channel (3 two-sided tests: false alarms below 2e-4); the black body's 1 nm
+    // tabulation and the quadrature: below 1e-4 relative.
+    for (int c = 0; c < 3; ++c)
+        EXPECT_LE(std::abs(m.mean[c] - want[c]), 4 * m.se[c] + 1e-4 * std::abs(want[c]))
+            << "channel " << c << ": " << m.mean[c] << " +- " << m.se[c] << ", the spectrum gives " << want[c]
+            << ", its RGB upsampled would give " << rgb_way[c];
+}
+
+// Which parameters keep their spectra: diffuse's reflectance, plastic's two, a conductor's
+// specular_reflectance; RGB values keep none.
+TEST(SpectralMaterials, MaterialsKeepTheirReflectanceSpectra) {
+    const std::string text = R"(<scene version="3.0.0">
+  <bsdf type="plastic" id="a"><spectrum name="diffuse_reflectance" value="400:0.2, 700:0.8"/>
+    <spectrum name="specular_reflectance" value="400:1, 700:0.5"/></bsdf>
+  <bsdf type="conductor" id="b"><spectrum name="specular_reflectance" value="400:0.5, 700:1"/></bsdf>
+  <bsdf type="roughplastic" id="c"><rgb name="diffuse_reflectance" value="0.2, 0.3, 0.4"/></bsdf>
+  <shape type="sphere"><ref id="a"/></shape>
+</scene>)";
+    const SceneDescription d = load_scene_text(text, "kept.xml", ".");
+    ASSERT_EQ(d.materials.size(), 3u);
+    ASSERT_TRUE(d.materials[0].spectra && d.materials[0].spectra->diffuse && d.materials[0].spectra->specular);
+    EXPECT_NEAR((*d.materials[0].spectra->diffuse)(550), 0.5f, 1e-6f);
+    EXPECT_NEAR((*d.materials[0].spectra->specular)(550), 0.75f, 1e-6f);
+    ASSERT_TRUE(d.materials[1].spectra && d.materials[1].spectra->specular);
+    EXPECT_FALSE(d.materials[1].spectra->diffuse);
+    EXPECT_FALSE(d.materials[2].spectra);
+}
+
 // ---- plastic renders as in RGB mode where colour cannot differ ---------------------------------
 
 // Grey plastics (smooth and rough, linear and not) under white light, full global illumination:

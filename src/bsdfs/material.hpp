@@ -36,6 +36,7 @@
 #include "bsdfs/roughdielectric.hpp"
 #include "bsdfs/roughplastic.hpp"
 #include "bsdfs/thindielectric.hpp"
+#include "spectral/dense_spectrum.hpp"
 
 namespace pathlab {
 
@@ -102,6 +103,14 @@ template <typename F>
     }
 }
 
+// Reflectances a scene file gave as spectra (`wavelength:value` pairs or a file), which spectral
+// mode uses instead of upsampling their RGB conversion (docs/spectral.md): the model's diffuse
+// reflectance (diffuse's and plastic's, Phong's rho_d) and its specular one (Phong's rho_s, a
+// conductor's or plastic's specular_reflectance); null where the file gave an RGB value.
+struct MaterialSpectra {
+    std::shared_ptr<const DenseSpectrum> diffuse, specular;
+};
+
 struct Material {
     MaterialModel model;
     // Two-sided materials shade the back of a surface like its front (the frame is flipped
@@ -116,6 +125,9 @@ struct Material {
     bool tangent_frame = false;        // its shading frame follows dp/du (anisotropic, normal or bump mapped)
     bool surface_coordinates = false;  // either: it uses uv, dp/du and dp/dv
     std::shared_ptr<const MaterialTextures> textures = nullptr;  // null: the same everywhere
+    // Spectral mode's reflectances given in the scene file as spectra (null: none; RGB mode uses
+    // the model's RGB colours, their conversions).
+    std::shared_ptr<const MaterialSpectra> spectra = nullptr;
 
     // Binds textures (and a normal or bump map) to the material.
     void set_textures(MaterialTextures t) {

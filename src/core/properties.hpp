@@ -79,8 +79,9 @@ public:
         Vec3f xyz{0.0f};    // point/vector given as x, y, z attributes (xyz_given)
         bool xyz_given = false;
         pathlab::Transform transform;  // for tag "transform"
-        // An emitter's value given as a spectrum (<spectrum> with wavelengths, a file or a type,
-        // <blackbody>): the spectrum itself, which `text` holds as its linear sRGB (null otherwise).
+        // A value given as a spectrum (<spectrum> with wavelengths, a file or a type, <blackbody>;
+        // an emitter's uniform <spectrum> in a version 3 file): the spectrum itself, which `text`
+        // holds as its linear sRGB (null otherwise).
         std::shared_ptr<const SampledSpectrum> spectrum;
         SourceLocation where;
         bool used = false;

@@ -170,6 +170,27 @@ Material read_wrapper(XmlSource& xml, const pugi::xml_node& n, const BsdfPlugin&
     return m;
 }
 
+// The model's reflectances that the file gave as spectra (MaterialSpectra), or null.
+std::shared_ptr<const MaterialSpectra> reflectance_spectra(Properties& p, const MaterialModel& model) {
+    const auto given = [&](std::initializer_list<const char*> names) -> std::shared_ptr<const DenseSpectrum> {
+        for (const char* name : names) {
+            if (!p.plugin().find(name) || !p.has(name)) continue;
+            const Properties::Value* v = p.given(name);
+            if (v && v->spectrum) return std::make_shared<const DenseSpectrum>(*v->spectrum);
+        }
+        return nullptr;
+    };
+    MaterialSpectra s;
+    if (std::holds_alternative<PhongMaterial>(model) || std::holds_alternative<PlasticMaterial>(model) ||
+        std::holds_alternative<RoughPlasticMaterial>(model))
+        s.diffuse = given({"reflectance", "diffuse_reflectance"});
+    if (!std::holds_alternative<DielectricMaterial>(model) && !std::holds_alternative<RoughDielectricMaterial>(model) &&
+        !std::holds_alternative<ThinDielectricMaterial>(model))
+        s.specular = given({"specular_reflectance"});
+    if (!s.diffuse && !s.specular) return nullptr;
+    return std::make_shared<const MaterialSpectra>(std::move(s));
+}
+
 Material read_bsdf_at(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b, int depth) {
     if (depth > kMaxNesting) xml.fail(n, fmt::format("BSDFs nested more than {} deep", kMaxNesting));
     if (std::string(n.name()) == "ref") {
@@ -211,6 +232,7 @@ Material read_bsdf_at(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b, 
     for (const auto& [c, q] : textured) t.bindings.push_back(bind_texture(xml, c, *q, p, b));
     return reading([&] {
         Material m = plugin->read(p);
+        m.spectra = reflectance_spectra(p, m.model);
         p.check_all_used();
         if (!t.bindings.empty()) m.set_textures(std::move(t));
         return m;

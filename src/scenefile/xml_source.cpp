@@ -281,9 +281,10 @@ std::string XmlSource::spectrum_value(const pugi::xml_node& c, const PluginInfo&
     const bool emitter = plugin.kind == "emitter";
     const bool unbounded = name == "eta" || name == "k" || name == "int_ior" || name == "ext_ior" || name == "intIOR" || name == "extIOR";
     const SpectrumUse use = emitter ? SpectrumUse::Illuminant : unbounded ? SpectrumUse::Unbounded : SpectrumUse::Reflectance;
-    // An emitter keeps its spectrum for spectral mode (docs/spectral.md); RGB mode reads the text.
+    // The spectrum is kept for spectral mode (emitters' and reflectances', docs/spectral.md);
+    // RGB mode reads the text.
     const auto convert = [&](const SampledSpectrum& s) {
-        if (emitter) spectrum = std::make_shared<const SampledSpectrum>(s);
+        spectrum = std::make_shared<const SampledSpectrum>(s);
         bool clamped = false;
         const Vec3d rgb = spectrum_to_linear_srgb(s, use, &clamped);
         if (clamped) note(c, fmt::format("the spectrum's sRGB colour was out of gamut and is clamped to {}", rgb_text(rgb)));

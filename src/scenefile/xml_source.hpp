@@ -79,8 +79,8 @@ public:
     [[noreturn]] static void rethrow(const PropertyError& e);
 
 private:
-    // A <spectrum>, <srgb> or <blackbody> as the text of an rgb value; an emitter's spectrum
-    // (not an <srgb>, nor 0.6's uniform value) is also given back as `spectrum`.
+    // A <spectrum>, <srgb> or <blackbody> as the text of an rgb value; the spectrum itself (not
+    // of an <srgb>, nor of a uniform value but a version 3 emitter's) is also given back as `spectrum`.
     std::string spectrum_value(const pugi::xml_node& c, const PluginInfo& plugin, std::shared_ptr<const SampledSpectrum>& spectrum) const;
     std::string substitute(const pugi::xml_node& n, const std::string& value) const;
     Vec3f xyz_default(const pugi::xml_node& n, float fallback) const;

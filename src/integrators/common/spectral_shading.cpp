@@ -153,11 +153,18 @@ const DenseMetal& dense_metal(const MeasuredConductor* metal) {
     throw std::logic_error("a measured conductor without its table");
 }
 
+// A reflectance at the wavelengths: the scene file's spectrum where it gave one, else rgb upsampled.
+Spectrum4 reflectance(const Rgb& rgb, const std::shared_ptr<const DenseSpectrum>* given, const SampledWavelengths& wl) {
+    if (given && *given) return (*given)->sample(wl);
+    return reflectance_spectrum(rgb, wl);
+}
+const std::shared_ptr<const DenseSpectrum>* diffuse_of(const MaterialSpectra* s) { return s ? &s->diffuse : nullptr; }
+const std::shared_ptr<const DenseSpectrum>* specular_of(const MaterialSpectra* s) { return s ? &s->specular : nullptr; }
+
 // A conductor's specular reflectance times its Fresnel reflectance at cos_i, per lane: eta and
 // k measured (a named metal) or the RGB ones upsampled.
-Spectrum4 conductor_reflectance(const Rgb& specular_reflectance, const Rgb& eta, const Rgb& k, const MeasuredConductor* measured,
-                                float cos_i, const SampledWavelengths& wl) {
-    const Spectrum4 R = reflectance_spectrum(specular_reflectance, wl);
+Spectrum4 conductor_reflectance(const Spectrum4& R, const Rgb& eta, const Rgb& k, const MeasuredConductor* measured, float cos_i,
+                                const SampledWavelengths& wl) {
     Spectrum4 e, kk;
     if (measured) {
         const DenseMetal& d = dense_metal(measured);
@@ -171,24 +178,26 @@ Spectrum4 conductor_reflectance(const Rgb& specular_reflectance, const Rgb& eta,
 }
 
 // rho' / (pi eta^2) of a coated diffuse base (plastic.hpp's CoatedDiffuse::base) per lane.
-Spectrum4 coat_base(const CoatedDiffuse& coat, const SampledWavelengths& wl) {
-    const Spectrum4 rho = reflectance_spectrum(coat.diffuse_reflectance, wl);
+Spectrum4 coat_base(const CoatedDiffuse& coat, const MaterialSpectra* spectra, const SampledWavelengths& wl) {
+    const Spectrum4 rho = reflectance(coat.diffuse_reflectance, diffuse_of(spectra), wl);
     const Spectrum4 denom = coat.nonlinear ? Spectrum4(1.0f) - rho * coat.fdr : Spectrum4(1.0f - coat.fdr);
     return rho / denom * (kInvPi / (coat.eta * coat.eta));
 }
 
 // The model's value at the wavelengths, without the shading context's factor: the RGB
 // formulas of the bsdf headers with each colour parameter replaced by its spectrum (models
-// whose value has no colour parameter give their grey RGB value). `uv`: where nested textured
-// materials are evaluated.
-Spectrum4 model_value(const MaterialModel& model, const Vec3f& wi, const Vec3f& wo, const SampledWavelengths& wl) {
+// whose value has no colour parameter give their grey RGB value); `spectra`: the reflectances
+// the scene file gave as spectra (or null).
+Spectrum4 model_value(const MaterialModel& model, const MaterialSpectra* spectra, const Vec3f& wi, const Vec3f& wo,
+                      const SampledWavelengths& wl) {
     if (const auto* p = std::get_if<PhongMaterial>(&model)) {
         // rho_d / pi + rho_s (n + 2) cos^n / (2 pi), as phong.hpp.
-        Spectrum4 f = reflectance_spectrum(p->diffuse, wl) * kInvPi;
+        Spectrum4 f = reflectance(p->diffuse, diffuse_of(spectra), wl) * kInvPi;
         if (!is_black(p->specular)) {
             const float cos_alpha = dot(PhongMaterial::mirror(wi), wo);
             if (cos_alpha > 0)
-                f += reflectance_spectrum(p->specular, wl) * ((p->exponent + 2) * std::pow(cos_alpha, p->exponent) * (1 / (2 * kPi)));
+                f += reflectance(p->specular, specular_of(spectra), wl) *
+                     ((p->exponent + 2) * std::pow(cos_alpha, p->exponent) * (1 / (2 * kPi)));
         }
         return f;
     }
@@ -202,26 +211,27 @@ Spectrum4 model_value(const MaterialModel& model, const Vec3f& wi, const Vec3f& 
         const float g = white.eval(wi, wo).x;
         if (g == 0) return Spectrum4(0.0f);
         const float cos_ih = dot(wi, normalize(wi + wo));
-        return conductor_reflectance(c->specular_reflectance, c->eta, c->k, c->measured, cos_ih, wl) * g;
+        const Spectrum4 R = reflectance(c->specular_reflectance, specular_of(spectra), wl);
+        return conductor_reflectance(R, c->eta, c->k, c->measured, cos_ih, wl) * g;
     }
     if (const auto* p = std::get_if<PlasticMaterial>(&model)) {
         // base (1 - F_i)(1 - F_o), as plastic.hpp.
         if (wi.z <= 0 || wo.z <= 0) return Spectrum4(0.0f);
-        return coat_base(p->coat, wl) * ((1 - p->coat.fresnel(wi.z)) * (1 - p->coat.fresnel(wo.z)));
+        return coat_base(p->coat, spectra, wl) * ((1 - p->coat.fresnel(wi.z)) * (1 - p->coat.fresnel(wo.z)));
     }
     if (const auto* p = std::get_if<RoughPlasticMaterial>(&model)) {
         // base T(cos_i) T(cos_o) + specular_reflectance F(wi.h) D G2 / (4 cos_i cos_o), as roughplastic.hpp.
         if (wi.z <= 0 || wo.z <= 0) return Spectrum4(0.0f);
-        Spectrum4 f = coat_base(p->coat, wl) * (p->T(wi.z) * p->T(wo.z));
+        Spectrum4 f = coat_base(p->coat, spectra, wl) * (p->T(wi.z) * p->T(wo.z));
         const Vec3f h = normalize(wi + wo);
         const float c = dot(wi, h), D = p->distribution.D(h);
         if (c > 0 && D > 0)
-            f += reflectance_spectrum(p->coat.specular_reflectance, wl) *
+            f += reflectance(p->coat.specular_reflectance, specular_of(spectra), wl) *
                  (p->coat.fresnel(c) * D * p->distribution.G2(wi, wo) / (4 * wi.z * wo.z));
         return f;
     }
     const auto nested = [&](const Material& m, const Vec2f& uv) {
-        return model_value(m.varies ? m.model_at(uv) : m.model, wi, wo, wl);
+        return model_value(m.varies ? m.model_at(uv) : m.model, m.spectra.get(), wi, wo, wl);
     };
     if (const auto* b = std::get_if<BlendMaterial>(&model))
         return nested(*b->first, b->uv) * (1 - b->weight) + nested(*b->second, b->uv) * b->weight;
@@ -239,13 +249,16 @@ struct LobeColour {
     Rgb rgb{1.0f};
     Spectrum4 spectral{1.0f};
 };
-LobeColour delta_lobe_colour(const MaterialModel& model, const Vec3f& wi, const Vec3f& wo, const SampledWavelengths& wl) {
-    if (const auto* c = std::get_if<ConductorMaterial>(&model))
-        return {c->fresnel(wi.z), conductor_reflectance(c->specular_reflectance, c->eta, c->k, c->measured, wi.z, wl)};
+LobeColour delta_lobe_colour(const MaterialModel& model, const MaterialSpectra* spectra, const Vec3f& wi, const Vec3f& wo,
+                             const SampledWavelengths& wl) {
+    if (const auto* c = std::get_if<ConductorMaterial>(&model)) {
+        const Spectrum4 R = reflectance(c->specular_reflectance, specular_of(spectra), wl);
+        return {c->fresnel(wi.z), conductor_reflectance(R, c->eta, c->k, c->measured, wi.z, wl)};
+    }
     if (const auto* p = std::get_if<PlasticMaterial>(&model))
-        return {p->coat.specular_reflectance, reflectance_spectrum(p->coat.specular_reflectance, wl)};
+        return {p->coat.specular_reflectance, reflectance(p->coat.specular_reflectance, specular_of(spectra), wl)};
     const auto nested = [&](const Material& m, const Vec2f& uv) {
-        return delta_lobe_colour(m.varies ? m.model_at(uv) : m.model, wi, wo, wl);
+        return delta_lobe_colour(m.varies ? m.model_at(uv) : m.model, m.spectra.get(), wi, wo, wl);
     };
     if (const auto* b = std::get_if<BlendMaterial>(&model))  // at most one of the two has Dirac lobes (spectral_unsupported_model)
         return nested(has_delta_lobe(*b->first) ? *b->first : *b->second, b->uv);
@@ -280,7 +293,7 @@ Spectrum4 spectral_eval(const ShadingPoint& sp, const Vec3f& wo, const Rgb& f_rg
     MaterialModel storage;
     const MaterialModel& model = model_here(sp, storage);
     if (std::holds_alternative<RoughDielectricMaterial>(model)) return Spectrum4(f_rgb.x);  // grey, the context's factor included
-    Spectrum4 f = model_value(model, sp.wi, wo, wl);
+    Spectrum4 f = model_value(model, sp.material->spectra.get(), sp.wi, wo, wl);
     if (sp.mode == TransportMode::Importance) f *= sp.material->importance_factor(sp, sp.wi, wo);
     return f;
 }
@@ -316,7 +329,7 @@ Spectrum4 spectral_sample_value(const ShadingPoint& sp, const BsdfSample& s, con
     if (is_black(s.f)) return Spectrum4(0.0f);
     if (!s.delta) return spectral_eval(sp, s.wo, s.f, wl);
     MaterialModel storage;
-    const LobeColour c = delta_lobe_colour(model_here(sp, storage), sp.wi, s.wo, wl);
+    const LobeColour c = delta_lobe_colour(model_here(sp, storage), sp.material->spectra.get(), sp.wi, s.wo, wl);
     const int m = c.rgb.x >= c.rgb.y && c.rgb.x >= c.rgb.z ? 0 : (c.rgb.y >= c.rgb.z ? 1 : 2);
     if (!(c.rgb[m] > 0)) return Spectrum4(0.0f);
     return c.spectral * (s.f[m] / c.rgb[m]);

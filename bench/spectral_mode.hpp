@@ -7,7 +7,7 @@ namespace pathlab::bench {
 
 struct SpectralModeOptions {
     std::vector<int> scenes{3, 5};  // course scene indices
-    std::vector<std::string> algorithms{"pt-mis"};
+    std::vector<std::string> algorithms{"pt-mis", "bdpt"};  // the two; lt works too (a sample: a light path)
     int size = 128;    // image width and height
     int spp = 8;       // samples per pixel per timed render
     int repeats = 7;   // interleaved rounds (medians reported)

@@ -273,6 +273,7 @@ StrategyResult Bdpt::connect(const RenderContext& ctx, std::vector<PathVertex>& 
 }
 
 PassCounters Bdpt::render_passes(const RenderContext& ctx, Film& film, uint64_t first, int count, const PassProgress& progress) {
+    if (ctx.spectral) return render_spectral_passes(ctx, film, first, count, progress);  // bdpt_spectral.cpp
     const size_t pixels = ctx.pixel_count(), per_chunk = chunk_size(pixels);
     const int chunks = int((pixels + per_chunk - 1) / per_chunk);
     const int strategies_depth = strategies_ ? strategies_->max_length() : -1;
@@ -329,7 +330,7 @@ const IntegratorInfo& bdpt_integrator() {
     static const IntegratorInfo info{"bdpt", {"bpt"}, "bidirectional path tracing: every connection strategy (s, t), combined by MIS",
                                      false, true, path_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
                                          return std::make_unique<Bdpt>(o);
-                                     }, false, true};
+                                     }, false, true, /*spectral=*/true};
     return info;
 }
 

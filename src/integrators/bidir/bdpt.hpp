@@ -35,6 +35,7 @@
 #include <vector>
 
 #include "integrators/bidir/path_vertex.hpp"
+#include "integrators/bidir/spectral_subpath.hpp"
 #include "integrators/common/path_rules.hpp"
 #include "integrators/integrator.hpp"
 #include "render/pass_image.hpp"
@@ -53,6 +54,15 @@ struct BdptFaults {
 // t = 1 the raster position it lands on.
 struct StrategyResult {
     Rgb L{0.0f};
+    float weight = 0;
+    bool splat = false;
+    Vec2f raster;
+};
+
+// The same in spectral mode: the contribution at the camera sample's wavelengths (a path through
+// dispersion already as hero_only(), bidir_spectral_shading.hpp).
+struct SpectralStrategyResult {
+    Spectrum4 L{0.0f};
     float weight = 0;
     bool splat = false;
     Vec2f raster;
@@ -119,6 +129,15 @@ public:
     bool power_heuristic() const { return options_.mis_power; }
     int max_bounces() const { return max_bounces_; }
 
+    // Spectral mode (bdpt_spectral.cpp): the subpaths of one sample at its wavelengths wl (both
+    // subpaths at the camera sample's), and strategy (s, t) on them, in RGB mode's order, random
+    // streams and MIS weights.
+    void camera_subpath_spectral(const RenderContext& ctx, size_t pixel, Sampler& sampler, const SampledWavelengths& wl,
+                                 SpectralSubpath& path, const Vec2f* shift = nullptr) const;
+    void light_subpath_spectral(const RenderContext& ctx, Sampler& sampler, const SampledWavelengths& wl, SpectralSubpath& path) const;
+    SpectralStrategyResult connect_spectral(const RenderContext& ctx, SpectralSubpath& light, int s, SpectralSubpath& camera, int t,
+                                            Sampler& sampler, const SampledWavelengths& wl) const;
+
     // The per-strategy films (null without --strategies).
     const StrategyImages* strategy_images() const { return strategies_.get(); }
 
@@ -128,12 +147,16 @@ public:
 private:
     void random_walk(const RenderContext& ctx, Ray ray, Sampler& sampler, Rgb beta, float pdfW, int max_vertices,
                      TransportMode mode, std::vector<PathVertex>& path) const;
+    void random_walk_spectral(const RenderContext& ctx, Ray ray, Sampler& sampler, Spectrum4 beta, float pdfW, int max_vertices,
+                              TransportMode mode, SampledWavelengths wl, SpectralSubpath& path) const;
+    PassCounters render_spectral_passes(const RenderContext& ctx, Film& film, uint64_t first, int count, const PassProgress& progress);
 
     IntegratorOptions options_;
     BdptFaults faults_;
     int max_bounces_;
     PassImage pass_;
     tbb::enumerable_thread_specific<std::pair<std::vector<PathVertex>, std::vector<PathVertex>>> subpaths_;  // camera, light
+    tbb::enumerable_thread_specific<std::pair<SpectralSubpath, SpectralSubpath>> spectral_subpaths_;  // camera, light
     std::unique_ptr<StrategyImages> strategies_;
 };
 

@@ -100,7 +100,8 @@ PassCounters LightTracer::render_passes(const RenderContext& ctx, Film& film, ui
                 const size_t end = std::min(paths, size_t(c + 1) * per_chunk);
                 for (size_t j = size_t(c) * per_chunk; j < end; ++j) {
                     Sampler sampler(ctx.seed, j, pass, ctx.sampler);
-                    trace(ctx, sampler, out, chunk_invalid);
+                    if (ctx.spectral) trace_spectral(ctx, sampler, out, chunk_invalid);
+                    else trace(ctx, sampler, out, chunk_invalid);
                 }
                 rays += Scene::rays_traced_by_this_thread() - rays_before;
                 invalid += chunk_invalid;
@@ -116,7 +117,7 @@ const IntegratorInfo& light_tracer_integrator() {
     static const IntegratorInfo info{"lt", {"ptracer"}, "light tracing: paths from the lights, every vertex connected to the camera",
                                      false, false, path_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
                                          return std::make_unique<LightTracer>(o);
-                                     }, false, true};
+                                     }, false, true, /*spectral=*/true};
     return info;
 }
 

@@ -42,6 +42,9 @@ public:
 
     // One light path: splats its contributions (pixel, value) into `out`; counts NaN/Inf ones.
     void trace(const RenderContext& ctx, Sampler& sampler, SplatList& out, uint64_t& invalid) const;
+    // The same in spectral mode (light_tracer_spectral.cpp): the path draws its own wavelengths
+    // and each splat is the film's estimator of its spectral value.
+    void trace_spectral(const RenderContext& ctx, Sampler& sampler, SplatList& out, uint64_t& invalid) const;
 
     // Light paths per chunk of a pass: a function of the pass size only, so that chunking (and
     // with it the order in which splats are added) never depends on the thread count.

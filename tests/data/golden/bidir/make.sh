@@ -1,0 +1,12 @@
+#!/bin/sh
+# RGB images of lt and bdpt rendered at commit 7d99cd4, before spectral mode reached them
+# (tests/test_spectral_bidir.cpp, SpectralBidir.RgbImagesAreThoseRenderedBeforeSpectralMode,
+# renders them again and compares bit for bit). Run from the repository root with that build.
+set -e
+S=scenes/materials/smooth.xml
+for spec in "5-bdpt:5:bdpt" "7-bdpt:7:bdpt" "1-lt:1:lt" "6-lt:6:lt" "smooth-bdpt:$S:bdpt" "smooth-lt:$S:lt"; do
+    IFS=: read f sc a <<EOT
+$spec
+EOT
+    build/pathlab render --scene "$sc" -a "$a" --resolution 16x12 --spp 4 --seed 7 -q -o "tests/data/golden/bidir/$f.pfm"
+done

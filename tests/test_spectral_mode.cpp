@@ -209,6 +209,9 @@ TEST(SpectralMode, IntegratorsNotConvertedRefuseIt) {
     }
     const std::string names = spectral_integrator_names();
     EXPECT_NE(names.find("pt-mis3"), std::string::npos) << names;
+    // The photon methods converted (test_spectral_photon.cpp); vcm and bpm still refuse (above).
+    for (const char* name : {"pm", "ppm", "sppm"}) EXPECT_TRUE(find_integrator(name)->spectral) << name;
+    for (const char* name : {"vcm", "bpm"}) EXPECT_FALSE(find_integrator(name)->spectral) << name;
 }
 
 TEST(SpectralMode, CommandLineRefusalExitsWithCodeTwo) {

@@ -30,11 +30,12 @@ namespace {
 
 // An integrator by name in either mode (its factory sees IntegratorOptions::spectral).
 RenderResult render_with(const Scene& scene, const std::string& name, IntegratorOptions o, bool spectral, int width, int height,
-                         uint64_t spp, uint64_t seed, uint64_t first = 0) {
+                         uint64_t spp, uint64_t seed, uint64_t first = 0, SamplerKind sampler = SamplerKind::Independent) {
     o.spectral = spectral;
     const std::unique_ptr<Integrator> integrator = find_integrator(name)->make(o);
     RenderSettings rs;
     rs.width = width, rs.height = height, rs.spp = spp, rs.seed = seed, rs.spectral = spectral, rs.first_sample = first;
+    rs.sampler = sampler;
     return render(scene, *integrator, rs);
 }
 
@@ -51,7 +52,7 @@ std::unique_ptr<Scene> glass_scene(const std::string& floor, const std::string& 
     <bsdf type="diffuse"><rgb name="reflectance" value="{}"/></bsdf></shape>
   <shape type="sphere"><point name="center" value="0, 0, 0.5"/><float name="radius" value="0.5"/>
     <bsdf type="dielectric">{}</bsdf></shape>
-  <shape type="sphere"><point name="center" value="-0.8, 0.5, 2.2"/><float name="radius" value="0.4"/>
+  <shape type="sphere"><point name="center" value="-1.2, 0.3, 1.4"/><float name="radius" value="0.4"/>
     <emitter type="area"><rgb name="radiance" value="{}"/></emitter></shape>
   <emitter type="constant"><rgb name="radiance" value="{}"/></emitter>
 </scene>)",
@@ -66,7 +67,9 @@ std::unique_ptr<Scene> glass_scene(const std::string& floor, const std::string& 
 // SppmConsistency, whose parameters these are, at half the photons), against a spectral pt-mis
 // reference (8x8, 16384 spp), two ways:
 //  - per pixel and channel, test_agreement's outlier count (false alarms 1e-4 for the image,
-//    binomial over its 192 tests): a pixel's passes are independent (each draws its own
+//    binomial over its 192 tests), and the largest |z| at most 5.5 (Bonferroni over the 192:
+//    7e-6 false alarms if the pixels' errors were normal; pt-mis's caustic pixels have heavier
+//    tails, hence the margin over the 5.0 of 1e-4): a pixel's passes are independent (each draws its own
 //    wavelengths and photons), so the films' standard errors are valid per pixel. Its pooled
 //    bias test is not used: the pixels of one pass share the pass's wavelengths (and photons),
 //    so their errors are correlated (a tint of the whole pass) and the pooled standard error
@@ -81,9 +84,12 @@ std::unique_ptr<Scene> glass_scene(const std::string& floor, const std::string& 
 struct PhotonAgreement {
     AgreementResult pixels;
     Vec3d z{0.0};
-    bool agree() const { return pixels.outliers <= pixels.allowed_outliers && std::abs(z[0]) <= 4.5 && std::abs(z[1]) <= 4.5 && std::abs(z[2]) <= 4.5; }
+    bool agree() const {
+        return pixels.outliers <= pixels.allowed_outliers && pixels.max_abs_z <= 5.5 && std::abs(z[0]) <= 4.5 && std::abs(z[1]) <= 4.5 &&
+               std::abs(z[2]) <= 4.5;
+    }
     std::string describe() const {
-        return fmt::format("{} outliers (allowed {}) of {}, max |z| {:.2f}; image mean z = ({:.2f}, {:.2f}, {:.2f}) (limit 4.5)", pixels.outliers,
+        return fmt::format("{} outliers (allowed {}) of {}, max |z| {:.2f} (limit 5.5); image mean z = ({:.2f}, {:.2f}, {:.2f}) (limit 4.5)", pixels.outliers,
                            pixels.allowed_outliers, pixels.pixels, pixels.max_abs_z, z[0], z[1], z[2]);
     }
 };
@@ -146,6 +152,7 @@ std::vector<RenderResult>* SpectralPhotonAgreement::refs_ = nullptr;
 
 TEST_P(SpectralPhotonAgreement, SppmAgreesWithSpectralPtMis) {
     const PhotonAgreement r = against_spectral_pt_mis(*(*scenes_)[size_t(GetParam())], (*refs_)[size_t(GetParam())], "sppm", 16);
+    std::printf("sppm: %s\n", r.describe().c_str());
     EXPECT_TRUE(r.agree()) << r.describe();
 }
 
@@ -154,6 +161,7 @@ TEST_P(SpectralPhotonAgreement, SppmAgreesWithSpectralPtMis) {
 // gathering's blur, the caustic map's) is then below the noise of 128 passes.
 TEST_P(SpectralPhotonAgreement, PmAgreesWithSpectralPtMis) {
     const PhotonAgreement r = against_spectral_pt_mis(*(*scenes_)[size_t(GetParam())], (*refs_)[size_t(GetParam())], "pm", 8);
+    std::printf("pm: %s\n", r.describe().c_str());
     EXPECT_TRUE(r.agree()) << r.describe();
 }
 
@@ -183,7 +191,7 @@ RunsMean runs_mean(const Scene& scene, const std::string& name, const Integrator
                    uint64_t seed0) {
     std::vector<Vec3d> means;
     for (int k = 0; k < runs; ++k) {
-        const Image m = render_with(scene, name, o, spectral, 16, 16, spp, seed0 + uint64_t(k)).film.mean();
+        const Image m = render_with(scene, name, o, spectral, 16, 16, spp, seed0 + uint64_t(k), 0, SamplerKind::Sobol).film.mean();
         Vec3d sum(0.0);
         for (size_t i = 0; i < m.pixel_count(); ++i) sum += Vec3d(m[i]);
         means.push_back(sum / double(m.pixel_count()));
@@ -219,13 +227,14 @@ TEST(SpectralPhotonGrey, SpectralAgreesWithRgbModeForPmPpmAndSppm) {
         int64_t photons;
         uint64_t spp;
     };
-    for (const Case& k : {Case{"sppm", 4096, 8}, Case{"ppm", 4096, 8}, Case{"pm", 4096, 4}}) {
+    for (const Case& k : {Case{"sppm", 512, 64}, Case{"ppm", 512, 64}, Case{"pm", 512, 64}}) {
         IntegratorOptions o;
         o.photons = k.photons;
         const RunsMean rgb = runs_mean(*scene, k.name, o, false, 12, k.spp, 100);
         const RunsMean spectral = runs_mean(*scene, k.name, o, true, 12, k.spp, 200);
         for (int c = 0; c < 3; ++c) {
             const double sigma = std::hypot(rgb.se[c], spectral.se[c]);
+            std::printf("%s channel %d: spectral %.5f (se %.5f), rgb %.5f (se %.5f)\n", k.name, c, spectral.mean[c], spectral.se[c], rgb.mean[c], rgb.se[c]);
             EXPECT_LE(std::abs(spectral.mean[c] - rgb.mean[c]), eps * rgb.mean[c] + 5 * sigma)
                 << k.name << " channel " << c << ": spectral " << spectral.mean[c] << ", rgb " << rgb.mean[c] << ", sigma " << sigma;
             EXPECT_GT(rgb.mean[c], 10 * sigma) << k.name << ": the test must resolve the image";

@@ -6,7 +6,6 @@
 
 #include "integrators/common/path_rules.hpp"
 #include "integrators/integrators.hpp"
-#include "integrators/photon/spectral_photon_methods.hpp"
 #include "integrators/photon/visible_point.hpp"
 
 namespace pathlab {
@@ -123,23 +122,17 @@ Rgb PhotonMapper::radiance(const Scene& scene, const Ray& camera_ray, Sampler& s
 }
 
 const IntegratorInfo& pm_integrator() {
-    static const IntegratorInfo info = [] {
-        IntegratorInfo i{"pm", {"photonmapper"}, "photon mapping (Jensen): global and caustic maps, k-nearest estimates, final gathering", false,
-                         true,
-                         [] {
-                             std::vector<ParamInfo> p = path_params();
-                             p.push_back({"photon_count", ParamType::Integer, "0",
-                                          "light paths of the photon maps (0: 8 per pixel; --photons wins)", "photonCount"});
-                             return p;
-                         }(),
-                         [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
-                             // Spectral mode: photon maps per pass at the pass's wavelengths (pm_spectral.cpp).
-                             if (o.spectral) return make_spectral_pm(o);
-                             return std::make_unique<PhotonMapper>(o);
-                         }};
-        i.spectral = true;
-        return i;
-    }();
+    static const IntegratorInfo info{"pm", {"photonmapper"}, "photon mapping (Jensen): global and caustic maps, k-nearest estimates, final gathering", false,
+                                     true,
+                                     [] {
+                                         std::vector<ParamInfo> p = path_params();
+                                         p.push_back({"photon_count", ParamType::Integer, "0",
+                                                      "light paths of the photon maps (0: 8 per pixel; --photons wins)", "photonCount"});
+                                         return p;
+                                     }(),
+                                     [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
+                                         return std::make_unique<PhotonMapper>(o);
+                                     }};
     return info;
 }
 

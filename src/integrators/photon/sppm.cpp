@@ -9,7 +9,6 @@
 #include "integrators/common/path_rules.hpp"
 #include "integrators/integrators.hpp"
 #include "integrators/photon/progressive_radius.hpp"
-#include "integrators/photon/spectral_photon_methods.hpp"
 #include "integrators/photon/visible_point.hpp"
 
 namespace pathlab {
@@ -134,10 +133,7 @@ std::vector<ParamInfo> progressive_photon_params() {
 const IntegratorInfo& sppm_integrator() {
     static const IntegratorInfo info{
         "sppm", {}, "stochastic progressive photon mapping (Knaus-Zwicker iterations): photons + next-event estimation", false, true,
-        progressive_photon_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
-            if (o.spectral) return make_spectral_sppm(o, /*pixel_centres=*/false);  // sppm_spectral.cpp
-            return std::make_unique<Sppm>(o);
-        }, false, false, /*spectral=*/true};
+        progressive_photon_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> { return std::make_unique<Sppm>(o); }, false, false};
     return info;
 }
 
@@ -145,9 +141,8 @@ const IntegratorInfo& ppm_integrator() {
     static const IntegratorInfo info{
         "ppm", {}, "progressive photon mapping (Hachisuka 2008): fixed hit points through the pixel centres, photon passes, shrinking radius",
         false, true, progressive_photon_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
-            if (o.spectral) return make_spectral_sppm(o, /*pixel_centres=*/true);  // sppm_spectral.cpp
             return std::make_unique<Sppm>(o, SppmFaults{}, CameraRays::PixelCentres);
-        }, false, false, /*spectral=*/true};
+        }, false, false};
     return info;
 }
 

@@ -154,8 +154,9 @@ TEST(SpectralMode, IntegratorsNotConvertedRefuseIt) {
     }
     const std::string names = spectral_integrator_names();
     EXPECT_NE(names.find("pt-mis3"), std::string::npos) << names;
-    // The bidirectional ones (test_spectral_bidir.cpp); vcm and bpm, whose bdpt merges photons, still refuse.
-    for (const char* name : {"lt", "bdpt"}) EXPECT_TRUE(find_integrator(name)->spectral) << name;
+    // The bidirectional ones (test_spectral_bidir.cpp) and the photon methods (test_spectral_photon.cpp);
+    // vcm and bpm, whose bdpt merges photons, still refuse.
+    for (const char* name : {"lt", "bdpt", "pm", "ppm", "sppm"}) EXPECT_TRUE(find_integrator(name)->spectral) << name;
     for (const char* name : {"vcm", "bpm"}) EXPECT_FALSE(find_integrator(name)->spectral) << name;
 }
 

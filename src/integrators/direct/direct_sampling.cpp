@@ -7,6 +7,7 @@
 // black in scenes lit only by point lights (0, 1): correct, and why MIS exists.
 #include "integrators/integrators.hpp"
 #include "integrators/common/direct_lighting.hpp"
+#include "integrators/common/spectral_shading.hpp"
 
 namespace pathlab {
 namespace {
@@ -51,6 +52,43 @@ public:
         return L + f * e.Le * (std::abs(wo.z) / pdfW);
     }
 
+    // Spectral mode: the same direction (the same random number), the BSDF's value and the
+    // emission found at the wavelengths wl (spectral_shading.hpp).
+    Spectrum4 radiance_spectral(const Scene& scene, const Ray& ray, Sampler& sampler, SampledWavelengths& wl) const override {
+        Intersection hit;
+        if (!scene.intersect(ray, hit)) return hide_ ? Spectrum4(0.0f) : escaped_spectrum(scene, ray.d, wl);
+        Spectrum4 L = hide_ ? Spectrum4(0.0f) : emitted_spectrum(scene, hit, -ray.d, wl);
+        const ShadingPoint sp = make_shading_point(scene, hit, ray.d);
+        if (sp.material->is_black()) return L;
+
+        const Vec2f u = sampler.next2d();
+        Vec3f wo;
+        Spectrum4 f(0.0f);
+        float pdfW = 0;
+        switch (strategy_) {
+            case Strategy::UniformHemisphere:
+            case Strategy::CosineHemisphere: {
+                const bool uniform = strategy_ == Strategy::UniformHemisphere;
+                wo = uniform ? square_to_uniform_hemisphere(u) : square_to_cosine_hemisphere(u);
+                pdfW = uniform ? uniform_hemisphere_pdf(wo) : cosine_hemisphere_pdf(wo);
+                float pdf_bsdf;  // (unused: these strategies do not sample the BSDF)
+                f = spectral_eval_and_pdf(sp, wo, wl, pdf_bsdf);
+                break;
+            }
+            case Strategy::Brdf: {
+                const auto s = spectral_sample(sp, u, wl);
+                if (!s) return L;
+                wo = s->wo, f = spectral_sample_value(sp, *s, wl), pdfW = s->pdfW;
+                break;
+            }
+        }
+        if (!(pdfW > 0) || f.is_black()) return L;
+        const EmitterHit e = trace_to_emitter(scene, sp.spawn(wo), sp.p);
+        if (is_black(e.Le)) return L;
+        const int light = e.hit ? e.isect.light : scene.environment_light();
+        return L + f * emission_spectrum(scene, light, e.Le, wl) * (std::abs(wo.z) / pdfW);
+    }
+
 private:
     Strategy strategy_;
     bool hide_;
@@ -58,25 +96,33 @@ private:
 
 }  // namespace
 
+namespace {
+
+IntegratorInfo direct_sampling_info(const char* name, const char* alias, const char* summary, Strategy strategy) {
+    IntegratorInfo i{name, {alias}, summary, true, true,
+                     {{"hide_emitters", ParamType::Boolean, "false", "emitters (and the environment) seen directly are black", "hideEmitters"}},
+                     [strategy](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
+                         return std::make_unique<DirectBySampling>(strategy, o.hide_emitters);
+                     }};
+    i.spectral = true;
+    return i;
+}
+
+}  // namespace
+
 const IntegratorInfo& direct_uniform_integrator() {
-    static const IntegratorInfo info{"direct-uniform", {"2a"}, "direct illumination by uniform hemisphere sampling", true, true, {{"hide_emitters", ParamType::Boolean, "false", "emitters (and the environment) seen directly are black", "hideEmitters"}},
-                                     [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
-                                         return std::make_unique<DirectBySampling>(Strategy::UniformHemisphere, o.hide_emitters);
-                                     }};
+    static const IntegratorInfo info =
+        direct_sampling_info("direct-uniform", "2a", "direct illumination by uniform hemisphere sampling", Strategy::UniformHemisphere);
     return info;
 }
 const IntegratorInfo& direct_cosine_integrator() {
-    static const IntegratorInfo info{"direct-cosine", {"2b"}, "direct illumination by cosine-weighted hemisphere sampling", true,
-                                     true, {{"hide_emitters", ParamType::Boolean, "false", "emitters (and the environment) seen directly are black", "hideEmitters"}}, [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
-                                         return std::make_unique<DirectBySampling>(Strategy::CosineHemisphere, o.hide_emitters);
-                                     }};
+    static const IntegratorInfo info = direct_sampling_info("direct-cosine", "2b", "direct illumination by cosine-weighted hemisphere sampling",
+                                                            Strategy::CosineHemisphere);
     return info;
 }
 const IntegratorInfo& direct_brdf_integrator() {
-    static const IntegratorInfo info{"direct-brdf", {"2c"}, "direct illumination by BRDF importance sampling", true, true, {{"hide_emitters", ParamType::Boolean, "false", "emitters (and the environment) seen directly are black", "hideEmitters"}},
-                                     [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
-                                         return std::make_unique<DirectBySampling>(Strategy::Brdf, o.hide_emitters);
-                                     }};
+    static const IntegratorInfo info =
+        direct_sampling_info("direct-brdf", "2c", "direct illumination by BRDF importance sampling", Strategy::Brdf);
     return info;
 }
 

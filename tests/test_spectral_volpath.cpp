@@ -192,17 +192,18 @@ double hg(double g, double cos_theta) { return (1 - g * g) / (4 * M_PI * std::po
 // colour of L, integrated here against the CIE observer by the midpoint rule every 1 nm. The
 // medium is homogeneous (exact free flights, closed-form transmittance), or a 3-channel grid of
 // that colour in every voxel (delta tracking, ratio tracking against the majorant grid times
-// the unbounded-spectrum bound: sigma_t = (0.2, 2.5, 0.3) has a spectrum that rises above 2.5).
+// the unbounded-spectrum bound: sigma_t = (2, 0.05, 0.1) has a spectrum that rises far above 2, at long wavelengths).
 TEST(SpectralVolpath, SingleScatteringInAColouredSlabMatchesTheQuadrature) {
     const float thickness = 0.3f, g = 0.4f;
-    const Rgb sigma_t_rgb(0.2f, 2.5f, 0.3f), albedo_rgb(0.9f, 0.5f, 0.2f);
+    const Rgb sigma_t_rgb(2.0f, 0.05f, 0.1f), albedo_rgb(0.9f, 0.5f, 0.2f);
     const Vec3f light_dir = normalize(Vec3f(0.3f, 0.2f, -1.0f));
     const Rgb E(1.0f, 2.0f, 3.0f);
     const RgbToSpectrumTable& table = RgbToSpectrumTable::srgb();
     const RgbUnboundedSpectrum st_spec(table, sigma_t_rgb);
     const RgbAlbedoSpectrum albedo_spec(table, albedo_rgb);
     const RgbIlluminantSpectrum e_spec(table, E);
-    ASSERT_GT(st_spec.max_value(), 1.02f * max_component(sigma_t_rgb));  // the case the majorant bound is for
+    ASSERT_GT(st_spec.max_value(), 1.5f * max_component(sigma_t_rgb));  // the case the majorant bound is for
+    std::printf("sigma_t's spectrum: max %.4f for an RGB of max %.4f\n", st_spec.max_value(), max_component(sigma_t_rgb));
 
     SceneDescription d;
     d.name = "slab";

@@ -7,12 +7,15 @@
 // black in scenes lit only by point lights (0, 1): correct, and why MIS exists.
 #include "integrators/integrators.hpp"
 #include "integrators/common/direct_lighting.hpp"
-#include "integrators/common/spectral_shading.hpp"
+#include "integrators/direct/direct_sampling_spectral.hpp"
 
 namespace pathlab {
 namespace {
 
 enum class Strategy { UniformHemisphere, CosineHemisphere, Brdf };
+static_assert(int(Strategy::UniformHemisphere) == int(DirectSamplingStrategy::UniformHemisphere) &&
+              int(Strategy::CosineHemisphere) == int(DirectSamplingStrategy::CosineHemisphere) &&
+              int(Strategy::Brdf) == int(DirectSamplingStrategy::Brdf));
 
 class DirectBySampling final : public PixelIntegrator {
 public:
@@ -52,41 +55,9 @@ public:
         return L + f * e.Le * (std::abs(wo.z) / pdfW);
     }
 
-    // Spectral mode: the same direction (the same random number), the BSDF's value and the
-    // emission found at the wavelengths wl (spectral_shading.hpp).
+    // Spectral mode (direct_sampling_spectral.cpp, a file of its own so that this one compiles as before).
     Spectrum4 radiance_spectral(const Scene& scene, const Ray& ray, Sampler& sampler, SampledWavelengths& wl) const override {
-        Intersection hit;
-        if (!scene.intersect(ray, hit)) return hide_ ? Spectrum4(0.0f) : escaped_spectrum(scene, ray.d, wl);
-        Spectrum4 L = hide_ ? Spectrum4(0.0f) : emitted_spectrum(scene, hit, -ray.d, wl);
-        const ShadingPoint sp = make_shading_point(scene, hit, ray.d);
-        if (sp.material->is_black()) return L;
-
-        const Vec2f u = sampler.next2d();
-        Vec3f wo;
-        Spectrum4 f(0.0f);
-        float pdfW = 0;
-        switch (strategy_) {
-            case Strategy::UniformHemisphere:
-            case Strategy::CosineHemisphere: {
-                const bool uniform = strategy_ == Strategy::UniformHemisphere;
-                wo = uniform ? square_to_uniform_hemisphere(u) : square_to_cosine_hemisphere(u);
-                pdfW = uniform ? uniform_hemisphere_pdf(wo) : cosine_hemisphere_pdf(wo);
-                float pdf_bsdf;  // (unused: these strategies do not sample the BSDF)
-                f = spectral_eval_and_pdf(sp, wo, wl, pdf_bsdf);
-                break;
-            }
-            case Strategy::Brdf: {
-                const auto s = spectral_sample(sp, u, wl);
-                if (!s) return L;
-                wo = s->wo, f = spectral_sample_value(sp, *s, wl), pdfW = s->pdfW;
-                break;
-            }
-        }
-        if (!(pdfW > 0) || f.is_black()) return L;
-        const EmitterHit e = trace_to_emitter(scene, sp.spawn(wo), sp.p);
-        if (is_black(e.Le)) return L;
-        const int light = e.hit ? e.isect.light : scene.environment_light();
-        return L + f * emission_spectrum(scene, light, e.Le, wl) * (std::abs(wo.z) / pdfW);
+        return direct_sampling_spectral(scene, ray, sampler, wl, DirectSamplingStrategy(int(strategy_)), hide_);
     }
 
 private:

@@ -265,14 +265,21 @@ TEST(SpectralVolpath, SingleScatteringInAColouredSlabMatchesTheQuadrature) {
 
 // ---- coloured media: two free-flight strategies ---------------------------------------------
 
-// The fog box (a bluish homogeneous fog, coloured walls, full global illumination) and a
-// coloured 3-channel grid in scene 2: exact free flights against delta and ratio tracking with
+// The fog box (a bluish homogeneous fog, coloured walls, full global illumination), scene 2 with
+// a strongly coloured homogeneous fog (sigma_t (1.5, 0.4, 0.1)) and with a coloured 3-channel grid: exact free flights against delta and ratio tracking with
 // the majorant inflated 2.5 times (null collisions); the same expectation: the per-pixel z-test
 // (judge/image_statistics.hpp), and the image means per channel at z = 4 (6 two-sided tests,
 // false alarms below 4e-4).
 TEST(SpectralVolpath, FreeFlightStrategiesAgreeOnColouredMedia) {
     std::vector<SceneDescription> scenes;
     scenes.push_back(load_scene_file(source_path("scenes/fog-box.xml")));
+    {
+        // A strongly coloured homogeneous fog in scene 2 (its lanes' extinctions far apart).
+        SceneDescription d = make_builtin_scene(2);
+        d.media.push_back(HomogeneousMedium{Rgb(1.5f, 0.4f, 0.1f), Rgb(1.35f, 0.24f, 0.03f), HgPhase{0.3f}});
+        d.meshes.push_back(fog_box(0));
+        scenes.push_back(d);
+    }
     {
         SceneDescription d = make_builtin_scene(2);
         VoxelGrid g;

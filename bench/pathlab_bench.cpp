@@ -142,6 +142,7 @@ int main(int argc, char** argv) {
     SpectralModeOptions smo;
     CLI::App* smc = app.add_subcommand("spectral-mode", "Spectral mode's cost per sample relative to RGB mode (docs/spectral.md)");
     smc->add_option("--scenes", smo.scenes, "Course scene indices")->delimiter(',')->capture_default_str();
+    CLI::Option* sm_files = smc->add_option("--scene-files", smo.scene_files, "Scene files (then course scenes only if --scenes is given)")->delimiter(',');
     smc->add_option("--algorithms", smo.algorithms, "Integrators that render spectrally")->delimiter(',')->capture_default_str();
     smc->add_option("--size", smo.size, "Image width and height")->capture_default_str();
     smc->add_option("--spp", smo.spp, "Samples per pixel per render")->capture_default_str();
@@ -155,6 +156,7 @@ int main(int argc, char** argv) {
     }
     if (*gat) pbgi_gather_suite(gopt);
     if (*dist) distributed_suite(dopt, args[0]);
+    if (*smc && sm_files->count() > 0 && smc->count("--scenes") == 0) smo.scenes.clear();
     if (*dfc) differentiable_suite(dfo);
     if (*lic) lights_suite(lo);
     if (*vol) volumes_suite(vo);

@@ -8,6 +8,7 @@
 #include "bench_common.hpp"
 #include "job/render_job.hpp"
 #include "scene/builtin_scenes.hpp"
+#include "scenefile/scene_file.hpp"
 
 namespace pathlab::bench {
 
@@ -15,8 +16,10 @@ void spectral_mode_suite(const SpectralModeOptions& o) {
     fmt::print("spectral mode against RGB mode: {}x{}, {} spp per render, medians of {} interleaved rounds\n", o.size, o.size, o.spp,
                o.repeats);
     fmt::print("{:<18} {:<10} {:>14} {:>14} {:>8}\n", "scene", "algorithm", "RGB ns/sample", "spectral ns/s.", "ratio");
-    for (int index : o.scenes) {
-        const SceneChoice choice = builtin_scene_choice(index);
+    std::vector<SceneChoice> choices;
+    for (int index : o.scenes) choices.push_back(builtin_scene_choice(index));
+    for (const std::string& file : o.scene_files) choices.push_back(scene_choice_of(load_scene_file(file)));
+    for (const SceneChoice& choice : choices) {
         const std::shared_ptr<const Scene> scene = Scene::build(choice.description);
         for (const std::string& algorithm : o.algorithms) {
             std::vector<double> rgb_ns, spectral_ns, ratios;

@@ -169,7 +169,7 @@ const IntegratorInfo& ic_integrator() {
     static const IntegratorInfo info{"ic", {"irrcache"}, "irradiance caching with gradients (Ward): cached indirect diffuse light at first hits, pt-mis elsewhere",
                                      false, true, ic_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
                                          return std::make_unique<IrradianceCaching>(o);
-                                     }, false, true};
+                                     }, false, true, /*spectral=*/true};
     return info;
 }
 

@@ -31,6 +31,8 @@ public:
 
     void prepare(const RenderContext& ctx, const PassProgress& progress) override;
     Rgb radiance(const Scene& scene, const Ray& ray, Sampler& sampler) const override;
+    // Spectral mode (cache_spectral.cpp): the cached indirect irradiance upsampled as an illuminant.
+    Spectrum4 radiance_spectral(const Scene& scene, const Ray& ray, Sampler& sampler, SampledWavelengths& wl) const override;
     void finish(const RenderContext& ctx) override;
     std::vector<IntegratorStatistic> statistics() const override;
 

@@ -165,7 +165,7 @@ const IntegratorInfo& pbgi_integrator() {
     static const IntegratorInfo info{"pbgi", {}, "point-based global illumination (Christensen): indirect diffuse light at first hits gathered from a surfel octree, pt-mis elsewhere",
                                      false, true, pbgi_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
                                          return std::make_unique<PointBasedGi>(o);
-                                     }, /*any_camera=*/false, /*any_filter=*/true};
+                                     }, /*any_camera=*/false, /*any_filter=*/true, /*spectral=*/true};
     return info;
 }
 

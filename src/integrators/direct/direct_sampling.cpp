@@ -7,11 +7,15 @@
 // black in scenes lit only by point lights (0, 1): correct, and why MIS exists.
 #include "integrators/integrators.hpp"
 #include "integrators/common/direct_lighting.hpp"
+#include "integrators/direct/direct_sampling_spectral.hpp"
 
 namespace pathlab {
 namespace {
 
 enum class Strategy { UniformHemisphere, CosineHemisphere, Brdf };
+static_assert(int(Strategy::UniformHemisphere) == int(DirectSamplingStrategy::UniformHemisphere) &&
+              int(Strategy::CosineHemisphere) == int(DirectSamplingStrategy::CosineHemisphere) &&
+              int(Strategy::Brdf) == int(DirectSamplingStrategy::Brdf));
 
 class DirectBySampling final : public PixelIntegrator {
 public:
@@ -51,6 +55,11 @@ public:
         return L + f * e.Le * (std::abs(wo.z) / pdfW);
     }
 
+    // Spectral mode (direct_sampling_spectral.cpp, a file of its own so that this one compiles as before).
+    Spectrum4 radiance_spectral(const Scene& scene, const Ray& ray, Sampler& sampler, SampledWavelengths& wl) const override {
+        return direct_sampling_spectral(scene, ray, sampler, wl, DirectSamplingStrategy(int(strategy_)), hide_);
+    }
+
 private:
     Strategy strategy_;
     bool hide_;
@@ -58,25 +67,33 @@ private:
 
 }  // namespace
 
+namespace {
+
+IntegratorInfo direct_sampling_info(const char* name, const char* alias, const char* summary, Strategy strategy) {
+    IntegratorInfo i{name, {alias}, summary, true, true,
+                     {{"hide_emitters", ParamType::Boolean, "false", "emitters (and the environment) seen directly are black", "hideEmitters"}},
+                     [strategy](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
+                         return std::make_unique<DirectBySampling>(strategy, o.hide_emitters);
+                     }};
+    i.spectral = true;
+    return i;
+}
+
+}  // namespace
+
 const IntegratorInfo& direct_uniform_integrator() {
-    static const IntegratorInfo info{"direct-uniform", {"2a"}, "direct illumination by uniform hemisphere sampling", true, true, {{"hide_emitters", ParamType::Boolean, "false", "emitters (and the environment) seen directly are black", "hideEmitters"}},
-                                     [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
-                                         return std::make_unique<DirectBySampling>(Strategy::UniformHemisphere, o.hide_emitters);
-                                     }};
+    static const IntegratorInfo info =
+        direct_sampling_info("direct-uniform", "2a", "direct illumination by uniform hemisphere sampling", Strategy::UniformHemisphere);
     return info;
 }
 const IntegratorInfo& direct_cosine_integrator() {
-    static const IntegratorInfo info{"direct-cosine", {"2b"}, "direct illumination by cosine-weighted hemisphere sampling", true,
-                                     true, {{"hide_emitters", ParamType::Boolean, "false", "emitters (and the environment) seen directly are black", "hideEmitters"}}, [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
-                                         return std::make_unique<DirectBySampling>(Strategy::CosineHemisphere, o.hide_emitters);
-                                     }};
+    static const IntegratorInfo info = direct_sampling_info("direct-cosine", "2b", "direct illumination by cosine-weighted hemisphere sampling",
+                                                            Strategy::CosineHemisphere);
     return info;
 }
 const IntegratorInfo& direct_brdf_integrator() {
-    static const IntegratorInfo info{"direct-brdf", {"2c"}, "direct illumination by BRDF importance sampling", true, true, {{"hide_emitters", ParamType::Boolean, "false", "emitters (and the environment) seen directly are black", "hideEmitters"}},
-                                     [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
-                                         return std::make_unique<DirectBySampling>(Strategy::Brdf, o.hide_emitters);
-                                     }};
+    static const IntegratorInfo info =
+        direct_sampling_info("direct-brdf", "2c", "direct illumination by BRDF importance sampling", Strategy::Brdf);
     return info;
 }
 

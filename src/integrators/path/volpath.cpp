@@ -22,6 +22,7 @@
 #include "integrators/common/path_rules.hpp"
 #include "integrators/integrators.hpp"
 #include "integrators/path/pt_mis.hpp"
+#include "integrators/path/volpath_spectral.hpp"
 
 namespace pathlab {
 namespace {
@@ -279,6 +280,11 @@ public:
         return L;
     }
 
+    // Spectral mode: volpath_spectral.cpp's copy of the loop above.
+    Spectrum4 radiance_spectral(const Scene& scene, const Ray& camera_ray, Sampler& sampler, SampledWavelengths& wl) const override {
+        return volpath_spectral_radiance(scene, camera_ray, sampler, wl, rules_, {mis_, pt_mis_without_media_, hide_});
+    }
+
 private:
     // Russian roulette on beta / mean(r), the path's actual weight (pt-mis's exactly when r = 1).
     bool survive_roulette(int bounces, Rgb& beta, const Rgb& r, Sampler& sampler) const {
@@ -301,8 +307,12 @@ std::unique_ptr<Integrator> make_volpath(const IntegratorOptions& options, Volpa
 }
 
 const IntegratorInfo& volpath_integrator() {
-    static const IntegratorInfo info{"volpath", {"volpathmis"}, "volumetric path tracing: participating media, delta tracking, MIS",
-                                     false, true, path_params(), [](const IntegratorOptions& o) { return make_volpath(o); }};
+    static const IntegratorInfo info = [] {
+        IntegratorInfo i{"volpath", {"volpathmis"}, "volumetric path tracing: participating media, delta tracking, MIS",
+                         false, true, path_params(), [](const IntegratorOptions& o) { return make_volpath(o); }};
+        i.spectral = true;
+        return i;
+    }();
     return info;
 }
 

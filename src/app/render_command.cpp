@@ -85,8 +85,8 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
                    "'sobol' (scrambled low-discrepancy points: lower error at equal time)")
         ->capture_default_str();
     app.add_flag("--spectral", o.spectral,
-                 "Spectral mode: paths carry 4 sampled wavelengths, RGB inputs are upsampled (docs/spectral.md); pt-mis, "
-                 "pt-mis3, pt-naive, direct-mis, direct-light, pm, ppm and sppm only (others refuse). Also a scene file's <default name=\"mode\" value=\"spectral\"/>");
+                 "Spectral mode: paths carry 4 sampled wavelengths, RGB inputs are upsampled (docs/spectral.md); every "
+                 "algorithm but vcm and bpm (which refuse). Also a scene file's <default name=\"mode\" value=\"spectral\"/>");
     add_threads_option(app, o.threads);
     app.add_option("-o,--output", o.outputs,
                    "Output file, repeatable; format by extension: .exr .hdr .pfm .png. Placeholders {scene} {index} "

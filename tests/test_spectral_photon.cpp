@@ -21,6 +21,7 @@
 #include "judge/image_statistics.hpp"
 #include "render_helpers.hpp"
 #include "scenefile/scene_file.hpp"
+#include "spectral_helpers.hpp"
 #include "spectral/rgb_spectra.hpp"
 #include "spectral/rgb_to_spectrum.hpp"
 #include "spectral/xyz_estimator.hpp"
@@ -171,15 +172,6 @@ INSTANTIATE_TEST_SUITE_P(SpectralPhoton, SpectralPhotonAgreement, ::testing::Val
 
 // ---- (b) spectral against RGB photon mapping on a grey scene under white light ------------
 
-// The film's colour of spectrum s (the mean of spectral_sample_to_linear_srgb), midpoint rule
-// every 0.25 nm.
-template <typename F>
-Vec3d film_colour(F&& s) {
-    Vec3d xyz(0.0);
-    const double h = 0.25;
-    for (double l = kVisibleMinWavelength + h / 2; l < kVisibleMaxWavelength; l += h) xyz += cie1931_xyz_bar(l) * (s(l) * h);
-    return xyz_to_linear_srgb(xyz / cie_y_integral());
-}
 
 // Image means per channel over R independent runs (seeds), and their standard error from the
 // runs' spread: valid although the pixels of one pass share photons (and, in spectral mode,

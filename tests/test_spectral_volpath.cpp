@@ -17,6 +17,7 @@
 #include "judge/image_statistics.hpp"
 #include "render_helpers.hpp"
 #include "scenefile/scene_file.hpp"
+#include "spectral_helpers.hpp"
 #include "spectral/rgb_spectra.hpp"
 
 namespace pathlab::test {
@@ -122,21 +123,6 @@ double white_round_trip_error(const Rgb& e) {
     return worst;
 }
 
-struct ImageMean {
-    Vec3d mean{0.0}, se{0.0};
-};
-ImageMean image_mean(const RenderResult& r) {
-    const Image m = r.film.mean(), s = r.film.standard_error();
-    ImageMean out;
-    const double n = double(m.pixel_count());
-    for (size_t i = 0; i < m.pixel_count(); ++i)
-        for (int c = 0; c < 3; ++c) {
-            out.mean[c] += m[i][c] / n;
-            out.se[c] += double(s[i][c]) * s[i][c];
-        }
-    for (int c = 0; c < 3; ++c) out.se[c] = std::sqrt(out.se[c]) / n;
-    return out;
-}
 
 // Scene 4 (the light box: a white emitter) with every surface grey and a grey medium filling the
 // box (homogeneous, or a one-channel grid). Every path's value is a product of grey factors

@@ -195,6 +195,9 @@ protected:
                            "-n {} {}",
                            ranks, PATHLAB_BINARY);
     }
+    // Renders one small scene per integrator with one process of 2 threads and 2 ranks of 1
+    // thread, and expects the same bytes (defined below).
+    void expect_two_ranks_equal_one_process(const std::vector<std::string>& algorithms, const std::string& flags);
 
     fs::path dir_;
 };
@@ -423,12 +426,11 @@ TEST_F(Distributed, PlainBinaryRunsWithoutMpirunAndForcedSingletonMpiToo) {
     EXPECT_TRUE(same_render(path("plain.exr"), path("singleton.exr")));
 }
 
-TEST_F(Distributed, TwoRanksOfOneThreadEqualOneProcessOfTwoThreadsForEveryIntegrator) {
-    // One scene file per integrator (the course's scene 3 with its <integrator>; volpath: scene 2
-    // in fog, whose file names volpath), all rendered by one command: one mpirun start instead of
-    // one per integrator. pbgi with a small cloud: its surfels and corner gathers are made by
-    // every rank alike.
-    const std::vector<std::string> algorithms = {"pt-mis", "lt", "bdpt", "sppm", "ppm", "pm", "vcm", "bpm", "ic", "pbgi", "volpath"};
+// One scene file per integrator (the course's scene 3 with its <integrator>; volpath: scene 2
+// in fog, whose file names volpath), all rendered by one command: one mpirun start instead of
+// one per integrator, with `flags` added. pbgi with a small cloud: its surfels and corner gathers
+// are made by every rank alike.
+void Distributed::expect_two_ranks_equal_one_process(const std::vector<std::string>& algorithms, const std::string& flags) {
     fs::create_directory_symlink(fs::path(PATHLAB_SOURCE_DIR) / "scenes/meshes", dir_ / "meshes");
     const std::string scene = file_bytes(std::string(PATHLAB_SOURCE_DIR) + "/scenes/3-ceiling-glossy.xml");
     const std::string open = "<scene version=\"3.0.0\">";
@@ -444,14 +446,24 @@ TEST_F(Distributed, TwoRanksOfOneThreadEqualOneProcessOfTwoThreadsForEveryIntegr
         std::ofstream(path(a + ".xml")) << text;
         list += (list.empty() ? "" : ",") + path(a + ".xml");
     }
-    const std::string args = fmt::format("--scene {} --resolution 16x12 --seed 5 -q --spp 5", list);
+    const std::string args = fmt::format("--scene {} --resolution 16x12 --seed 5 -q --spp 5 {}", list, flags);
     std::string err;
     ASSERT_EQ(shell(fmt::format("{} {} --threads 2 -o {}", PATHLAB_BINARY, args, path("one-{scene}.exr")), &err), 0) << err;
     ASSERT_EQ(shell(fmt::format("{} {} --threads 1 -o {}", mpirun(2), args, path("two-{scene}.exr")), &err), 0) << err;
     for (const std::string& a : algorithms) {
         EXPECT_EQ(read_render(path("one-" + a + ".exr")).attributes.at("pathlab:integrator"), a);
-        EXPECT_TRUE(same_render(path("one-" + a + ".exr"), path("two-" + a + ".exr"))) << a;
+        EXPECT_TRUE(same_render(path("one-" + a + ".exr"), path("two-" + a + ".exr"))) << a << " " << flags;
     }
+}
+
+TEST_F(Distributed, TwoRanksOfOneThreadEqualOneProcessOfTwoThreadsForEveryIntegrator) {
+    expect_two_ranks_equal_one_process({"pt-mis", "lt", "bdpt", "sppm", "ppm", "pm", "vcm", "bpm", "ic", "pbgi", "volpath"}, "");
+}
+
+// Spectral mode's wavelengths come from per-sample (or per-pass) streams, so ranks give the
+// one-process bytes there too.
+TEST_F(Distributed, TwoRanksEqualOneProcessInSpectralMode) {
+    expect_two_ranks_equal_one_process({"pt-mis", "lt", "bdpt", "sppm", "pm", "ic", "pbgi", "volpath"}, "--spectral");
 }
 
 TEST_F(Distributed, RanksWithATimeBudgetAgreeOnOneSampleCount) {

@@ -60,7 +60,7 @@ struct StrategyResult {
 };
 
 // The same in spectral mode: the contribution at the camera sample's wavelengths (a path through
-// dispersion already as hero_only(), bidir_spectral_shading.hpp).
+// dispersion already as hero_only(), hero_only.hpp).
 struct SpectralStrategyResult {
     Spectrum4 L{0.0f};
     float weight = 0;

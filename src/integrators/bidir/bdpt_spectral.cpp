@@ -8,7 +8,7 @@
 // template of them, as for pt-mis, so that RGB mode's translation unit compiles as before.
 //
 // Dispersion: a subpath that scatters at a dispersive interface continues with the hero
-// wavelength alone (bidir_spectral_sample). A strategy whose path contains such a vertex, on
+// wavelength alone (spectral_sample). A strategy whose path contains such a vertex, on
 // either side, is the hero's estimate: hero_only(L), the factor 4 of terminate_secondary()
 // applied once for the whole path, even when both subpaths met dispersion (they share the hero).
 #include <tbb/blocked_range.h>
@@ -17,7 +17,7 @@
 #include <atomic>
 
 #include "integrators/bidir/bdpt.hpp"
-#include "integrators/bidir/bidir_spectral_shading.hpp"
+#include "integrators/bidir/hero_only.hpp"
 #include "integrators/bidir/strategy_images.hpp"
 #include "integrators/common/spectral_shading.hpp"
 #include "spectral/xyz_estimator.hpp"
@@ -29,7 +29,7 @@ namespace {
 // transport mode) for light leaving towards the world direction w, and its density pdfW.
 Spectrum4 bsdf_towards(const PathVertex& v, const Vec3f& w, float& pdfW, const SampledWavelengths& wl) {
     const Vec3f wo = v.sp.frame.to_local(w);
-    return bidir_spectral_eval(v.sp, wo, v.sp.material->eval_and_pdf(v.sp, v.sp.wi, wo, pdfW), wl);
+    return spectral_eval(v.sp, wo, v.sp.material->eval_and_pdf(v.sp, v.sp.wi, wo, pdfW), wl);
 }
 
 // |cos| at v of the world direction w (bdpt.cpp's cos_at).
@@ -72,10 +72,10 @@ void Bdpt::random_walk_spectral(const RenderContext& ctx, Ray ray, Sampler& samp
         if (cur.sp.material->is_black() || int(path.size()) >= max_vertices) return;
 
         cur.sp.reverse_pdf = true;
-        const auto s = bidir_spectral_sample(cur.sp, sampler.next2d(), wl);
+        const auto s = spectral_sample(cur.sp, sampler.next2d(), wl);
         cur.sp.reverse_pdf = false;
         if (!s) return;
-        const Spectrum4 weight = bidir_spectral_sample_value(cur.sp, *s, wl) * (std::abs(s->wo.z) / s->pdfW);
+        const Spectrum4 weight = spectral_sample_value(cur.sp, *s, wl) * (std::abs(s->wo.z) / s->pdfW);
         beta *= weight;
         scatter *= weight;
         if (wl.secondary_terminated() && path.dispersed_from > int(path.size())) {

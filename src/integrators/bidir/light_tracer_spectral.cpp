@@ -2,7 +2,7 @@
 // LightTracer::trace's path (the same random numbers in the same order, roulette on the largest
 // lane), carrying a spectral throughput. A copy of the loop in its own file, as pt-mis's, so that
 // RGB mode's translation unit compiles as before.
-#include "integrators/bidir/bidir_spectral_shading.hpp"
+#include "integrators/bidir/hero_only.hpp"
 #include "integrators/bidir/light_tracer.hpp"
 #include "integrators/common/spectral_shading.hpp"
 #include "spectral/xyz_estimator.hpp"
@@ -79,15 +79,15 @@ void LightTracer::trace_spectral(const RenderContext& ctx, Sampler& sampler, Spl
                 const Rgb f_rgb = m.eval(sp, sp.wi, wo);
                 const float camera_pdf = faults_.drop_camera_geometry ? 1.0f : k->pdfW;
                 if (!is_black(f_rgb) && !scene.occluded(spawn_segment(sp.p, sp.ng, camera.position(), Vec3f(0.0f)))) {
-                    const Spectrum4 f = bidir_spectral_eval(sp, wo, f_rgb, wl);
+                    const Spectrum4 f = spectral_eval(sp, wo, f_rgb, wl);
                     splat_spectral(out, ctx, k->raster, power * beta * f * (std::abs(wo.z) * k->We / camera_pdf), wl, invalid);
                 }
             }
         }
         if (!rules_.may_bounce(bounces)) return;
-        const auto s = bidir_spectral_sample(sp, sampler.next2d(), wl);
+        const auto s = spectral_sample(sp, sampler.next2d(), wl);
         if (!s) return;
-        beta *= bidir_spectral_sample_value(sp, *s, wl) * (std::abs(s->wo.z) / s->pdfW);
+        beta *= spectral_sample_value(sp, *s, wl) * (std::abs(s->wo.z) / s->pdfW);
         // The other lanes' light went elsewhere: their values no longer mean anything (and
         // must not keep the path alive in the roulette).
         if (wl.secondary_terminated()) beta = Spectrum4(beta[0], 0.0f, 0.0f, 0.0f);

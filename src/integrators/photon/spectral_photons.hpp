@@ -21,9 +21,8 @@
 // flagged hero_only). The factor 4 of terminate_secondary belongs once to the whole camera +
 // light path: SpectralMergeSum counts a hero-only photon's lane 0 four times against a camera
 // path that still has 4 lanes, once against a hero-only camera path (whose hero pdf is p/4
-// already). spectral_sample's dispersive branch samples the raw model (radiance transport);
-// photon paths sample through spectral_sample_importance, which applies importance transport's
-// adjustments with the hero's index.
+// already). spectral_sample samples a dispersive dielectric through Material::sample with the
+// path's context at the hero's index, so importance transport's adjustments use that index.
 #pragma once
 
 #include <memory>
@@ -50,22 +49,6 @@ struct SpectralPower {
     Spectrum4 power;
     bool hero_only = false;  // its path met a dispersive interface: lanes 1-3 are 0
 };
-
-// spectral_sample for a photon path (sp in importance transport): at a dispersive dielectric
-// the hero wavelength's index through Material::sample, so that importance transport's
-// refraction factor (eta_wo / eta_wi)^2 and shading-normal correction use that index; elsewhere
-// spectral_sample itself.
-inline std::optional<BsdfSample> spectral_sample_importance(const ShadingPoint& sp, const Vec2f& u, SampledWavelengths& wl) {
-    if (const auto* d = std::get_if<DielectricMaterial>(&sp.material->model); d && d->dispersion) [[unlikely]] {
-        DielectricMaterial hero_model = *d;
-        hero_model.int_ior = float((*d->dispersion)(wl[0]));
-        wl.terminate_secondary();
-        Material hero = *sp.material;
-        hero.model = hero_model;
-        return hero.sample(sp, sp.wi, u);
-    }
-    return spectral_sample(sp, u, wl);
-}
 
 // One vertex of a spectral light path where a photon may be stored: a non-Dirac surface.
 struct SpectralPhotonVertex {
@@ -107,7 +90,7 @@ void trace_spectral_light_path(const Scene& scene, Sampler& sampler, SampledWave
                                        through_dirac_only});
         }
         if (sp.material->is_black() || j + 1 >= max_vertices) return;
-        const auto s = spectral_sample_importance(sp, sampler.next2d(), wl);
+        const auto s = spectral_sample(sp, sampler.next2d(), wl);
         if (!s) return;
         const Spectrum4 weight = spectral_sample_value(sp, *s, wl) * (std::abs(s->wo.z) / s->pdfW);
         beta *= weight;

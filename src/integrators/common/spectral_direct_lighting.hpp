@@ -18,12 +18,24 @@ inline Spectrum4 estimate_light_sample_spectral(const Scene& scene, const Shadin
     if (!ls || is_black(ls->Le)) return Spectrum4(0.0f);
     if (dot(ls->wi, sp.ng) <= 0 && !sp.material->is_dielectric()) return Spectrum4(0.0f);
     const Vec3f wo = sp.frame.to_local(ls->wi);
+    // The BSDF in RGB first (as RGB mode, so a shadow ray is traced where it would be), its
+    // spectral value once the light is known to be visible; a dispersive interface (which
+    // reduces wl to the hero) at once.
     float pdf_bsdf;
-    const Spectrum4 f = spectral_eval_and_pdf(sp, wo, wl, pdf_bsdf);
-    if (f.is_black()) return Spectrum4(0.0f);
+    const bool dispersive = is_dispersive(*sp.material);
+    Spectrum4 f(0.0f);
+    Rgb f_rgb(0.0f);
+    if (dispersive) [[unlikely]] {
+        f = spectral_eval_and_pdf(sp, wo, wl, pdf_bsdf);
+        if (f.is_black()) return Spectrum4(0.0f);
+    } else {
+        f_rgb = sp.material->eval_and_pdf(sp, sp.wi, wo, pdf_bsdf);
+        if (is_black(f_rgb)) return Spectrum4(0.0f);
+    }
     const Ray shadow = std::isinf(ls->distance) ? spawn_ray(sp.p, sp.ng, ls->wi)
                                                 : spawn_segment(sp.p, sp.ng, ls->point, ls->normal);
     if (scene.occluded(shadow)) return Spectrum4(0.0f);
+    if (!dispersive) f = spectral_eval(sp, wo, f_rgb, wl);
     const float pdf_light = choice.pmf * ls->pdfW;
     const float weight = (mis && !ls->delta) ? balance_heuristic(pdf_light, pdf_bsdf) : 1.0f;
     return f * emission_spectrum(scene, choice.index, ls->Le, wl) * (std::abs(wo.z) * weight / pdf_light);

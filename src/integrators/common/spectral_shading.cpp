@@ -111,6 +111,12 @@ bool is_dispersive(const MaterialModel& m) {
     return false;
 }
 
+}  // namespace
+
+bool is_dispersive(const Material& m) { return is_dispersive(m.model); }
+
+namespace {
+
 // Whether the material can sample a Dirac delta.
 bool has_delta_lobe(const Material& m) { return (m.lobes() & kLobeSpecular) != 0; }
 

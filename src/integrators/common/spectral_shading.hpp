@@ -45,6 +45,10 @@ std::string spectral_unsupported_model(const Material& m);
 // The material models spectral mode renders, for messages.
 const char* spectral_material_names();
 
+// Whether the material has a dispersive index (dielectric, roughdielectric): sampling and
+// evaluating it reduce the wavelengths to the hero.
+bool is_dispersive(const Material& m);
+
 // The material's sample at the wavelengths wl: RGB mode's sample(), except at a dispersive
 // dielectric, which refracts (and reflects) the hero wavelength with its index there and keeps
 // only the hero (wl.terminate_secondary(): the other lanes' paths would part from it).

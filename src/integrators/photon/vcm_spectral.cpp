@@ -19,7 +19,7 @@
 
 #include <atomic>
 
-#include "integrators/bidir/bidir_spectral_shading.hpp"
+#include "integrators/bidir/hero_only.hpp"
 #include "integrators/photon/progressive_radius.hpp"
 #include "integrators/photon/vcm.hpp"
 #include "spectral/xyz_estimator.hpp"

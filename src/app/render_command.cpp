@@ -86,7 +86,7 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
         ->capture_default_str();
     app.add_flag("--spectral", o.spectral,
                  "Spectral mode: paths carry 4 sampled wavelengths, RGB inputs are upsampled (docs/spectral.md); every "
-                 "algorithm but vcm and bpm (which refuse). Also a scene file's <default name=\"mode\" value=\"spectral\"/>");
+                 "algorithm renders in it. Also a scene file's <default name=\"mode\" value=\"spectral\"/>");
     add_threads_option(app, o.threads);
     app.add_option("-o,--output", o.outputs,
                    "Output file, repeatable; format by extension: .exr .hdr .pfm .png. Placeholders {scene} {index} "

@@ -135,8 +135,29 @@ public:
     void camera_subpath_spectral(const RenderContext& ctx, size_t pixel, Sampler& sampler, const SampledWavelengths& wl,
                                  SpectralSubpath& path, const Vec2f* shift = nullptr) const;
     void light_subpath_spectral(const RenderContext& ctx, Sampler& sampler, const SampledWavelengths& wl, SpectralSubpath& path) const;
+    // `vm`: the merging strategies that also take part in the MIS weight (spectral vcm).
     SpectralStrategyResult connect_spectral(const RenderContext& ctx, SpectralSubpath& light, int s, SpectralSubpath& camera, int t,
-                                            Sampler& sampler, const SampledWavelengths& wl) const;
+                                            Sampler& sampler, const SampledWavelengths& wl, const MergeMis* vm = nullptr) const;
+    // for_each_connection in spectral mode: the same strategies, order and random streams,
+    // evaluated by connect_spectral (strategy(s, t, SpectralStrategyResult)).
+    template <typename Strategy, typename AfterVertex>
+    void for_each_connection_spectral(const RenderContext& ctx, size_t pixel, uint64_t pass, SpectralSubpath& light,
+                                      SpectralSubpath& camera, const SampledWavelengths& wl, const MergeMis* vm, Strategy&& strategy,
+                                      AfterVertex&& after_vertex) const {
+        for (int t = 1; t <= int(camera.size()); ++t) {
+            Sampler sampler(ctx.seed, sample_stream(pixel, 1 + uint64_t(t)), pass, ctx.sampler);
+            const int s_max = !vm || vm->connections ? std::max(1, int(light.size())) : 0;
+            for (int s = 0; s <= s_max; ++s) {
+                const int depth = s + t - 2;
+                if ((s == 1 && t == 1) || depth < 0 || depth > max_bounces_) continue;
+                if (options_.only_length >= 0 && depth != options_.only_length) continue;
+                if (options_.hide_emitters && depth == 0) continue;
+                const SpectralStrategyResult r = connect_spectral(ctx, light, s, camera, t, sampler, wl, vm);
+                if (!r.L.is_black()) strategy(s, t, r);
+            }
+            after_vertex(t);
+        }
+    }
 
     // The per-strategy films (null without --strategies).
     const StrategyImages* strategy_images() const { return strategies_.get(); }

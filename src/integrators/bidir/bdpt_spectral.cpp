@@ -152,7 +152,7 @@ void Bdpt::light_subpath_spectral(const RenderContext& ctx, Sampler& sampler, co
 }
 
 SpectralStrategyResult Bdpt::connect_spectral(const RenderContext& ctx, SpectralSubpath& light, int s, SpectralSubpath& camera, int t,
-                                              Sampler& sampler, const SampledWavelengths& wl) const {
+                                              Sampler& sampler, const SampledWavelengths& wl, const MergeMis* vm) const {
     const Scene& scene = ctx.scene;
     SpectralStrategyResult r;
     PathVertex sampled;
@@ -215,7 +215,7 @@ SpectralStrategyResult Bdpt::connect_spectral(const RenderContext& ctx, Spectral
     if (r.L.is_black()) return r;
     // A path through a dispersive vertex on either side is the hero's estimate, once.
     if ((s >= 2 && light.dispersed(s - 1)) || (t >= 2 && camera.dispersed(t - 1))) r.L = hero_only(r.L);
-    r.weight = mis_weight(ctx, light.vertices, s, camera.vertices, t, sampled, known);
+    r.weight = mis_weight(ctx, light.vertices, s, camera.vertices, t, sampled, known, vm);
     return r;
 }
 

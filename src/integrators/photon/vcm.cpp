@@ -122,6 +122,7 @@ Rgb Vcm::merge(const std::vector<PathVertex>& camera, int t, float r, const Merg
 }
 
 PassCounters Vcm::render_passes(const RenderContext& ctx, Film& film, uint64_t first, int count, const PassProgress& progress) {
+    if (ctx.spectral) return render_spectral_passes(ctx, film, first, count, progress);  // vcm_spectral.cpp
     const size_t pixels = ctx.pixel_count(), per_chunk = Bdpt::chunk_size(pixels);
     const int chunks = int((pixels + per_chunk - 1) / per_chunk);
     const double r1 = initial_photon_radius(ctx, options_), alpha = options_.photon_alpha;
@@ -200,7 +201,7 @@ const IntegratorInfo& vcm_integrator() {
     static const IntegratorInfo info{"vcm", {}, "vertex connection and merging: bdpt's connections and photon merging, combined by MIS",
                                      false, true, vcm_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
                                          return std::make_unique<Vcm>(o);
-                                     }, false, true};
+                                     }, false, true, /*spectral=*/true};
     return info;
 }
 
@@ -210,7 +211,7 @@ const IntegratorInfo& bpm_integrator() {
                                          o.vcm_connections = false;
                                          o.vcm_merging = true;
                                          return std::make_unique<Vcm>(o);
-                                     }, false, true};
+                                     }, false, true, /*spectral=*/true};
     return info;
 }
 

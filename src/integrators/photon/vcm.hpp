@@ -32,6 +32,7 @@
 #include "integrators/bidir/bdpt.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/photon/photon_grid.hpp"
+#include "integrators/photon/spectral_photons.hpp"
 #include "render/pass_image.hpp"
 
 namespace pathlab {
@@ -57,6 +58,10 @@ public:
     // The MIS weight of merging photon y_{s-1} (light subpath y[0..s)) at camera vertex z_{t-1}.
     float merge_weight(const PathVertex* y, int s, const std::vector<PathVertex>& camera, int t, const MergeMis& vm) const;
 
+    // Spectral mode (vcm_spectral.cpp): every path of iteration `pass` at the pass's wavelengths.
+    uint64_t trace_light_paths_spectral(const RenderContext& ctx, uint64_t pass, const SampledWavelengths& wl);
+    Spectrum4 merge_spectral(const SpectralSubpath& camera, int t, float r, const MergeMis& vm, const SampledWavelengths& wl) const;
+
     const Bdpt& bdpt() const { return bdpt_; }
     size_t photon_count() const { return photons_.size(); }
     size_t light_vertex_count() const;
@@ -64,6 +69,8 @@ public:
     size_t memory_bytes() const;
 
 private:
+    PassCounters render_spectral_passes(const RenderContext& ctx, Film& film, uint64_t first, int count, const PassProgress& progress);
+
     IntegratorOptions options_;
     VcmFaults faults_;
     Bdpt bdpt_;  // the subpaths, the connections and their weights
@@ -79,6 +86,14 @@ private:
     PassImage pass_;
     tbb::enumerable_thread_specific<std::pair<std::vector<PathVertex>, std::vector<PathVertex>>> subpaths_;  // camera, light
     double norm_ = 1;  // N pi r^2 of the current iteration
+    // Spectral mode: the light subpaths' throughputs beside chunk_vertices_ (same indices), where
+    // each path met dispersion (its index into the path; max(): never), the photons' powers
+    // beside photons_, and the threads' subpaths.
+    std::vector<std::vector<Spectrum4>> chunk_betas_;
+    std::vector<std::vector<SpectralPower>> chunk_powers_;
+    std::vector<int> path_dispersed_from_;
+    std::vector<SpectralPower> powers_;
+    tbb::enumerable_thread_specific<std::pair<SpectralSubpath, SpectralSubpath>> spectral_subpaths_;  // camera, light
 };
 
 }  // namespace pathlab

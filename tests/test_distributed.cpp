@@ -463,7 +463,7 @@ TEST_F(Distributed, TwoRanksOfOneThreadEqualOneProcessOfTwoThreadsForEveryIntegr
 // Spectral mode's wavelengths come from per-sample (or per-pass) streams, so ranks give the
 // one-process bytes there too.
 TEST_F(Distributed, TwoRanksEqualOneProcessInSpectralMode) {
-    expect_two_ranks_equal_one_process({"pt-mis", "lt", "bdpt", "sppm", "pm", "ic", "pbgi", "volpath"}, "--spectral");
+    expect_two_ranks_equal_one_process({"pt-mis", "lt", "bdpt", "sppm", "pm", "vcm", "ic", "pbgi", "volpath"}, "--spectral");
 }
 
 TEST_F(Distributed, RanksWithATimeBudgetAgreeOnOneSampleCount) {

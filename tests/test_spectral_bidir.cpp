@@ -19,6 +19,7 @@
 #include "integrators/bidir/strategy_images.hpp"
 #include "render_helpers.hpp"
 #include "scenefile/scene_file.hpp"
+#include "spectral_helpers.hpp"
 
 namespace pathlab::test {
 namespace {
@@ -91,49 +92,13 @@ TEST(SpectralBidir, LightTracerAndBdptAgreeWithSpectralPtMisOnTheCourseScenes) {
 
 // ---- dispersion ------------------------------------------------------------------------------
 
-// A ceiling light above the view behind a pane of strongly dispersive glass (Cauchy
-// n = 1.5 + 0.04 / lambda^2, about ten times N-BK7's dispersion; two parallel interfaces 0.1
-// apart), lighting a floor and three bright walls (much light arrives after several bounces): the light subpaths that reach them are dispersed, and so
-// is every path the light tracer splats but those of the light escaping past the pane's edge.
-// pt-mis finds the light only by hitting it through the pane (its light samples are occluded by
-// the glass).
-std::string dispersive_scene(bool behind_glass) {
-    std::string text = R"(<scene version="3.0.0">
-  <sensor type="perspective"><float name="fov" value="55"/>
-    <transform name="to_world"><lookat origin="0, -4, 1.3" target="0, 0, 0.9" up="0, 0, 1"/></transform>
-    <film type="hdrfilm"><integer name="width" value="20"/><integer name="height" value="20"/></film></sensor>
-  <shape type="rectangle"><transform name="to_world"><scale value="3"/></transform>
-    <bsdf type="diffuse"><rgb name="reflectance" value="0.8, 0.65, 0.45"/></bsdf></shape>
-  <shape type="rectangle"><transform name="to_world"><scale value="3"/><rotate x="1" angle="90"/><translate y="2" z="1.5"/></transform>
-    <bsdf type="diffuse"><rgb name="reflectance" value="0.5, 0.7, 0.85"/></bsdf></shape>
-  <shape type="rectangle"><transform name="to_world"><scale value="3"/><rotate y="1" angle="90"/><translate x="-2" z="1.5"/></transform>
-    <bsdf type="twosided"><bsdf type="diffuse"><rgb name="reflectance" value="0.85, 0.8, 0.7"/></bsdf></bsdf></shape>
-  <shape type="rectangle"><transform name="to_world"><scale value="3"/><rotate y="1" angle="90"/><translate x="2" z="1.5"/></transform>
-    <bsdf type="twosided"><bsdf type="diffuse"><rgb name="reflectance" value="0.85, 0.8, 0.7"/></bsdf></bsdf></shape>
-  <shape type="rectangle"><transform name="to_world"><scale value="1.5"/><rotate x="1" angle="180"/><translate z="4.5"/></transform>
-    <emitter type="area"><rgb name="radiance" value="6, 5, 3.5"/></emitter></shape>
-  <shape type="rectangle"><transform name="to_world"><scale value="3"/><translate z="4.3"/></transform>
-    <bsdf type="dielectric"><string name="cauchy" value="1.5, 0.04"/></bsdf></shape>
-  <shape type="rectangle"><transform name="to_world"><scale value="3"/><rotate x="1" angle="180"/><translate z="4.2"/></transform>
-    <bsdf type="dielectric"><string name="cauchy" value="1.5, 0.04"/></bsdf></shape>)";
-    // A pane of the same glass (two parallel interfaces 0.1 apart) between the camera and the
-    // scene: every camera subpath is dispersed too, and every connection of bdpt joins two
-    // hero-only subpaths, where the factor 4 of terminate_secondary() must count once.
-    if (behind_glass)
-        text += R"(
-  <shape type="rectangle"><transform name="to_world"><scale value="2"/><rotate x="1" angle="90"/><translate y="-3.2" z="1.2"/></transform>
-    <bsdf type="dielectric"><string name="cauchy" value="1.5, 0.04"/></bsdf></shape>
-  <shape type="rectangle"><transform name="to_world"><scale value="2"/><rotate x="1" angle="-90"/><translate y="-3.1" z="1.2"/></transform>
-    <bsdf type="dielectric"><string name="cauchy" value="1.5, 0.04"/></bsdf></shape>)";
-    return text + "\n</scene>";
-}
 
 // lt and bdpt against pt-mis under the pane, and bdpt against pt-mis behind the second; 256
 // passes (pt-mis is noisy here); 9 two-sided tests at 4 sigma, t with 255 degrees of freedom:
 // false alarms below 8e-4.
 TEST(SpectralBidir, AgreeWithPtMisThroughDispersiveGlass) {
     for (const bool behind_glass : {false, true}) {
-        const auto scene = Scene::build(load_scene_text(dispersive_scene(behind_glass), "dispersive.xml", "."));
+        const auto scene = Scene::build(load_scene_text(dispersive_room(behind_glass, 20), "dispersive.xml", "."));
         const PassMeans pt = spectral_pass_means(*scene, "pt-mis", 20, 20, 256, 41, 6);
         for (const char* algorithm : {"lt", "bdpt"}) {
             if (behind_glass && std::string(algorithm) == "lt") continue;  // it cannot see through the pane
@@ -193,10 +158,10 @@ RenderResult render_threads(const SceneChoice& choice, const std::string& algori
 // Scenes 5 and 6, the dispersive room behind the pane, that room with a Gaussian reconstruction
 // filter (raster splats and the pass's lattice shift), and scene 5 with the Sobol sampler.
 TEST(SpectralBidir, OneAndTwoThreadsGiveTheSameBytes) {
-    std::string filtered = dispersive_scene(true);
+    std::string filtered = dispersive_room(true, 20);
     const std::string film = R"(<film type="hdrfilm">)";
     filtered.replace(filtered.find(film), film.size(), film + R"(<rfilter type="gaussian"/>)");
-    const SceneChoice dispersive = scene_choice_of(load_scene_text(dispersive_scene(true), "dispersive.xml", "."));
+    const SceneChoice dispersive = scene_choice_of(load_scene_text(dispersive_room(true, 20), "dispersive.xml", "."));
     const SceneChoice gaussian = scene_choice_of(load_scene_text(filtered, "filtered.xml", "."));
     const std::vector<std::pair<SceneChoice, SamplerKind>> cases = {{builtin_scene_choice(5), SamplerKind::Independent},
                                                                     {builtin_scene_choice(6), SamplerKind::Independent},

@@ -13,42 +13,11 @@
 #include "job/render_job.hpp"
 #include "render_helpers.hpp"
 #include "scenefile/scene_file.hpp"
+#include "spectral_helpers.hpp"
 
 namespace pathlab::test {
 namespace {
 
-// A ceiling light behind a pane of strongly dispersive glass (Cauchy n = 1.5 + 0.04 / lambda^2,
-// two parallel interfaces 0.1 apart) over a floor and three bright walls (test_spectral_bidir.cpp's
-// room): every light subpath, hence every photon, that reaches them is hero-only. With
-// `behind_glass` a second pane of that glass stands before the camera, so every camera subpath is
-// hero-only too, and connections and merges join two hero-only subpaths (the factor 4 once).
-std::string dispersive_room(bool behind_glass) {
-    std::string text = R"(<scene version="3.0.0">
-  <sensor type="perspective"><float name="fov" value="55"/>
-    <transform name="to_world"><lookat origin="0, -4, 1.3" target="0, 0, 0.9" up="0, 0, 1"/></transform>
-    <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/></film></sensor>
-  <shape type="rectangle"><transform name="to_world"><scale value="3"/></transform>
-    <bsdf type="diffuse"><rgb name="reflectance" value="0.8, 0.65, 0.45"/></bsdf></shape>
-  <shape type="rectangle"><transform name="to_world"><scale value="3"/><rotate x="1" angle="90"/><translate y="2" z="1.5"/></transform>
-    <bsdf type="diffuse"><rgb name="reflectance" value="0.5, 0.7, 0.85"/></bsdf></shape>
-  <shape type="rectangle"><transform name="to_world"><scale value="3"/><rotate y="1" angle="90"/><translate x="-2" z="1.5"/></transform>
-    <bsdf type="twosided"><bsdf type="diffuse"><rgb name="reflectance" value="0.85, 0.8, 0.7"/></bsdf></bsdf></shape>
-  <shape type="rectangle"><transform name="to_world"><scale value="3"/><rotate y="1" angle="90"/><translate x="2" z="1.5"/></transform>
-    <bsdf type="twosided"><bsdf type="diffuse"><rgb name="reflectance" value="0.85, 0.8, 0.7"/></bsdf></bsdf></shape>
-  <shape type="rectangle"><transform name="to_world"><scale value="1.5"/><rotate x="1" angle="180"/><translate z="4.5"/></transform>
-    <emitter type="area"><rgb name="radiance" value="6, 5, 3.5"/></emitter></shape>
-  <shape type="rectangle"><transform name="to_world"><scale value="3"/><translate z="4.3"/></transform>
-    <bsdf type="dielectric"><string name="cauchy" value="1.5, 0.04"/></bsdf></shape>
-  <shape type="rectangle"><transform name="to_world"><scale value="3"/><rotate x="1" angle="180"/><translate z="4.2"/></transform>
-    <bsdf type="dielectric"><string name="cauchy" value="1.5, 0.04"/></bsdf></shape>)";
-    if (behind_glass)
-        text += R"(
-  <shape type="rectangle"><transform name="to_world"><scale value="2"/><rotate x="1" angle="90"/><translate y="-3.2" z="1.2"/></transform>
-    <bsdf type="dielectric"><string name="cauchy" value="1.5, 0.04"/></bsdf></shape>
-  <shape type="rectangle"><transform name="to_world"><scale value="2"/><rotate x="1" angle="-90"/><translate y="-3.1" z="1.2"/></transform>
-    <bsdf type="dielectric"><string name="cauchy" value="1.5, 0.04"/></bsdf></shape>)";
-    return text + "\n</scene>";
-}
 
 RenderResult render_spectral(const Scene& scene, const std::string& name, IntegratorOptions o, int size, uint64_t spp, uint64_t seed,
                              uint64_t first = 0, SamplerKind sampler = SamplerKind::Independent) {
@@ -132,8 +101,8 @@ TEST(SpectralVcm, VcmAndBpmAgreeWithSpectralPtMis) {
     };
     std::vector<Case> cases;
     cases.push_back({"scene 3", Scene::build(make_builtin_scene(3)), 3, 512, 8});
-    cases.push_back({"under the dispersive pane", Scene::build(load_scene_text(dispersive_room(false), "room.xml", ".")), 6, 2048, 16});
-    cases.push_back({"behind a dispersive pane too", Scene::build(load_scene_text(dispersive_room(true), "room.xml", ".")), 6, 2048, 16});
+    cases.push_back({"under the dispersive pane", Scene::build(load_scene_text(dispersive_room(false, 16), "room.xml", ".")), 6, 2048, 16});
+    cases.push_back({"behind a dispersive pane too", Scene::build(load_scene_text(dispersive_room(true, 16), "room.xml", ".")), 6, 2048, 16});
     for (const Case& c : cases) {
         const MeanSe pt = pt_mis_mean(*c.scene, 16, c.pt_spp, c.max_depth);
         const float radius = 0.03f * c.scene->scene_sphere().radius;
@@ -159,7 +128,7 @@ RenderResult render_threads(const SceneChoice& choice, const std::string& algori
 // Scene 5 and the room behind both panes: the same mean and standard-error bytes and ray counts.
 TEST(SpectralVcm, OneAndTwoThreadsGiveTheSameBytes) {
     const std::vector<SceneChoice> choices = {builtin_scene_choice(5),
-                                              scene_choice_of(load_scene_text(dispersive_room(true), "room.xml", "."))};
+                                              scene_choice_of(load_scene_text(dispersive_room(true, 16), "room.xml", "."))};
     for (const SceneChoice& choice : choices)
         for (const char* algorithm : {"vcm", "bpm"}) {
             const RenderResult one = render_threads(choice, algorithm, 1), two = render_threads(choice, algorithm, 2);

@@ -173,11 +173,8 @@ Material read_wrapper(XmlSource& xml, const pugi::xml_node& n, const BsdfPlugin&
 // The model's reflectances that the file gave as spectra (MaterialSpectra), or null.
 std::shared_ptr<const MaterialSpectra> reflectance_spectra(Properties& p, const MaterialModel& model) {
     const auto given = [&](std::initializer_list<const char*> names) -> std::shared_ptr<const DenseSpectrum> {
-        for (const char* name : names) {
-            if (!p.plugin().find(name) || !p.has(name)) continue;
-            const Properties::Value* v = p.given(name);
-            if (v && v->spectrum) return std::make_shared<const DenseSpectrum>(*v->spectrum);
-        }
+        for (const char* name : names)
+            if (const auto spectrum = given_spectrum(p, name)) return std::make_shared<const DenseSpectrum>(*spectrum);
         return nullptr;
     };
     MaterialSpectra s;

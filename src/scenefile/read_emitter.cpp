@@ -6,18 +6,20 @@
 
 namespace pathlab {
 
+std::shared_ptr<const SampledSpectrum> given_spectrum(Properties& p, const char* name) {
+    if (!p.plugin().find(name) || !p.has(name)) return nullptr;
+    const Properties::Value* v = p.given(name);
+    return v ? v->spectrum : nullptr;
+}
+
 std::shared_ptr<const EmissionSpectrum> emitter_spectrum(Properties& p) {
-    for (const char* name : {"radiance", "intensity", "irradiance"}) {
-        if (!p.plugin().find(name) || !p.has(name)) continue;
-        const Properties::Value* v = p.given(name);
-        if (!v || !v->spectrum) return nullptr;
-        const auto rgb = parse_float_list(v->text);
-        if (!rgb || rgb->size() != 3) return nullptr;  // the reader wrote "r, g, b"
-        auto s = std::make_shared<EmissionSpectrum>();
-        s->values = DenseSpectrum(*v->spectrum);
-        s->rgb = Rgb((*rgb)[0], (*rgb)[1], (*rgb)[2]);
-        return s;
-    }
+    for (const char* name : {"radiance", "intensity", "irradiance"})
+        if (const auto spectrum = given_spectrum(p, name)) {
+            auto s = std::make_shared<EmissionSpectrum>();
+            s->values = DenseSpectrum(*spectrum);
+            s->rgb = p.get_rgb(name);  // what the emitter read
+            return s;
+        }
     return nullptr;
 }
 

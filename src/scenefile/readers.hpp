@@ -71,8 +71,11 @@ std::shared_ptr<const Texture> texture_child(XmlSource& xml, const pugi::xml_nod
 void read_shape(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b);       // read_shape.cpp
 std::vector<PluginInfo> group_shape_plugins();  // shapegroup, instance
 void read_free_emitter(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b);  // read_emitter.cpp
-// The spectrum an emitter's radiance, intensity or irradiance was given as (a black body, a
-// tabulated spectrum), with the RGB the emitter read from it; null for an RGB value.
+// The spectrum the plugin's parameter `name` was given as (a black body, a tabulated spectrum:
+// Properties::Value::spectrum); null where it was not declared, not given or given as RGB.
+std::shared_ptr<const SampledSpectrum> given_spectrum(Properties& p, const char* name);
+// The spectrum an emitter's radiance, intensity or irradiance was given as, with the RGB the
+// emitter read from it; null for an RGB value.
 std::shared_ptr<const EmissionSpectrum> emitter_spectrum(Properties& p);
 // read_medium.cpp: a <medium> (its index in desc.media), one declared at the top level, the
 // medium a <ref id> names, and the null BSDF's declaration.

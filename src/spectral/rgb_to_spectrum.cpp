@@ -24,12 +24,10 @@ SigmoidPolynomial RgbToSpectrumTable::operator()(const Vec3f& in) const {
     const float scale = float(res_ - 1) / z;
     const float x = rgb[(m + 1) % 3] * scale, y = rgb[(m + 2) % 3] * scale;
     const int xi = std::min(int(x), res_ - 2), yi = std::min(int(y), res_ - 2);
-    const int zi = std::clamp(int(std::upper_bound(z_nodes_.begin(), z_nodes_.end(), z) - z_nodes_.begin()) - 1, 0, res_ - 2);
+    const int zi = z_slice(z);
     const float dx = x - float(xi), dy = y - float(yi);
     const float dz = (z - z_nodes_[size_t(zi)]) / (z_nodes_[size_t(zi) + 1] - z_nodes_[size_t(zi)]);
-    const auto at = [&](int k, int j, int i, int a) {
-        return data_[(((size_t(m) * size_t(res_) + size_t(k)) * size_t(res_) + size_t(j)) * size_t(res_) + size_t(i)) * 3 + size_t(a)];
-    };
+    const auto at = [&](int k, int j, int i, int a) { return node(m, k, j, i)[a]; };
     float c[3];
     for (int a = 0; a < 3; ++a) {
         const auto lerp = [](float t, float u, float v) { return (1 - t) * u + t * v; };
@@ -38,6 +36,23 @@ SigmoidPolynomial RgbToSpectrumTable::operator()(const Vec3f& in) const {
         c[a] = lerp(dz, along_y(zi), along_y(zi + 1));
     }
     return {c[0], c[1], c[2]};
+}
+
+int RgbToSpectrumTable::z_slice(float z) const {
+    return std::clamp(int(std::upper_bound(z_nodes_.begin(), z_nodes_.end(), z) - z_nodes_.begin()) - 1, 0, res_ - 2);
+}
+
+float RgbToSpectrumTable::max_node_value_around(float z) const {
+    const int zi = z_slice(z);
+    float largest = 0;
+    for (int m = 0; m < 3; ++m)
+        for (int k = zi; k <= zi + 1; ++k)
+            for (int j = 0; j < res_; ++j)
+                for (int i = 0; i < res_; ++i) {
+                    const float* c = node(m, k, j, i);
+                    largest = std::max(largest, SigmoidPolynomial{c[0], c[1], c[2]}.max_value());
+                }
+    return largest;
 }
 
 }  // namespace pathlab

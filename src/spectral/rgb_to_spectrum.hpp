@@ -26,11 +26,22 @@ public:
     // NaN taken as 0).
     SigmoidPolynomial operator()(const Vec3f& rgb) const;
     int resolution() const { return res_; }
+    // The largest value over [360, 830] nm of any node spectrum of the two z slices that a lookup
+    // of a colour whose largest channel is z interpolates between (every channel m, x and y):
+    // since the lookup's coefficients are a convex combination of those nodes', this bounds
+    // what it may return (greys aside, which are looked up in closed form).
+    float max_node_value_around(float z) const;
 
     // The sRGB table built with pathlab (defined by the generated source).
     static const RgbToSpectrumTable& srgb();
 
 private:
+    // The lower of the two z slices around z, and the coefficients of node (m, k, j, i).
+    int z_slice(float z) const;
+    const float* node(int m, int k, int j, int i) const {
+        return data_ + (((size_t(m) * size_t(res_) + size_t(k)) * size_t(res_) + size_t(j)) * size_t(res_) + size_t(i)) * 3;
+    }
+
     int res_;
     const float* data_;
     std::vector<float> z_nodes_;

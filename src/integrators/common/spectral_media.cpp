@@ -4,12 +4,7 @@
 #include <cmath>
 
 #include "integrators/common/spectral_shading.hpp"
-#include "spectral/rgb_optimiser.hpp"
 #include "spectral/rgb_to_spectrum.hpp"
-
-// The generated table's data (build/generated/srgb_to_spectrum.cpp, tools/make_rgb_table.cpp):
-// 3 res^3 coefficient triples laid out [max channel][z][y][x][3] (rgb_optimiser.hpp).
-extern "C" const float pathlab_srgb_table_data[];
 
 namespace pathlab {
 namespace {
@@ -84,19 +79,9 @@ Spectrum4 extinction_at(const Medium& m, const Vec3f& p, const SampledWavelength
 }
 
 float compute_unbounded_spectrum_bound() {
-    const RgbToSpectrumTable& table = RgbToSpectrumTable::srgb();
-    const int res = table.resolution();
-    const std::vector<float> z = rgb_table_z_nodes(res);
-    // The z slice the lookup of a colour of largest channel 1/2 interpolates in (as rgb_to_spectrum.cpp).
-    const int zi = std::clamp(int(std::upper_bound(z.begin(), z.end(), 0.5f) - z.begin()) - 1, 0, res - 2);
-    float largest = 0.5f;  // a grey: sigmoid(0)
-    for (int m = 0; m < 3; ++m)
-        for (int k = zi; k <= zi + 1; ++k)
-            for (int j = 0; j < res; ++j)
-                for (int i = 0; i < res; ++i) {
-                    const float* c = pathlab_srgb_table_data + (((size_t(m) * size_t(res) + size_t(k)) * size_t(res) + size_t(j)) * size_t(res) + size_t(i)) * 3;
-                    largest = std::max(largest, SigmoidPolynomial{c[0], c[1], c[2]}.max_value());
-                }
+    // The unbounded spectrum looks the table up at a colour of largest channel exactly 1/2; a
+    // grey gives sigmoid(0) = 1/2.
+    const float largest = std::max(0.5f, RgbToSpectrumTable::srgb().max_node_value_around(0.5f));
     return std::min(2.0f, 2 * largest * (1 + 1e-5f));
 }
 

@@ -19,6 +19,7 @@
 #include "integrators/bidir/bdpt.hpp"
 #include "integrators/bidir/hero_only.hpp"
 #include "integrators/bidir/strategy_images.hpp"
+#include "integrators/common/light_path_start.hpp"
 #include "integrators/common/spectral_shading.hpp"
 #include "spectral/xyz_estimator.hpp"
 
@@ -122,13 +123,12 @@ void Bdpt::camera_subpath_spectral(const RenderContext& ctx, size_t pixel, Sampl
 void Bdpt::light_subpath_spectral(const RenderContext& ctx, Sampler& sampler, const SampledWavelengths& wl, SpectralSubpath& path) const {
     path.clear();
     const Scene& scene = ctx.scene;
-    const LightChoice choice = scene.choose_light(sampler.next1d());
-    const Vec2f u_pos = sampler.next2d(), u_dir = sampler.next2d();
-    if (choice.index < 0) return;
-    const Light& light = scene.lights()[size_t(choice.index)];
-    const auto es = sample_emission(light, u_pos, u_dir, scene.scene_sphere());
-    if (!es || is_black(es->Le) || !(es->pdfA > 0) || !(es->pdfW > 0)) return;
-    const uint32_t flags = light_flags(light);
+    const auto start = start_light_path(scene, sampler);
+    if (!start) return;
+    const LightChoice& choice = start->choice;
+    const Light& light = *start->light;
+    const EmissionSample* es = &start->emission;
+    const uint32_t flags = start->flags;
     PathVertex l;
     l.kind = VertexKind::Light;
     l.p = es->origin;

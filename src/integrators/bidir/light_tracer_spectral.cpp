@@ -4,6 +4,7 @@
 // RGB mode's translation unit compiles as before.
 #include "integrators/bidir/hero_only.hpp"
 #include "integrators/bidir/light_tracer.hpp"
+#include "integrators/common/light_path_start.hpp"
 #include "integrators/common/spectral_shading.hpp"
 #include "spectral/xyz_estimator.hpp"
 
@@ -31,13 +32,12 @@ void LightTracer::trace_spectral(const RenderContext& ctx, Sampler& sampler, Spl
     // The path's own wavelengths, from a stream RGB mode never reads (the camera samples' one,
     // forked from this path's sampler): a pure function of (seed, path, pass).
     SampledWavelengths wl = sample_camera_wavelengths(sampler);
-    const LightChoice choice = scene.choose_light(sampler.next1d());
-    const Vec2f u_pos = sampler.next2d(), u_dir = sampler.next2d();
-    if (choice.index < 0) return;
-    const Light& light = scene.lights()[size_t(choice.index)];
-    const auto es = sample_emission(light, u_pos, u_dir, scene.scene_sphere());
-    if (!es || is_black(es->Le) || !(es->pdfA > 0) || !(es->pdfW > 0)) return;
-    const uint32_t flags = light_flags(light);
+    const auto start = start_light_path(scene, sampler);
+    if (!start) return;
+    const LightChoice& choice = start->choice;
+    const Light& light = *start->light;
+    const EmissionSample* es = &start->emission;
+    const uint32_t flags = start->flags;
     const Spectrum4 Le = emission_spectrum(scene, choice.index, es->Le, wl);
 
     // Paths of no bounce: the emitter seen by the camera.

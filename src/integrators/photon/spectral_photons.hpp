@@ -29,6 +29,7 @@
 #include <optional>
 #include <vector>
 
+#include "integrators/common/light_path_start.hpp"
 #include "integrators/common/spectral_direct_lighting.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/photon/photon.hpp"
@@ -65,13 +66,11 @@ struct SpectralPhotonVertex {
 template <typename Visit>
 void trace_spectral_light_path(const Scene& scene, Sampler& sampler, SampledWavelengths wl, int max_vertices, int rr_depth,
                                Visit&& visit) {
-    const LightChoice choice = scene.choose_light(sampler.next1d());
-    const Vec2f u_pos = sampler.next2d(), u_dir = sampler.next2d();
-    if (choice.index < 0) return;
-    const Light& light = scene.lights()[size_t(choice.index)];
-    const auto es = sample_emission(light, u_pos, u_dir, scene.scene_sphere());
-    if (!es || is_black(es->Le) || !(es->pdfA > 0) || !(es->pdfW > 0)) return;
-    const uint32_t flags = light_flags(light);
+    const auto start = start_light_path(scene, sampler);
+    if (!start) return;
+    const LightChoice& choice = start->choice;
+    const EmissionSample* es = &start->emission;
+    const uint32_t flags = start->flags;
     Spectrum4 beta = emission_spectrum(scene, choice.index, es->Le, wl) * (es->cos / (choice.pmf * es->pdfA * es->pdfW));
     Ray ray = (flags & kLightSurface) ? spawn_ray(es->origin, es->normal, es->direction) : Ray{es->origin, es->direction, kInf};
     Spectrum4 scatter(1.0f);  // the scattering's throughput alone, for Russian roulette

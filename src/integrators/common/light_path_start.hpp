@@ -1,0 +1,31 @@
+// The first vertex of a light path (light tracing, bdpt's light subpaths, photons): a light
+// chosen by power, then a point and a direction from its emission sampling, drawing the same
+// random numbers in the same order as the RGB integrators' own copies of these lines (whose
+// object code stays as it was: docs/spectral.md).
+#pragma once
+
+#include <optional>
+
+#include "scene/scene.hpp"
+
+namespace pathlab {
+
+struct LightPathStart {
+    LightChoice choice;
+    const Light* light;
+    EmissionSample emission;
+    uint32_t flags;  // light_flags(*light)
+};
+
+// Nothing where no light is chosen or its emission sample carries nothing.
+inline std::optional<LightPathStart> start_light_path(const Scene& scene, Sampler& sampler) {
+    const LightChoice choice = scene.choose_light(sampler.next1d());
+    const Vec2f u_pos = sampler.next2d(), u_dir = sampler.next2d();
+    if (choice.index < 0) return std::nullopt;
+    const Light& light = scene.lights()[size_t(choice.index)];
+    const auto es = sample_emission(light, u_pos, u_dir, scene.scene_sphere());
+    if (!es || is_black(es->Le) || !(es->pdfA > 0) || !(es->pdfW > 0)) return std::nullopt;
+    return LightPathStart{choice, &light, *es, light_flags(light)};
+}
+
+}  // namespace pathlab

@@ -66,10 +66,8 @@ void pbgi_gather_suite(const GatherAccuracyOptions& o) {
         // The truth the gathers aim at: the irradiance from the surfels' radiance on the real
         // surfaces, by 64 x 64 stratified cosine-distributed rays whose hits take the radiance of
         // the nearest surfel on the same surface (the side facing the ray).
-        std::vector<Photon> centres(tree.surfels().size());
-        for (size_t i = 0; i < centres.size(); ++i) centres[i].p = tree.surfels()[i].p;
         PhotonKdTree kd;
-        kd.build(centres, 0.1f);
+        kd.build(tree.surfels(), 0.1f);  // their centres
         std::vector<Rgb> reference(points.size());
         tbb::parallel_for(size_t(0), points.size(), [&](size_t i) {
             const Frame frame(points[i].second);

@@ -38,8 +38,8 @@ Rate rate(const Scene& scene, const std::string& algorithm, const LightTracingOp
 std::vector<std::vector<Splat>> record_pass(const Scene& scene, int size, uint64_t pass) {
     const PerspectiveCamera camera(scene.camera(), size, size);
     const RenderContext ctx{scene, camera, size, size, 17, SamplerKind::Independent, 32};
-    const LightTracer lt({});
-    const size_t paths = ctx.pixel_count(), per_chunk = LightTracer::chunk_size(paths);
+    const LightTracer<RgbTransport> lt({});
+    const size_t paths = ctx.pixel_count(), per_chunk = LightTracer<RgbTransport>::chunk_size(paths);
     const size_t chunks = (paths + per_chunk - 1) / per_chunk;
     std::vector<std::vector<Splat>> out(chunks);
     tbb::parallel_for(size_t(0), chunks, [&](size_t c) {

@@ -35,22 +35,24 @@ SceneDescription scene_of(const std::string& key) {
     return make_builtin_scene(std::stoi(key));
 }
 
-std::vector<Photon> trace(const RenderContext& ctx, int paths, double& seconds) {
-    const Bdpt walker({});
+using RgbPhoton = Photon<RgbTransport>;
+
+std::vector<RgbPhoton> trace(const RenderContext& ctx, int paths, double& seconds) {
+    const Bdpt<RgbTransport> walker({});
     const auto t0 = Clock::now();
     const int chunks = 256, per = (paths + chunks - 1) / chunks;
-    std::vector<std::vector<Photon>> out(static_cast<size_t>(chunks));
+    std::vector<std::vector<RgbPhoton>> out(static_cast<size_t>(chunks));
     tbb::parallel_for(0, chunks, [&](int c) {
-        std::vector<PathVertex> path;
+        std::vector<PathVertex<RgbTransport>> path;
         for (int j = c * per; j < std::min(paths, (c + 1) * per); ++j) {
             Sampler sampler(ctx.seed, uint64_t(j), 0);
-            walker.light_subpath(ctx, sampler, path);
+            walker.light_subpath(ctx, sampler, RgbWavelengths{}, path);
             for (size_t v = 2; v < path.size(); ++v)
                 if (path[v].kind == VertexKind::Surface && path[v].connectible())
                     out[size_t(c)].push_back({path[v].p, path[v].sp.frame.to_world(path[v].sp.wi), path[v].beta, uint16_t(v)});
         }
     });
-    std::vector<Photon> photons;
+    std::vector<RgbPhoton> photons;
     for (const auto& c : out) photons.insert(photons.end(), c.begin(), c.end());
     seconds = ms_since(t0) * 1e-3;
     return photons;
@@ -79,7 +81,7 @@ std::vector<Vec3f> visible_points(const RenderContext& ctx) {
 }
 
 template <typename Search>
-void time_search(const std::vector<Photon>& photons, const std::vector<Vec3f>& queries, float r, int repeats, double& build_ms,
+void time_search(const std::vector<RgbPhoton>& photons, const std::vector<Vec3f>& queries, float r, int repeats, double& build_ms,
                  double& query_ms, double& found) {
     std::vector<double> builds, queries_ms;
     for (int k = 0; k < repeats; ++k) {
@@ -91,7 +93,7 @@ void time_search(const std::vector<Photon>& photons, const std::vector<Vec3f>& q
         t0 = Clock::now();
         tbb::parallel_for(size_t(0), queries.size(), [&](size_t i) {
             double n = 0;
-            s.for_each_within(queries[i], r, [&](const Photon& ph) { n += double(ph.power.x > -1); });
+            s.for_each_within(queries[i], r, [&](uint32_t k) { n += double(photons[k].power.x > -1); });
             sums[i] = n;
         });
         queries_ms.push_back(ms_since(t0));
@@ -116,7 +118,7 @@ void photon_mapping_suite(const PhotonMappingOptions& o) {
         const PerspectiveCamera camera(scene->camera(), o.size, o.size);
         const RenderContext ctx{*scene, camera, o.size, o.size, 5, SamplerKind::Independent, 32};
         double seconds = 0;
-        const std::vector<Photon> photons = trace(ctx, o.light_paths, seconds);
+        const std::vector<RgbPhoton> photons = trace(ctx, o.light_paths, seconds);
         const std::vector<Vec3f> queries = visible_points(ctx);
         const float r = o.radius_factor * scene->scene_sphere().radius;
         double gb = 0, gq = 0, gf = 0, kb = 0, kq = 0, kf = 0;
@@ -133,7 +135,7 @@ void photon_mapping_suite(const PhotonMappingOptions& o) {
         const auto scene = Scene::build(scene_of(key));
         const PerspectiveCamera camera(scene->camera(), o.equal_time_size, o.equal_time_size);
         const RenderContext ctx{*scene, camera, o.equal_time_size, o.equal_time_size, 5, SamplerKind::Independent, 32};
-        Vcm vcm({});
+        Vcm<RgbTransport> vcm({});
         Film film(o.equal_time_size, o.equal_time_size);
         std::vector<double> ms;
         for (int k = 0; k < o.repeats; ++k) {
@@ -148,7 +150,7 @@ void photon_mapping_suite(const PhotonMappingOptions& o) {
         std::fflush(stdout);
     }
     fmt::print("\n(A light vertex is {} bytes: vcm keeps whole subpaths for its connections; sppm keeps only the photons.)\n",
-               sizeof(PathVertex));
+               sizeof(PathVertex<RgbTransport>));
 
     fmt::print("\n## Equal time at {0}x{0}, {1} s per render ({2} threads, medians of {3} rounds; reference: bdpt at {4} spp, "
                "vcm on sds-caustic.xml, its noise subtracted)\n\n",
@@ -183,7 +185,7 @@ void photon_mapping_suite(const PhotonMappingOptions& o) {
 
     fmt::print("\nMemory: a photon is {} bytes; the grid adds 8 bytes per photon (cell ends and the sorted order), the k-d tree\n"
                "its nodes and index (nanoflann: leaves of up to 10 points).\n",
-               sizeof(Photon));
+               sizeof(RgbPhoton));
 }
 
 }  // namespace pathlab::bench

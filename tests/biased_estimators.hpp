@@ -9,9 +9,9 @@
 namespace pathlab::test {
 
 // direct-light with the receiver's cos(theta) dropped (a classic student bug).
-class DirectLightWithoutCosine final : public PixelIntegrator {
+class DirectLightWithoutCosine final : public PixelIntegrator<RgbTransport> {
 public:
-    Rgb radiance(const Scene& scene, const Ray& ray, Sampler& sampler) const override {
+    Rgb radiance(const Scene& scene, const Ray& ray, Sampler& sampler, RgbWavelengths&) const override {
         Intersection hit;
         if (!scene.intersect(ray, hit)) return scene.escaped_radiance();
         const Rgb Le = emitted_radiance(scene, hit, -ray.d);

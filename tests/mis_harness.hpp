@@ -187,8 +187,8 @@ public:
     }
 
     // ---- the subpaths bdpt would have traced for strategy (s, t) --------------------------------
-    PathVertex vertex(const FullPath& f, int j, bool camera_side) const {
-        PathVertex v;
+    PathVertex<RgbTransport> vertex(const FullPath& f, int j, bool camera_side) const {
+        PathVertex<RgbTransport> v;
         const int n = k(f);
         if (j == 0 && camera_side) {
             v.kind = VertexKind::Camera;
@@ -220,11 +220,11 @@ public:
     // Subpaths with the densities their random walks record (pdf_fwd from the predecessor,
     // pdf_rev from the successor on the same subpath); the vertices at the new edge get NaN,
     // which bdpt must overwrite.
-    void subpaths(const FullPath& f, int s, std::vector<PathVertex>& light, std::vector<PathVertex>& camera) const {
+    void subpaths(const FullPath& f, int s, std::vector<PathVertex<RgbTransport>>& light, std::vector<PathVertex<RgbTransport>>& camera) const {
         const int n = k(f), t = n + 1 - s;
         camera.clear(), light.clear();
         for (int j = 0; j < t; ++j) {
-            PathVertex v = vertex(f, j, true);
+            PathVertex<RgbTransport> v = vertex(f, j, true);
             v.pdf_fwd = j == 0 ? 1 : j == 1 ? area(f, camera_.pdf_direction(dir(f, 0, 1)), 0, 1) : bsdf_density(f, j - 2, j - 1, j);
             v.pdf_rev = j + 2 <= t - 1 ? bsdf_density(f, j + 2, j + 1, j) : NAN;
             if (j == t - 1 || (j == t - 2 && t >= 2)) v.pdf_rev = NAN;
@@ -232,23 +232,23 @@ public:
         }
         for (int i = 0; i < s; ++i) {
             const int j = n - i;
-            PathVertex v = vertex(f, j, false);
+            PathVertex<RgbTransport> v = vertex(f, j, false);
             v.pdf_fwd = i == 0 ? light_origin(f) : i == 1 ? light_emission(f) : bsdf_density(f, j + 2, j + 1, j);
             v.pdf_rev = i + 2 <= s - 1 ? bsdf_density(f, j - 2, j - 1, j) : NAN;
             if (i >= s - 2) v.pdf_rev = NAN;
             light.push_back(v);
         }
     }
-    PathVertex sampled_end(const FullPath& f, int s) const {
+    PathVertex<RgbTransport> sampled_end(const FullPath& f, int s) const {
         if (s == 1) {
-            PathVertex v = vertex(f, k(f), false);
+            PathVertex<RgbTransport> v = vertex(f, k(f), false);
             v.pdf_fwd = light_origin(f);
             return v;
         }
         return vertex(f, 0, true);
     }
 
-    const Bdpt& bdpt(bool power) const { return power ? power_ : balance_; }
+    const Bdpt<RgbTransport>& bdpt(bool power) const { return power ? power_ : balance_; }
     LightKind kind() const { return kind_; }
     const RenderContext& ctx() const { return ctx_; }
 
@@ -258,7 +258,7 @@ private:
     PerspectiveCamera camera_;
     RenderContext ctx_;
     LightKind kind_;
-    Bdpt balance_, power_;
+    Bdpt<RgbTransport> balance_, power_;
 
     static IntegratorOptions power_options() {
         IntegratorOptions o;

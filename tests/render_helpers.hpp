@@ -26,13 +26,16 @@ inline RenderResult render_scene(const SceneDescription& desc, const std::string
     return job.run();
 }
 
-// A per-pixel estimator by name, for tests that call radiance() on chosen rays.
-inline std::unique_ptr<PixelIntegrator> make_pixel_integrator(const std::string& name, const IntegratorOptions& options = {}) {
+// A per-pixel estimator by name for transport T (RGB by default), for tests that call radiance()
+// on chosen rays.
+template <class T = RgbTransport>
+std::unique_ptr<PixelIntegrator<T>> make_pixel_integrator(const std::string& name, IntegratorOptions options = {}) {
+    options.spectral = T::spectral;
     std::unique_ptr<Integrator> i = find_integrator(name)->make(options);
-    auto* p = dynamic_cast<PixelIntegrator*>(i.get());
+    auto* p = dynamic_cast<PixelIntegrator<T>*>(i.get());
     if (!p) throw std::invalid_argument(name + " is not a pixel integrator");
     i.release();
-    return std::unique_ptr<PixelIntegrator>(p);
+    return std::unique_ptr<PixelIntegrator<T>>(p);
 }
 
 inline std::string shared_dir() { return PATHLAB_SHARED_DIR; }

@@ -57,7 +57,7 @@ AgreementResult compare_with_pt_mis(const std::string& key, Integrator& bdpt, in
 class BdptAgreement : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(BdptAgreement, ConvergesToThePathTracersImage) {
-    Bdpt bdpt({});
+    Bdpt<RgbTransport> bdpt({});
     const bool file = looks_like_scene_file(GetParam());
     // The shipped scenes (caustic, lampshade) are slow to converge for pt-mis: fewer pixels.
     const bool shipped = GetParam() == "caustic.xml" || GetParam() == "lampshade.xml";
@@ -82,13 +82,13 @@ INSTANTIATE_TEST_SUITE_P(Scenes, BdptAgreement,
 // left unset at a mirror vertex (the weights of the strategies on either side of it no longer
 // sum to 1; mirror-box.xml is made so that they carry comparable weights).
 TEST(BdptAgreement, DetectsAMisWeightThatDropsAStrategy) {
-    Bdpt bdpt({}, BdptFaults{.drop_nee_strategy = true});
+    Bdpt<RgbTransport> bdpt({}, BdptFaults{.drop_nee_strategy = true});
     const AgreementResult r = compare_with_pt_mis("2", bdpt, 8, 8, 4096);
     EXPECT_FALSE(r.agree) << r.describe();
 }
 
 TEST(BdptAgreement, DetectsAMissingReversePdfAtASpecularVertex) {
-    Bdpt bdpt({}, BdptFaults{.specular_pdf_rev_missing = true});
+    Bdpt<RgbTransport> bdpt({}, BdptFaults{.specular_pdf_rev_missing = true});
     const AgreementResult r = compare_with_pt_mis("mirror-box.xml", bdpt, 16, 12, 16384);
     EXPECT_FALSE(r.agree) << r.describe();
 }
@@ -98,7 +98,7 @@ TEST(BdptDeterminism, OneAndTwoThreadsGiveBitIdenticalImages) {
         RenderResult runs[2];
         for (const int threads : {1, 2}) {
             tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
-            Bdpt bdpt({});
+            Bdpt<RgbTransport> bdpt({});
             runs[threads - 1] = render_integrator(scene_of(key), bdpt, 40, 30, 4, 9);
         }
         EXPECT_TRUE(bit_identical(runs[0].film.mean(), runs[1].film.mean())) << key;
@@ -132,7 +132,7 @@ TEST_P(BdptStrategies, EachLengthsStrategiesAddUpAndConverge) {
     o.max_depth = kDepth;
     o.strategies_dir = dir;
     o.strategies_depth = kDepth;
-    Bdpt bdpt(o);
+    Bdpt<RgbTransport> bdpt(o);
     render_integrator(d, bdpt, kW, kH, kStrategySpp, 5);  // fills the strategies' films and writes them
     const StrategyImages& images = *bdpt.strategy_images();
     for (int n = 0; n <= kDepth; ++n) {
@@ -140,7 +140,7 @@ TEST_P(BdptStrategies, EachLengthsStrategiesAddUpAndConverge) {
         length.only_length = n;
         length.strategies_dir.clear();
         const RenderResult reference = pt_mis_render(d, length, kW, kH, kStrategySpp, 77 + uint64_t(n));
-        Bdpt bdpt_n(length);
+        Bdpt<RgbTransport> bdpt_n(length);
         const RenderResult own = render_integrator(d, bdpt_n, kW, kH, kStrategySpp, 5);
         const AgreementResult weighted = agreement(own.film, reference.film);
         EXPECT_TRUE(weighted.agree) << "length " << n << ", bdpt: " << weighted.describe();

@@ -15,7 +15,7 @@ double weight_sum(const MisHarness& h, const FullPath& f) {
     double sum = 0;
     for (int s = 0; s <= n; ++s) {
         if (!h.valid(f, s)) continue;
-        std::vector<PathVertex> light, camera;
+        std::vector<PathVertex<RgbTransport>> light, camera;
         h.subpaths(f, s, light, camera);
         sum += h.bdpt(false).mis_weight(h.ctx(), light, s, camera, n + 1 - s, h.sampled_end(f, s));
     }
@@ -31,7 +31,7 @@ void expect_weights(const MisHarness& h, const FullPath& f, const std::string& w
         for (int s = 0; s <= n; ++s) {
             if (!h.valid(f, s)) continue;
             ++strategies;
-            std::vector<PathVertex> light, camera;
+            std::vector<PathVertex<RgbTransport>> light, camera;
             h.subpaths(f, s, light, camera);
             const float w = h.bdpt(power).mis_weight(h.ctx(), light, s, camera, n + 1 - s, h.sampled_end(f, s));
             const double expected = h.direct_weight(f, s, power);

@@ -42,11 +42,12 @@ std::pair<double, double> plane_hit(const PerspectiveCamera& cam, float sx, floa
 TEST(PointLightOverPlane, EveryPixelCentreMatchesTheClosedForm) {
     const auto scene = Scene::build(point_light_over_plane());
     const auto estimator = make_pixel_integrator("direct-light");
+    RgbWavelengths rgb;
     const PerspectiveCamera cam(scene->camera(), 32, 32);
     for (int y = 0; y < 32; ++y)
         for (int x = 0; x < 32; ++x) {
             Sampler sampler(1, uint64_t(y * 32 + x), 0);
-            const Rgb L = estimator->radiance(*scene, cam.generate(x + 0.5f, y + 0.5f), sampler);
+            const Rgb L = estimator->radiance(*scene, cam.generate(x + 0.5f, y + 0.5f), sampler, rgb);
             const auto [px, py] = plane_hit(cam, x + 0.5f, y + 0.5f);
             const double expected = closed_form(px, py);
             ASSERT_NEAR(L.x, expected, 1e-5 * expected) << "pixel " << x << "," << y;
@@ -91,6 +92,7 @@ TEST(PointLightOverPlane, OnePercentTooBrightIsDetected) {
 void expect_emitter_pixels_exact(int scene_index, float radiance, int min_pixels) {
     const auto scene = Scene::build(make_builtin_scene(scene_index));
     const auto estimator = make_pixel_integrator("direct-light");
+    RgbWavelengths rgb;
     const PerspectiveCamera cam(scene->camera(), 512, 512);
     int seen = 0;
     for (int y = 0; y < 512; y += 2)
@@ -99,7 +101,7 @@ void expect_emitter_pixels_exact(int scene_index, float radiance, int min_pixels
             Intersection hit;
             if (!scene->intersect(ray, hit) || hit.light < 0) continue;
             Sampler sampler(3, uint64_t(y * 512 + x), 0);
-            const Rgb L = estimator->radiance(*scene, ray, sampler);
+            const Rgb L = estimator->radiance(*scene, ray, sampler, rgb);
             ASSERT_EQ(L, Rgb(radiance)) << "pixel " << x << "," << y;
             ++seen;
         }
@@ -122,8 +124,9 @@ TEST(Environment, EscapingRaysReturnItsRadiance) {
     d.lights = {EnvironmentLight{Rgb(0.25f, 0.5f, 0.75f)}};
     const auto scene = Scene::build(d);
     const auto estimator = make_pixel_integrator("direct-light");
+    RgbWavelengths rgb;
     Sampler sampler(1, 0, 0);
-    EXPECT_EQ(estimator->radiance(*scene, Ray{{0, 0, 1}, {0, 0, 1}, kInf}, sampler), Rgb(0.25f, 0.5f, 0.75f));
+    EXPECT_EQ(estimator->radiance(*scene, Ray{{0, 0, 1}, {0, 0, 1}, kInf}, sampler, rgb), Rgb(0.25f, 0.5f, 0.75f));
 }
 
 }  // namespace

@@ -46,9 +46,9 @@ TEST(DirectAgreement, LightSamplingConvergesToTheMisImageWithPointLights) {
 
 // Test of the test: direct-brdf with the classic bug of dividing by the chosen lobe's density
 // (times its selection probability) instead of the mixture density must disagree.
-class BrdfSamplingWithChosenLobePdf final : public PixelIntegrator {
+class BrdfSamplingWithChosenLobePdf final : public PixelIntegrator<RgbTransport> {
 public:
-    Rgb radiance(const Scene& scene, const Ray& ray, Sampler& sampler) const override {
+    Rgb radiance(const Scene& scene, const Ray& ray, Sampler& sampler, RgbWavelengths&) const override {
         Intersection hit;
         if (!scene.intersect(ray, hit)) return scene.escaped_radiance();
         const Rgb L = emitted_radiance(scene, hit, -ray.d);

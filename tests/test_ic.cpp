@@ -44,7 +44,7 @@ TEST(IcGradients, PredictANearbyRecordBetterThanTheRecordAlone) {
     const auto scene = Scene::build(d);
     const PerspectiveCamera camera(scene->camera(), 64, 64);
     const RenderContext ctx{*scene, camera, 64, 64, 3, SamplerKind::Independent, 32};
-    IrradianceCaching coarse(ic_options(0.0f, 1024)), fine(ic_options(0.0f, 4096));
+    IrradianceCaching<RgbTransport> coarse(ic_options(0.0f, 1024)), fine(ic_options(0.0f, 4096));
     coarse.prepare(ctx, {}), fine.prepare(ctx, {});
     Sampler pick(11, 0, 0);
     double with = 0, without = 0;
@@ -75,7 +75,7 @@ TEST(IcGradients, PredictANearbyRecordBetterThanTheRecordAlone) {
 TEST(IcConsistency, WithoutACacheItAgreesWithThePathTracer) {
     for (const int index : {2, 4}) {
         const SceneDescription d = make_builtin_scene(index);
-        IrradianceCaching ic(ic_options(0.0f));
+        IrradianceCaching<RgbTransport> ic(ic_options(0.0f));
         const std::unique_ptr<Integrator> pt = find_integrator("pt-mis")->make({});
         const RenderResult a = render_with(d, ic, 16, 16, 4096, 3), b = render_with(d, *pt, 16, 16, 8192, 4);
         const AgreementResult r = test_agreement(a.film.mean(), a.film.standard_error(), b.film.mean(), b.film.standard_error(),
@@ -106,7 +106,7 @@ TEST(IcConvergence, TheErrorFallsWithTheThreshold) {
         std::vector<double> mean_error, rms_error;
         std::vector<size_t> records;
         for (const float a : {0.4f, 0.2f, 0.1f}) {
-            IrradianceCaching ic(ic_options(a));
+            IrradianceCaching<RgbTransport> ic(ic_options(a));
             const RenderResult r = render_with(d, ic, 32, 32, spp, 3);
             mean_error.push_back(std::abs(mean_luminance(r.film.mean()) - mean_luminance(ref.film.mean())));
             rms_error.push_back(bias_rms(r.film.mean(), r.film.standard_error(), ref.film.mean(), ref.film.standard_error()));
@@ -128,7 +128,7 @@ TEST(IcConvergence, TheErrorFallsWithTheThreshold) {
 TEST(IcDeterminism, OneAndTwoThreadsGiveTheSameRecordsAndBytes) {
     for (const int index : {3, 6}) {
         const SceneDescription d = make_builtin_scene(index);
-        IrradianceCaching one(ic_options(0.2f)), two(ic_options(0.2f));
+        IrradianceCaching<RgbTransport> one(ic_options(0.2f)), two(ic_options(0.2f));
         const RenderResult a = render_with(d, one, 40, 30, 4, 9, 1), b = render_with(d, two, 40, 30, 4, 9, 2);
         EXPECT_TRUE(bit_identical(a.film.mean(), b.film.mean())) << index;
         ASSERT_EQ(one.cache().size(), two.cache().size()) << index;

@@ -45,7 +45,7 @@ AgreementResult compare_with_pt_mis(const std::string& key, Integrator& lt, int 
 class LightTracerAgreement : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(LightTracerAgreement, ConvergesToThePathTracersImage) {
-    LightTracer lt({});
+    LightTracer<RgbTransport> lt({});
     const bool file = looks_like_scene_file(GetParam());
     const AgreementResult r = file ? compare_with_pt_mis(GetParam(), lt, 16, 12, 16384) : compare_with_pt_mis(GetParam(), lt, 8, 8);
     ::testing::Test::RecordProperty("agreement", r.describe());
@@ -65,21 +65,21 @@ INSTANTIATE_TEST_SUITE_P(Scenes, LightTracerAgreement,
 TEST(LightTracerAgreement, DetectsAMissingCameraGeometryTerm) {
     LightTracerFaults f;
     f.drop_camera_geometry = true;
-    LightTracer lt({}, f);
+    LightTracer<RgbTransport> lt({}, f);
     EXPECT_FALSE(compare_with_pt_mis("2", lt, 8, 8, 4096).agree);
 }
 
 TEST(LightTracerAgreement, DetectsAMissingEmissionPdf) {
     LightTracerFaults f;
     f.drop_emission_pdf = true;
-    LightTracer lt({}, f);
+    LightTracer<RgbTransport> lt({}, f);
     EXPECT_FALSE(compare_with_pt_mis("4", lt, 8, 8, 4096).agree);
 }
 
 RenderResult lt_render(const std::string& key, int threads, uint64_t spp, uint64_t first = 0) {
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
     const auto scene = Scene::build(scene_of(key));
-    LightTracer lt({});
+    LightTracer<RgbTransport> lt({});
     RenderSettings rs;
     rs.width = 40, rs.height = 30, rs.spp = spp, rs.seed = 9, rs.first_sample = first;
     return render(*scene, lt, rs);
@@ -98,7 +98,7 @@ TEST(LightTracerDeterminism, ARenderSplitIntoTwoPartsSumsToTheOneShotRender) {
     const RenderResult whole = lt_render("5", 2, 8);
     // Continued into the same film: bit for bit.
     const auto scene = Scene::build(scene_of("5"));
-    LightTracer lt({});
+    LightTracer<RgbTransport> lt({});
     RenderSettings rs;
     rs.width = 40, rs.height = 30, rs.spp = 3, rs.seed = 9;
     Film film(40, 30);

@@ -79,11 +79,11 @@ TEST_P(NewLightsAgreement, BdptAndLightTracingConvergeToPtMis) {
     const Case& c = GetParam();
     const SceneDescription d = c.scene();
     const RenderResult pt = render_scene(d, "pt-mis", c.w, c.h, int(c.spp), 501);
-    Bdpt bdpt({});
+    Bdpt<RgbTransport> bdpt({});
     const AgreementResult b = agree(render_integrator(d, bdpt, c.w, c.h, c.spp, 502), pt);
     RecordProperty("bdpt", b.describe());
     EXPECT_TRUE(b.agree) << c.name << ", bdpt: " << b.describe();
-    LightTracer lt({});
+    LightTracer<RgbTransport> lt({});
     const auto scene = Scene::build(d);
     const std::vector<uint8_t> mask = specular_first_vertex_mask(*scene, c.w, c.h, 16, /*dilate=*/false);
     const AgreementResult l = agree(render_integrator(d, lt, c.w, c.h, 2 * c.spp, 503), pt, &mask);

@@ -193,7 +193,7 @@ double pbgi_bias(const SceneDescription& d, const RenderResult& ref, int surfels
     o.pbgi_surfels = surfels;
     o.pbgi_cutoff = cutoff;
     o.pbgi_spacing = 1;
-    PointBasedGi pbgi(o, faults);
+    PointBasedGi<RgbTransport> pbgi(o, faults);
     const RenderResult r = render_with(d, pbgi, 32, 32, 512, 3);
     const auto [a, sa] = blocks(r.film);
     const auto [b, sb] = blocks(ref.film);
@@ -219,7 +219,7 @@ TEST(PbgiDeterminism, OneAndTwoThreadsGiveTheSameBytes) {
         IntegratorOptions o;
         o.pbgi_surfels = 3000;
         o.pbgi_bounces = 2;
-        PointBasedGi one(o), two(o);
+        PointBasedGi<RgbTransport> one(o), two(o);
         const RenderResult a = render_with(d, one, 40, 30, 4, 9, 1), b = render_with(d, two, 40, 30, 4, 9, 2);
         EXPECT_TRUE(bit_identical(a.film.mean(), b.film.mean())) << index;
         ASSERT_EQ(one.tree().surfels().size(), two.tree().surfels().size());

@@ -26,7 +26,7 @@ constexpr int kSize = 16;
 double bias(const Scene& scene, const Image& ref, const Image& ref_se, int64_t photons, PmFaults faults = {}) {
     IntegratorOptions o;
     o.photons = photons;
-    PhotonMapper pm(o, faults);
+    PhotonMapper<RgbTransport> pm(o, faults);
     RenderSettings rs;
     rs.width = rs.height = kSize, rs.spp = 2048, rs.seed = 8;
     const RenderResult a = render(scene, pm, rs);
@@ -59,13 +59,13 @@ TEST(PmMaps, TheCausticMapHoldsOnlyPhotonsThroughDiracLobes) {
     o.photons = 20000;
     const auto box = Scene::build(make_builtin_scene(2));
     const PerspectiveCamera c1(box->camera(), 8, 8);
-    PhotonMapper diffuse(o);
+    PhotonMapper<RgbTransport> diffuse(o);
     diffuse.prepare(RenderContext{*box, c1, 8, 8, 1, SamplerKind::Independent, 32});
     EXPECT_GT(diffuse.global_photons(), 20000u);
     EXPECT_EQ(diffuse.caustic_photons(), 0u) << "no Dirac lobes in scene 2";
     const auto glass = Scene::build(load_scene_file(std::string(PATHLAB_SOURCE_DIR) + "/scenes/caustic.xml"));
     const PerspectiveCamera c2(glass->camera(), 8, 8);
-    PhotonMapper caustic(o);
+    PhotonMapper<RgbTransport> caustic(o);
     caustic.prepare(RenderContext{*glass, c2, 8, 8, 1, SamplerKind::Independent, 32});
     EXPECT_GT(caustic.caustic_photons(), 100u) << "the glass ball focuses photons";
     EXPECT_LT(caustic.caustic_photons(), caustic.global_photons());
@@ -79,7 +79,7 @@ TEST(PmDeterminism, OneAndTwoThreadsGiveBitIdenticalImages) {
             const auto s = Scene::build(make_builtin_scene(scene));
             IntegratorOptions o;
             o.photons = 20000;
-            PhotonMapper pm(o);
+            PhotonMapper<RgbTransport> pm(o);
             RenderSettings rs;
             rs.width = 40, rs.height = 30, rs.spp = 2, rs.seed = 9;
             runs[threads - 1] = render(*s, pm, rs);

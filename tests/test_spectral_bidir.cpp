@@ -195,7 +195,7 @@ TEST(SpectralBidir, BdptStrategiesAddUpToItsImage) {
     const auto scene = Scene::build(d);
     RenderSettings rs;
     rs.width = kW, rs.height = kH, rs.spp = 64, rs.seed = 5, rs.spectral = true;
-    Bdpt bdpt(o);
+    Bdpt<SpectralTransport> bdpt(o);
     const RenderResult all = render(*scene, bdpt, rs);
     const StrategyImages& images = *bdpt.strategy_images();
     Image sum(kW, kH);

@@ -7,7 +7,7 @@
 
 #include <cmath>
 
-#include "integrators/common/spectral_shading.hpp"
+#include "integrators/common/transport.hpp"
 #include "scenefile/scene_file.hpp"
 #include "spectral_helpers.hpp"
 
@@ -63,22 +63,22 @@ TEST(SpectralEmitters, LightSampleEmissionIsTheSpectrumTimesTheLightsFactor) {
     // The point light seen from the origin, 4 away: intensity / 16.
     const auto ls = sample_light(scene->lights()[0], Vec3f(0.0f), Vec2f(0.5f, 0.5f));
     ASSERT_TRUE(ls);
-    const Spectrum4 L = emission_spectrum(*scene, 0, ls->Le, wl);
+    const Spectrum4 L = light_colour(*scene, 0, ls->Le, wl);
     for (int i = 0; i < kSpectrumLanes; ++i)
         EXPECT_NEAR(L[i], 0.5 * planck(wl[i], 4000) / 16, 2e-5 * planck(wl[i], 4000) / 16) << "lane " << i << " at " << wl[i] << " nm";
     // The environment's flat spectrum, and an RGB emitter (no spectrum) upsampled as before.
-    const Spectrum4 sky = escaped_spectrum(*scene, Vec3f(0, 0, 1), wl);
+    const Spectrum4 sky = escaped_radiance(*scene, Vec3f(0, 0, 1), wl);
     for (int i = 0; i < kSpectrumLanes; ++i) EXPECT_FLOAT_EQ(sky[i], 2.0f);
     const Rgb e(1, 2, 3);
-    EXPECT_EQ(emission_spectrum(*scene, 3, e, wl), illuminant_spectrum(e, wl));
+    EXPECT_EQ(light_colour(*scene, 3, e, wl), illuminant_spectrum(e, wl));
     // A coloured factor (a spot's projected texture) multiplies the spectrum by its upsampled
     // unbounded spectrum; a black one gives black.
     const EmissionSpectrum& spot = *scene->light_spectrum(1);
     const Rgb tint(0.2f, 0.5f, 0.9f);
-    const Spectrum4 tinted = emission_spectrum(*scene, 1, spot.rgb * tint, wl);
+    const Spectrum4 tinted = light_colour(*scene, 1, spot.rgb * tint, wl);
     const Spectrum4 want = spot.values.sample(wl) * unbounded_spectrum(tint, wl);
     for (int i = 0; i < kSpectrumLanes; ++i) EXPECT_NEAR(tinted[i], want[i], 1e-4f * want[i]) << i;
-    EXPECT_TRUE(emission_spectrum(*scene, 1, Rgb(0.0f), wl).is_black());
+    EXPECT_TRUE(light_colour(*scene, 1, Rgb(0.0f), wl).is_black());
 }
 
 TEST(SpectralEmitters, MalformedSpectraNameTheirLine) {

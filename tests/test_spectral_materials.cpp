@@ -11,7 +11,7 @@
 #include <functional>
 #include <memory>
 
-#include "integrators/common/spectral_shading.hpp"
+#include "integrators/common/transport.hpp"
 #include "scenefile/scene_file.hpp"
 #include "spectral/dispersion.hpp"
 #include "spectral/metals.hpp"
@@ -90,7 +90,7 @@ TEST(SpectralMaterials, NonDeltaValuesMatchRgbEvaluationOfTheSpectra) {
                     const Vec3f wo = sp.frame.to_local(wo_world);
                     SampledWavelengths wl = kWl;
                     float pdf = 0, pdf_rgb = 0;
-                    const Spectrum4 f = spectral_eval_and_pdf(sp, wo, wl, pdf);
+                    const Spectrum4 f = bsdf_eval(sp, wo, wl, pdf);
                     const ShadingPoint a = point_on(low, wi, mode, n), b = point_on(high, wi, mode, n);
                     const Rgb f_low = low.eval_and_pdf(a, a.wi, wo, pdf_rgb), f_high = high.eval(b, b.wi, wo);
                     m.eval_and_pdf(sp, sp.wi, wo, pdf_rgb);
@@ -143,9 +143,9 @@ TEST(SpectralMaterials, DeltaValuesMatchRgbSamplesOfTheSpectra) {
             const Material m = c.make([](const Rgb& x) { return x; });
             const ShadingPoint sp = point_on(m, wi, mode, normalize(Vec3f(0.1f, 0.1f, 1)));
             SampledWavelengths wl = kWl;
-            const auto s = spectral_sample(sp, u, wl);
+            const auto s = bsdf_sample(sp, u, wl);
             ASSERT_TRUE(s && s->delta) << c.name;
-            const Spectrum4 f = spectral_sample_value(sp, *s, wl);
+            const Spectrum4 f = bsdf_sample_colour(sp, *s, wl);
             // The oracle: the gold's eta and k are fixed RGB here, so substitute them by hand.
             const auto oracle = [&](int a, int b, int cc) {
                 const ColourLanes colour = lanes(a, b, cc);
@@ -197,14 +197,14 @@ TEST(SpectralMaterials, NamedMetalsUseTheirMeasuredIndices) {
         // Smooth: F(cos_i) / cos per lane.
         const ShadingPoint sp = point_on(d.materials[0], wi, TransportMode::Radiance);
         SampledWavelengths wl = kWl;
-        const auto s = spectral_sample(sp, Vec2f(0.5f, 0.5f), wl);
+        const auto s = bsdf_sample(sp, Vec2f(0.5f, 0.5f), wl);
         ASSERT_TRUE(s);
-        const Spectrum4 f = spectral_sample_value(sp, *s, wl);
+        const Spectrum4 f = bsdf_sample_colour(sp, *s, wl);
         // Rough: R F(wi.h) D G / (4 cos cos); its scalar part from the RGB model with F = 1.
         const ShadingPoint rp = point_on(d.materials[1], wi, TransportMode::Radiance);
         const Vec3f wo = normalize(Vec3f(-0.3f, 0.0f, 0.9f));
         float pdf;
-        const Spectrum4 fr = spectral_eval_and_pdf(rp, wo, wl, pdf);
+        const Spectrum4 fr = bsdf_eval(rp, wo, wl, pdf);
         RoughConductorMaterial white = std::get<RoughConductorMaterial>(d.materials[1].model);
         white.eta = Rgb(0.0f), white.k = Rgb(1.0f);
         const float g = white.eval(rp.wi, wo).x;
@@ -236,7 +236,7 @@ TEST(SpectralMaterials, RoughDielectricDispersesAtTheHeroWavelength) {
         const Material at_hero{hero, false};
         for (const Vec2f u : {Vec2f(0.9f, 0.3f), Vec2f(0.2f, 0.7f)}) {  // refraction, reflection
             SampledWavelengths wl = start;
-            const auto s = spectral_sample(sp, u, wl);
+            const auto s = bsdf_sample(sp, u, wl);
             const auto want = at_hero.sample(sp.wi, u);
             ASSERT_EQ(bool(s), bool(want));
             EXPECT_TRUE(wl.secondary_terminated());
@@ -247,7 +247,7 @@ TEST(SpectralMaterials, RoughDielectricDispersesAtTheHeroWavelength) {
             // Evaluation (light sampling's) terminates too, and is the hero's.
             SampledWavelengths wl2 = start;
             float pdf;
-            const Spectrum4 f = spectral_eval_and_pdf(sp, s->wo, wl2, pdf);
+            const Spectrum4 f = bsdf_eval(sp, s->wo, wl2, pdf);
             EXPECT_TRUE(wl2.secondary_terminated());
             float pdf_hero;
             EXPECT_FLOAT_EQ(f[0], at_hero.eval_and_pdf(sp.wi, s->wo, pdf_hero).x);

@@ -17,7 +17,7 @@
 #include "job/usage_error.hpp"
 #include "render_helpers.hpp"
 #include "scenefile/scene_file.hpp"
-#include "integrators/common/spectral_shading.hpp"
+#include "integrators/common/transport.hpp"
 #include "spectral/dispersion.hpp"
 #include "spectral/rgb_spectra.hpp"
 
@@ -386,7 +386,7 @@ TEST(SpectralMode, PrismDeviationPerWavelengthFromTheBsdfSample) {
             sp.ng = normal;
             sp.wi = sp.frame.to_local(-dir);
             // u.x = 0.999999: refraction (the Fresnel reflectance is far below it here)
-            const auto smp = spectral_sample(sp, Vec2f(0.999999f, 0.5f), w);
+            const auto smp = bsdf_sample(sp, Vec2f(0.999999f, 0.5f), w);
             EXPECT_TRUE(smp && (smp->lobe & kLobeTransmission));
             return normalize(sp.frame.to_world(smp->wo));
         };

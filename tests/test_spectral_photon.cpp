@@ -15,7 +15,7 @@
 
 #include "integrators/integrators.hpp"
 #include "integrators/photon/pm.hpp"
-#include "integrators/photon/spectral_photons.hpp"
+#include "integrators/photon/photon.hpp"
 #include "integrators/photon/sppm.hpp"
 #include "job/render_job.hpp"
 #include "judge/image_statistics.hpp"
@@ -320,8 +320,8 @@ TEST(SpectralPhotonRgb, RgbModeRendersAsBefore) {
     o.photons = 2000;
     RenderSettings rs;
     rs.width = 16, rs.height = 12, rs.spp = 3, rs.seed = 7;
-    PhotonMapper pm(o);
-    Sppm sppm(o), ppm(o, SppmFaults{}, CameraRays::PixelCentres);
+    PhotonMapper<RgbTransport> pm(o);
+    Sppm<RgbTransport> sppm(o), ppm(o, SppmFaults{}, CameraRays::PixelCentres);
     const Image direct[3] = {render(*scene, pm, rs).film.mean(), render(*scene, ppm, rs).film.mean(), render(*scene, sppm, rs).film.mean()};
     const char* names[3] = {"pm", "ppm", "sppm"};
     for (int i = 0; i < 3; ++i) {
@@ -337,14 +337,14 @@ TEST(SpectralPhotonRgb, RgbModeRendersAsBefore) {
 TEST(SpectralPhotonMerge, HeroOnlyPhotonsCountFourTimesOnceForTheWholePath) {
     SampledWavelengths four = SampledWavelengths::sample_visible(0.3), hero = four;
     hero.terminate_secondary();
-    SpectralMergeSum sum;
-    sum.add(Spectrum4(1.0f), SpectralPower{Spectrum4(1, 2, 3, 4), false});
-    sum.add(Spectrum4(2.0f), SpectralPower{Spectrum4(0.5f, 0, 0, 0), true});
+    MergeSum<SpectralTransport> sum;
+    sum.add(Spectrum4(1.0f) * Spectrum4(1, 2, 3, 4), false);
+    sum.add(Spectrum4(2.0f) * Spectrum4(0.5f, 0, 0, 0), true);
     EXPECT_EQ(sum.total(four), Spectrum4(1 + 4 * 1.0f, 2, 3, 4));
     EXPECT_EQ(sum.total(hero), Spectrum4(1 + 1.0f, 2, 3, 4));
     // The film's estimate of the hero-only part alone is f(l0) / p(l0) with either camera path.
-    SpectralMergeSum only;
-    only.add(Spectrum4(1.0f), SpectralPower{Spectrum4(0.8f, 0, 0, 0), true});
+    MergeSum<SpectralTransport> only;
+    only.add(Spectrum4(1.0f) * Spectrum4(0.8f, 0, 0, 0), true);
     const Vec3d a = spectral_sample_to_xyz(only.total(four), four), b = spectral_sample_to_xyz(only.total(hero), hero);
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], 1e-6 * std::abs(b[c]) + 1e-12);
 }

@@ -11,9 +11,8 @@
 #include <random>
 
 #include "geometry/shape_meshes.hpp"
-#include "integrators/common/spectral_media.hpp"
+#include "media/spectral_medium.hpp"
 #include "integrators/path/volpath.hpp"
-#include "integrators/path/volpath_spectral.hpp"
 #include "judge/image_statistics.hpp"
 #include "render_helpers.hpp"
 #include "scenefile/scene_file.hpp"
@@ -36,31 +35,13 @@ RenderResult render_spectral(const SceneDescription& d, Integrator& integrator, 
     return render(*scene, integrator, rs);
 }
 
-std::unique_ptr<Integrator> volpath(int max_depth = -1, VolpathSettings s = {}) {
+// volpath in spectral mode (RGB mode with spectral = false).
+std::unique_ptr<Integrator> volpath(int max_depth = -1, VolpathSettings s = {}, bool spectral = true) {
     IntegratorOptions o;
     o.max_depth = max_depth;
+    o.spectral = spectral;
     return make_volpath(o, s);
 }
-
-// volpath_spectral_radiance with the majorant inflated: delta tracking with null collisions
-// and ratio tracking in every medium (homogeneous ones too), another free-flight strategy.
-class InflatedMajorantVolpath final : public PixelIntegrator {
-public:
-    InflatedMajorantVolpath(int max_depth, float factor) : rules_(options(max_depth)) { settings_.majorant_factor = factor; }
-    Rgb radiance(const Scene&, const Ray&, Sampler&) const override { return Rgb(0.0f); }
-    Spectrum4 radiance_spectral(const Scene& scene, const Ray& ray, Sampler& sampler, SampledWavelengths& wl) const override {
-        return volpath_spectral_radiance(scene, ray, sampler, wl, rules_, settings_);
-    }
-
-private:
-    static IntegratorOptions options(int max_depth) {
-        IntegratorOptions o;
-        o.max_depth = max_depth;
-        return o;
-    }
-    PathRules rules_;
-    VolpathSpectralSettings settings_;
-};
 
 // ---- without media: spectral pt-mis ---------------------------------------------------------
 
@@ -69,7 +50,7 @@ TEST(SpectralVolpath, WithoutMediaItIsSpectralPtMisBitForBit) {
     for (int s = 0; s < 8; ++s) scenes.push_back(make_builtin_scene(s));
     // A dispersive glass: paths left with the hero alone.
     scenes.push_back(load_scene_file(source_path("scenes/dispersion-caustic.xml")));
-    const auto pt = make_pixel_integrator("pt-mis");
+    const auto pt = make_pixel_integrator<SpectralTransport>("pt-mis");
     const auto own_loop = volpath(-1, {true, false}), delegating = volpath();
     for (const SceneDescription& d : scenes) {
         const RenderResult a = render_spectral(d, *pt, 16, 12, 4, 7), b = render_spectral(d, *delegating, 16, 12, 4, 7);
@@ -153,9 +134,8 @@ TEST(SpectralVolpath, GreyMediumUnderAWhiteLightAgreesWithRgbMode) {
             d.media.push_back(grey_grid(0.8f));
         }
         d.meshes.push_back(fog_box(0));
-        const auto integrator = volpath(4);
-        const ImageMean rgb = image_mean(render_spectral(d, *integrator, 16, 16, 64, 31, false));
-        const ImageMean spectral = image_mean(render_spectral(d, *integrator, 16, 16, 64, 32, true));
+        const ImageMean rgb = image_mean(render_spectral(d, *volpath(4, {}, false), 16, 16, 64, 31, false));
+        const ImageMean spectral = image_mean(render_spectral(d, *volpath(4), 16, 16, 64, 32, true));
         for (int c = 0; c < 3; ++c) {
             const double sigma = std::hypot(rgb.se[c], spectral.se[c]);
             EXPECT_LE(std::abs(spectral.mean[c] - rgb.mean[c]), eps * rgb.mean[c] + 4 * sigma)
@@ -285,9 +265,10 @@ TEST(SpectralVolpath, FreeFlightStrategiesAgreeOnColouredMedia) {
         scenes.push_back(d);
     }
     for (const SceneDescription& d : scenes) {
-        const auto exact = volpath(4);
-        InflatedMajorantVolpath inflated(4, 2.5f);
-        const RenderResult a = render_spectral(d, *exact, 12, 12, 256, 41), b = render_spectral(d, inflated, 12, 12, 256, 42);
+        // The majorant inflated: delta tracking with null collisions and ratio tracking in every
+        // medium (homogeneous ones too), another free-flight strategy.
+        const auto exact = volpath(4), inflated = volpath(4, {true, true, 2.5f});
+        const RenderResult a = render_spectral(d, *exact, 12, 12, 256, 41), b = render_spectral(d, *inflated, 12, 12, 256, 42);
         const AgreementResult r = test_agreement(a.film.mean(), a.film.standard_error(), b.film.mean(), b.film.standard_error(), kAgreement);
         EXPECT_TRUE(r.agree) << d.name << ": " << r.describe();
         // The image means too (a small bias in every pixel adds up there): z = 4 per channel.
@@ -326,7 +307,8 @@ TEST(SpectralVolpath, UnboundedSpectrumBoundHolds) {
     // Grey extinction is exact: a flat spectrum at the RGB's value.
     const SampledWavelengths wl = SampledWavelengths::sample_visible(0.3);
     const HomogeneousMedium grey{Rgb(0.7f), Rgb(0.35f), IsotropicPhase{}};
-    const SpectralMediumCoefficients c = spectral_medium_coefficients(grey, Vec3f(0.0f), wl);
+    const Medium medium = grey;
+    const MediumCoefficientsOf<Spectrum4> c = MediumAtWavelengths{medium, wl}.coefficients(Vec3f(0.0f));
     for (int i = 0; i < kSpectrumLanes; ++i) {
         EXPECT_EQ(c.sigma_t[i], 0.7f);
         EXPECT_FLOAT_EQ(c.sigma_s[i], 0.35f);

@@ -23,15 +23,15 @@ namespace pathlab::test {
 namespace {
 
 TEST(SppmRadius, FollowsKnausAndZwickersRecurrence) {
-    EXPECT_DOUBLE_EQ(Sppm::radius(0.1, 2.0 / 3.0, 1), 0.1);
+    EXPECT_DOUBLE_EQ(Sppm<RgbTransport>::radius(0.1, 2.0 / 3.0, 1), 0.1);
     for (const double alpha : {0.5, 2.0 / 3.0, 0.9}) {
         double r2 = 0.01;
         for (uint64_t i = 1; i < 2000; ++i) {
-            ASSERT_NEAR(Sppm::radius(0.1, alpha, i) * Sppm::radius(0.1, alpha, i), r2, 1e-10 * r2) << "alpha " << alpha << ", i " << i;
+            ASSERT_NEAR(Sppm<RgbTransport>::radius(0.1, alpha, i) * Sppm<RgbTransport>::radius(0.1, alpha, i), r2, 1e-10 * r2) << "alpha " << alpha << ", i " << i;
             r2 *= (double(i) + alpha) / (double(i) + 1);
         }
     }
-    EXPECT_DOUBLE_EQ(Sppm::radius(0.1, 1.0, 500), 0.1);  // alpha = 1: the radius never shrinks
+    EXPECT_DOUBLE_EQ(Sppm<RgbTransport>::radius(0.1, 1.0, 500), 0.1);  // alpha = 1: the radius never shrinks
 }
 
 // Scene 2 (diffuse, ceiling light) and 3 (glossy), 8x8, 256 iterations of 16384 photons with
@@ -49,7 +49,7 @@ AgreementResult sppm_against_pt_mis(int scene_index, SppmFaults faults = {}) {
     IntegratorOptions o;
     o.photons = 16384;
     o.photon_radius = 0.05f * scene->scene_sphere().radius;
-    Sppm sppm(o, faults);
+    Sppm<RgbTransport> sppm(o, faults);
     rs.spp = 256, rs.seed = 8;
     const RenderResult a = render(*scene, sppm, rs);
     return test_agreement(a.film.mean(), a.film.standard_error(), ref.film.mean(), ref.film.standard_error(),
@@ -81,7 +81,7 @@ class SppmBias : public ::testing::Test {
 protected:
     static void SetUpTestSuite() {
         scene_ = Scene::build(load_scene_file(std::string(PATHLAB_SOURCE_DIR) + "/scenes/caustic.xml")).release();
-        Bdpt bdpt({});
+        Bdpt<RgbTransport> bdpt({});
         RenderSettings rs;
         rs.width = 24, rs.height = 18, rs.spp = 8192, rs.seed = 4;
         const RenderResult r = render(*scene_, bdpt, rs);
@@ -94,7 +94,7 @@ protected:
         o.photons = 16384;
         o.photon_radius = radius;
         o.photon_alpha = alpha;
-        Sppm sppm(o, faults);
+        Sppm<RgbTransport> sppm(o, faults);
         RenderSettings rs;
         rs.width = 24, rs.height = 18, rs.spp = 512, rs.seed = 8;
         const RenderResult a = render(*scene_, sppm, rs);
@@ -122,7 +122,7 @@ TEST_F(SppmBias, ShrinksWithTheRadiusAndWithIterationsAndNeedsPi) {
 RenderResult sppm_render(int scene, int threads, uint64_t spp, uint64_t first = 0) {
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
     const auto s = Scene::build(make_builtin_scene(scene));
-    Sppm sppm({});
+    Sppm<RgbTransport> sppm({});
     RenderSettings rs;
     rs.width = 40, rs.height = 30, rs.spp = spp, rs.seed = 9, rs.first_sample = first;
     return render(*s, sppm, rs);
@@ -156,7 +156,7 @@ TEST(SppmAgreement, DirectLightAloneAgreesWithThePathTracer) {
         IntegratorOptions o;
         o.max_depth = 1;
         const auto s = Scene::build(make_builtin_scene(scene));
-        Sppm sppm(o);
+        Sppm<RgbTransport> sppm(o);
         const std::unique_ptr<Integrator> pt = find_integrator("pt-mis")->make(o);
         RenderSettings rs;
         rs.width = rs.height = 8, rs.spp = 8192, rs.seed = 2;

@@ -48,8 +48,8 @@ TEST(VcmEquivalence, WithoutMergingItIsBdptBitForBit) {
     for (const SceneDescription& d : equivalence_scenes()) {
         IntegratorOptions o;
         o.vcm_merging = false;
-        Vcm vcm(o);
-        Bdpt bdpt({});
+        Vcm<RgbTransport> vcm(o);
+        Bdpt<RgbTransport> bdpt({});
         const RenderResult a = render_with(d, vcm, 24, 18, 3), b = render_with(d, bdpt, 24, 18, 3);
         EXPECT_TRUE(bit_identical(a.film.mean(), b.film.mean())) << d.name;
         EXPECT_GT(mean_luminance(a.film.mean()), 0.0) << d.name;
@@ -60,12 +60,12 @@ TEST(VcmEquivalence, WithoutConnectionsItIsBpmBitForBit) {
     for (const SceneDescription& d : equivalence_scenes()) {
         IntegratorOptions o;
         o.vcm_connections = false;
-        Vcm vcm(o);
+        Vcm<RgbTransport> vcm(o);
         const std::unique_ptr<Integrator> bpm = find_integrator("bpm")->make({});
         const RenderResult a = render_with(d, vcm, 24, 18, 3), b = render_with(d, *bpm, 24, 18, 3);
         EXPECT_TRUE(bit_identical(a.film.mean(), b.film.mean())) << d.name;
         // ... and differs from vcm with both (the switch does something).
-        Vcm both({});
+        Vcm<RgbTransport> both({});
         EXPECT_FALSE(bit_identical(a.film.mean(), render_with(d, both, 24, 18, 3).film.mean())) << d.name;
     }
 }
@@ -85,7 +85,7 @@ TEST(VcmDeterminism, OneAndTwoThreadsGiveBitIdenticalImages) {
 // passes 0-7 rendered at once.
 TEST(VcmDeterminism, ARenderSplitIntoPartsEqualsTheOneShotRender) {
     const SceneDescription d = make_builtin_scene(5);
-    Vcm a({}), b({}), c({});
+    Vcm<RgbTransport> a({}), b({}), c({});
     const RenderResult whole = render_with(d, a, 40, 30, 8);
     Film merged = render_with(d, b, 40, 30, 3).film;
     merged.merge(render_with(d, c, 40, 30, 5, 5, 0, 3).film);
@@ -109,7 +109,7 @@ AgreementResult against_pt_mis(int scene_index, const std::string& algorithm, Vc
     IntegratorOptions o;
     o.photon_radius = 0.03f * Scene::build(d)->scene_sphere().radius;
     o.vcm_connections = algorithm == "vcm";
-    Vcm vcm(o, faults);
+    Vcm<RgbTransport> vcm(o, faults);
     const RenderResult a = render_with(d, vcm, 16, 16, 2048, 8);
     return test_agreement(a.film.mean(), a.film.standard_error(), ref.film.mean(), ref.film.standard_error(), AgreementOptions{1e-3, 1e-4});
 }
@@ -147,7 +147,7 @@ class VcmBias : public ::testing::Test {
 protected:
     static void SetUpTestSuite() {
         scene_ = new SceneDescription(scene_file("caustic.xml"));
-        Bdpt bdpt({});
+        Bdpt<RgbTransport> bdpt({});
         const RenderResult r = render_with(*scene_, bdpt, 24, 18, 8192, 4);
         ref_ = new Image(r.film.mean());
         ref_se_ = new Image(r.film.standard_error());
@@ -165,8 +165,8 @@ protected:
         for (int run = 0; run < runs; ++run) {
             // sppm with as many light paths per iteration as vcm (one per pixel).
             std::unique_ptr<Integrator> integrator;
-            if (algorithm == "sppm") integrator = std::make_unique<Sppm>(o, SppmFaults{.no_pi_in_kernel = faults.no_pi_in_kernel});
-            else integrator = std::make_unique<Vcm>(o, faults);
+            if (algorithm == "sppm") integrator = std::make_unique<Sppm<RgbTransport>>(o, SppmFaults{.no_pi_in_kernel = faults.no_pi_in_kernel});
+            else integrator = std::make_unique<Vcm<RgbTransport>>(o, faults);
             Integrator& vcm = *integrator;
             Film film;
             uint64_t done = 0;
@@ -232,9 +232,9 @@ TEST_F(VcmBias, FallsAtTheSlopeOfTheRadiusSchedule) {
 // agree with each other in the mean (within 5%; both blur the caustic slightly).
 TEST(VcmCaustics, SpecularDiffuseSpecularLightIsFound) {
     const SceneDescription d = scene_file("sds-caustic.xml");
-    Bdpt bdpt({});
-    Vcm vcm({});
-    Sppm sppm({});
+    Bdpt<RgbTransport> bdpt({});
+    Vcm<RgbTransport> vcm({});
+    Sppm<RgbTransport> sppm({});
     const RenderResult b = render_with(d, bdpt, 40, 30, 64), v = render_with(d, vcm, 40, 30, 64), s = render_with(d, sppm, 40, 30, 64);
     const double lb = mean_luminance(b.film.mean()), lv = mean_luminance(v.film.mean()), ls = mean_luminance(s.film.mean());
     // The standard error of bdpt's mean image, from the per-pixel errors (pixels independent).

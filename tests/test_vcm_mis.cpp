@@ -41,14 +41,14 @@ public:
     }
 
     float connection_weight(const FullPath& f, int s) const {
-        std::vector<PathVertex> light, camera;
+        std::vector<PathVertex<RgbTransport>> light, camera;
         h_.subpaths(f, s, light, camera);
         return vcm_.bdpt().mis_weight(h_.ctx(), light, s, camera, h_.k(f) + 1 - s, h_.sampled_end(f, s), {}, &vm_);
     }
     // The photon x_j on the light subpath x_k .. x_j, merged at x_j on the camera subpath x_0 .. x_j.
     float merge_weight(const FullPath& f, int j) const {
         const int s = h_.k(f) - j + 1;
-        std::vector<PathVertex> light, camera, unused;
+        std::vector<PathVertex<RgbTransport>> light, camera, unused;
         h_.subpaths(f, s, light, unused);
         h_.subpaths(f, s - 1, unused, camera);
         // As the light walk stores it: 0 after a Dirac vertex.
@@ -63,7 +63,7 @@ private:
         return o;
     }
     const MisHarness& h_;
-    Vcm vcm_;
+    Vcm<RgbTransport> vcm_;
     bool power_;
     MergeMis vm_;
 };

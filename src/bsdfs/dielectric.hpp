@@ -34,7 +34,7 @@ struct DielectricMaterial {
     float ext_ior = 1.000277f;
     // A wavelength-dependent interior index (Sellmeier or Cauchy), or null. RGB mode refracts
     // with int_ior, the index at kDispersionReferenceWavelength (n_d); spectral mode refracts
-    // the hero wavelength with its own index and drops the other three (spectral_shading.hpp).
+    // the hero wavelength with its own index and drops the other three (bsdfs/spectral_bsdf.hpp).
     std::shared_ptr<const Ior> dispersion = nullptr;
 
     Rgb eval(const Vec3f&, const Vec3f&) const { return Rgb(0.0f); }

@@ -42,8 +42,7 @@
 #include "render/pixel_filter.hpp"
 #include "samplers/sampler.hpp"
 #include "scene/scene.hpp"
-#include "spectral/sampled_wavelengths.hpp"
-#include "spectral/spectrum4.hpp"
+#include "integrators/common/transport.hpp"
 
 namespace pathlab {
 
@@ -82,8 +81,8 @@ struct IntegratorOptions {
     int pbgi_direct_samples = 16;
     // Paths of no bounce (emitters and the environment seen directly) are left out (Mitsuba's hide_emitters).
     bool hide_emitters = false;
-    // Spectral mode (docs/spectral.md): paths carry 4 sampled wavelengths instead of RGB; only
-    // integrators whose IntegratorInfo::spectral is true accept it (RenderJob refuses the rest).
+    // Spectral mode (docs/spectral.md): paths carry 4 sampled wavelengths instead of RGB, the
+    // integrator's SpectralTransport instantiation (common/transport.hpp; make_for_transport).
     bool spectral = false;
 };
 
@@ -97,9 +96,6 @@ struct RenderContext {
     int tile_size = 32;  // largest tile edge for pixel integrators (smaller when there are few tiles)
     // The reconstruction filter (render/pixel_filter.hpp); null or box: each sample in its own pixel.
     const PixelFilter* filter = nullptr;
-    // Spectral mode: each camera sample draws its wavelengths (SampledWavelengths) from a stream
-    // RGB mode never reads and the film receives the sample's XYZ estimate as linear sRGB.
-    bool spectral = false;
 
     size_t pixel_count() const { return size_t(width) * size_t(height); }
 };
@@ -134,34 +130,29 @@ public:
 };
 
 // Today's per-pixel estimators: one Monte Carlo estimate of the radiance arriving along a
-// camera ray. Sample s of pixel p uses Sampler(seed, p, s) (its first 2D sample jitters the
-// ray within the pixel), and each pixel accumulates its samples in index order.
+// camera ray, in the colour of transport T (common/transport.hpp: RGB, or the sample's 4
+// wavelengths, which a dispersive interface may reduce to the hero). Sample s of pixel p uses
+// Sampler(seed, p, s) (its first 2D sample jitters the ray within the pixel; spectral mode's
+// wavelengths come from a stream of their own), and each pixel accumulates its samples in index
+// order, each converted by film_colour.
+template <class T>
 class PixelIntegrator : public Integrator {
 public:
-    virtual Rgb radiance(const Scene& scene, const Ray& ray, Sampler& sampler) const = 0;
-    // Spectral mode: the radiance at the 4 wavelengths `wl` (which a dispersive interface may
-    // reduce to the hero, wl.terminate_secondary()). Only integrators whose IntegratorInfo says
-    // `spectral` override it; the default is never called (RenderJob refuses --spectral first).
-    virtual Spectrum4 radiance_spectral(const Scene&, const Ray&, Sampler&, SampledWavelengths&) const { return Spectrum4(0.0f); }
+    virtual ColourOf<T> radiance(const Scene& scene, const Ray& ray, Sampler& sampler, WavelengthsOf<T>& wl) const = 0;
     PassCounters render_passes(const RenderContext& ctx, Film& film, uint64_t first, int count,
                                const PassProgress& progress) final;
 
 private:
     PassCounters render_filtered_passes(const RenderContext& ctx, Film& film, uint64_t first, int count, const PassProgress& progress);
-    PassCounters render_spectral_passes(const RenderContext& ctx, Film& film, uint64_t first, int count, const PassProgress& progress);
-    // One camera sample's colour: radiance() in RGB mode, the XYZ film estimator of
-    // radiance_spectral() in spectral mode.
-    Rgb sample_colour(const RenderContext& ctx, const Ray& ray, Sampler& sampler) const;
+    // One camera sample's colour for the film.
+    Vec3d sample_colour(const RenderContext& ctx, const Ray& ray, Sampler& sampler) const {
+        WavelengthsOf<T> wl = T::camera_wavelengths(sampler);
+        return film_colour(radiance(ctx.scene, ray, sampler, wl), wl);
+    }
     std::vector<Vec3d> lattice_, filtered_;  // a filtered pass (pixel_filter.hpp)
 };
-
-// The stream of a camera sample's wavelength number (Sampler::fork), apart from every stream
-// RGB mode reads, so spectral mode leaves RGB mode's random numbers where they are.
-inline constexpr uint64_t kWavelengthStream = 0x5ec7a1e9f00d0001ull;
-// A camera sample's wavelengths: a pure function of the sample's (seed, pixel, index).
-inline SampledWavelengths sample_camera_wavelengths(const Sampler& sampler) {
-    return SampledWavelengths::sample_visible(sampler.fork(kWavelengthStream).next1d());
-}
+extern template class PixelIntegrator<RgbTransport>;
+extern template class PixelIntegrator<SpectralTransport>;
 
 // The lattice shift of a filtered pass: every pixel's sample of that pass is at pixel + shift.
 Vec2f filter_shift(const RenderContext& ctx, uint64_t pass);
@@ -186,10 +177,18 @@ struct IntegratorInfo {
     bool any_camera = true;
     bool any_filter = true;
     // Renders in spectral mode (--spectral); the others refuse it.
-    bool spectral = false;
+    bool spectral = true;
 
     PluginInfo plugin() const;
 };
+
+// IntegratorInfo::make of an integrator written once (a class template over the transport, whose
+// constructor takes the options first): its instantiation for the transport the options ask for.
+template <template <class> class I, class... Args>
+std::unique_ptr<Integrator> make_for_transport(const IntegratorOptions& options, const Args&... args) {
+    if (options.spectral) return std::make_unique<I<SpectralTransport>>(options, args...);
+    return std::make_unique<I<RgbTransport>>(options, args...);
+}
 
 const std::vector<IntegratorInfo>& integrators();
 const IntegratorInfo* find_integrator(const std::string& name_or_alias);

@@ -8,14 +8,13 @@
 #include <atomic>
 
 #include "integrators/integrator.hpp"
-#include "spectral/xyz_estimator.hpp"
 
 namespace pathlab {
 
-PassCounters PixelIntegrator::render_passes(const RenderContext& ctx, Film& film, uint64_t first, int count,
-                                            const PassProgress& progress) {
+template <class T>
+PassCounters PixelIntegrator<T>::render_passes(const RenderContext& ctx, Film& film, uint64_t first, int count,
+                                               const PassProgress& progress) {
     if (ctx.filter && !ctx.filter->is_box()) return render_filtered_passes(ctx, film, first, count, progress);
-    if (ctx.spectral) return render_spectral_passes(ctx, film, first, count, progress);
     const int w = ctx.width, h = ctx.height;
     // Tiles small enough that every worker gets several (small images still use all cores).
     const int workers = std::max(1, tbb::this_task_arena::max_concurrency());
@@ -40,7 +39,7 @@ PassCounters PixelIntegrator::render_passes(const RenderContext& ctx, Film& film
                         const Vec2f jitter = sampler.next2d();
                         const Ray ray = lens ? ctx.camera.generate(float(x) + jitter.x, float(y) + jitter.y, sampler.next2d())
                                              : ctx.camera.generate(float(x) + jitter.x, float(y) + jitter.y);
-                        const Rgb L = radiance(ctx.scene, ray, sampler);
+                        const Vec3d L = sample_colour(ctx, ray, sampler);
                         if (is_finite(L)) film.add(pixel, L);
                         else ++tile_invalid;
                     }
@@ -57,7 +56,8 @@ PassCounters PixelIntegrator::render_passes(const RenderContext& ctx, Film& film
 // the pass's lattice shift, then the pass filtered into the film as one sample of every pixel.
 // The pixel's own jitter is drawn and not used, so the rest of its random numbers are those of
 // the unfiltered render.
-PassCounters PixelIntegrator::render_filtered_passes(const RenderContext& ctx, Film& film, uint64_t first, int count,
+template <class T>
+PassCounters PixelIntegrator<T>::render_filtered_passes(const RenderContext& ctx, Film& film, uint64_t first, int count,
                                                      const PassProgress& progress) {
     const int w = ctx.width, h = ctx.height;
     const int rows_per_task = std::max(1, 1024 / std::max(1, w));
@@ -80,9 +80,9 @@ PassCounters PixelIntegrator::render_filtered_passes(const RenderContext& ctx, F
                         const float sx = float(x) + shift.x, sy = float(y) + shift.y;
                         const Ray ray = ctx.camera.needs_lens_sample() ? ctx.camera.generate(sx, sy, sampler.next2d())
                                                                        : ctx.camera.generate(sx, sy);
-                        const Rgb L = sample_colour(ctx, ray, sampler);
+                        const Vec3d L = sample_colour(ctx, ray, sampler);
                         if (is_finite(L)) {
-                            lattice_[pixel] = Vec3d(L);
+                            lattice_[pixel] = L;
                         } else {
                             lattice_[pixel] = Vec3d(0.0);
                             ++task_invalid;
@@ -99,59 +99,13 @@ PassCounters PixelIntegrator::render_filtered_passes(const RenderContext& ctx, F
     return {rays.load(), invalid.load()};
 }
 
-// Spectral mode's tile loop: the RGB loop above with the sample's colour from its wavelengths
-// (kept apart so that RGB mode's loop stays exactly what it was).
-PassCounters PixelIntegrator::render_spectral_passes(const RenderContext& ctx, Film& film, uint64_t first, int count,
-                                                     const PassProgress& progress) {
-    const int w = ctx.width, h = ctx.height;
-    const int workers = std::max(1, tbb::this_task_arena::max_concurrency());
-    int ts = std::max(1, ctx.tile_size);
-    while (ts > 4 && ((w + ts - 1) / ts) * ((h + ts - 1) / ts) < 4 * workers) ts /= 2;
-    const int tiles_x = (w + ts - 1) / ts, tiles_y = (h + ts - 1) / ts;
-    const int tile_count = tiles_x * tiles_y;
-
-    std::atomic<uint64_t> rays{0}, invalid{0};
-    std::atomic<int> tiles_done{0};
-    const bool lens = ctx.camera.needs_lens_sample();
-    tbb::parallel_for(tbb::blocked_range<int>(0, tile_count, 1), [&](const tbb::blocked_range<int>& range) {
-        for (int tile = range.begin(); tile != range.end(); ++tile) {
-            const uint64_t rays_before = Scene::rays_traced_by_this_thread();
-            uint64_t tile_invalid = 0;
-            const int x0 = (tile % tiles_x) * ts, y0 = (tile / tiles_x) * ts;
-            for (int y = y0; y < std::min(y0 + ts, h); ++y)
-                for (int x = x0; x < std::min(x0 + ts, w); ++x) {
-                    const size_t pixel = size_t(y) * size_t(w) + size_t(x);
-                    for (int k = 0; k < count; ++k) {
-                        Sampler sampler(ctx.seed, pixel, first + uint64_t(k), ctx.sampler);
-                        const Vec2f jitter = sampler.next2d();
-                        const Ray ray = lens ? ctx.camera.generate(float(x) + jitter.x, float(y) + jitter.y, sampler.next2d())
-                                             : ctx.camera.generate(float(x) + jitter.x, float(y) + jitter.y);
-                        SampledWavelengths wl = sample_camera_wavelengths(sampler);
-                        const Spectrum4 L = radiance_spectral(ctx.scene, ray, sampler, wl);
-                        const Vec3d rgb = spectral_sample_to_linear_srgb(L, wl);
-                        if (std::isfinite(rgb.x) && std::isfinite(rgb.y) && std::isfinite(rgb.z)) film.add(pixel, rgb);
-                        else ++tile_invalid;
-                    }
-                }
-            rays += Scene::rays_traced_by_this_thread() - rays_before;
-            invalid += tile_invalid;
-            if (progress) progress(double(++tiles_done) / tile_count);
-        }
-    });
-    return {rays.load(), invalid.load()};
-}
-
-Rgb PixelIntegrator::sample_colour(const RenderContext& ctx, const Ray& ray, Sampler& sampler) const {
-    if (!ctx.spectral) return radiance(ctx.scene, ray, sampler);
-    SampledWavelengths wl = sample_camera_wavelengths(sampler);
-    const Spectrum4 L = radiance_spectral(ctx.scene, ray, sampler, wl);
-    return Rgb(spectral_sample_to_linear_srgb(L, wl));
-}
-
 Vec2f filter_shift(const RenderContext& ctx, uint64_t pass) {
     // A stream no pixel or path index uses.
     Sampler sampler(ctx.seed, ~uint64_t(0), pass, ctx.sampler);
     return sampler.next2d();
 }
+
+template class PixelIntegrator<RgbTransport>;
+template class PixelIntegrator<SpectralTransport>;
 
 }  // namespace pathlab

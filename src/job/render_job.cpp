@@ -1,4 +1,4 @@
-#include "integrators/common/spectral_shading.hpp"
+#include "bsdfs/spectral_bsdf.hpp"
 #include "job/render_job.hpp"
 
 #include <algorithm>

@@ -77,7 +77,7 @@ RenderStats render_into(const Scene& scene, Integrator& integrator, const Render
     const int rank_count = ranks.size(), me = ranks.rank();
     const PerspectiveCamera camera(scene.camera(), w, h);
     const PixelFilter filter(scene.description().filter, w, h);
-    const RenderContext ctx{scene, camera, w, h, settings.seed, settings.sampler, settings.tile_size, &filter, settings.spectral};
+    const RenderContext ctx{scene, camera, w, h, settings.seed, settings.sampler, settings.tile_size, &filter};
     const bool show_progress = settings.progress && ranks.root();
     Progress progress(show_progress);
     const auto start = std::chrono::steady_clock::now();

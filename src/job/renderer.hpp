@@ -61,7 +61,7 @@ struct RenderSettings {
     double time_limit = 0;      // seconds; 0: none
     uint64_t seed = 0;
     SamplerKind sampler = SamplerKind::Independent;
-    bool spectral = false;      // spectral mode (RenderContext::spectral)
+    bool spectral = false;      // spectral mode: the integrator was made for it (IntegratorOptions::spectral); outputs say so
     uint64_t first_sample = 0;  // sample index of the first pass
     int tile_size = 32;         // largest tile edge; smaller when the image has too few tiles
     bool progress = false;      // progress line on stderr

@@ -2,12 +2,12 @@
 // tracer asks of a medium along a ray segment: where the path scatters next (free-flight
 // sampling) and how much light gets through (transmittance). docs/volumes.md derives both.
 //
-// Free-flight sampling, per RGB channel, with a hero channel h and spectral MIS (Miller,
+// Free-flight sampling, per RGB channel (or spectral lane), with a hero channel h and spectral MIS (Miller,
 // Georgiev and Jarosz 2019): the path is sampled with channel h's coefficients, h uniform among
 // the three, and its contribution f_c / p_h is replaced by f_c / mean_k p_k, the one-sample
 // balance heuristic over the three channels' sampling techniques. The integrator carries
 // beta_c = f_c / q and r_k = p_k / q for any common normaliser q (each step divides by the
-// largest p_k, so r <= 1), and a contribution is beta * L / mean(r). Both functions below
+// largest p_k, so r <= 1), and a contribution is beta * L / mean(r). free_flight.hpp's two functions
 // multiply beta and r by the step's factors:
 //  - homogeneous media sample the distance exactly: t ~ sigma_t,h exp(-sigma_t,h t);
 //      scatter at t:  f_c = sigma_s,c exp(-sigma_t,c t),  p_k = sigma_t,k exp(-sigma_t,k t)
@@ -27,6 +27,7 @@
 #include <variant>
 
 #include "media/heterogeneous.hpp"
+#include "media/free_flight.hpp"
 #include "media/homogeneous.hpp"
 #include "samplers/sampler.hpp"
 
@@ -38,31 +39,27 @@ inline const PhaseFunction& medium_phase(const Medium& m) {
     return std::visit([](const auto& x) -> const PhaseFunction& { return x.phase; }, m);
 }
 
-struct MediumCoefficients {
-    Rgb sigma_t, sigma_s;
-};
+using MediumCoefficients = MediumCoefficientsOf<Rgb>;
 MediumCoefficients medium_coefficients(const Medium& m, const Vec3f& p);
 
-// Where free-flight sampling ended: a real collision (scattering) at distance t, or no
-// collision before tmax.
-struct FreeFlight {
-    bool scattered = false;
-    float t = 0;
+// A medium seen in RGB (free_flight.hpp's view): its coefficients per channel.
+struct MediumRgb {
+    using Colour = Rgb;
+    const Medium& m;
+    bool constant_extinction(Rgb& sigma_t) const;
+    Rgb extinction(const Vec3f& p) const;
+    MediumCoefficients coefficients(const Vec3f& p) const { return medium_coefficients(m, p); }
+    MajorantIterator majorants(const Vec3f& o, const Vec3f& d, float tmax, float factor, float& scale) const;
 };
 
-// Samples the first scattering along o + t d (d a unit vector) for t in [0, tmax) with hero
-// channel `hero`, multiplying beta and r as above; the random numbers come from `rng`.
-// majorant_factor > 1 inflates the majorant (null collisions in homogeneous media too; the
-// tests use it, renders do not).
-FreeFlight sample_free_flight(const Medium& m, const Vec3f& o, const Vec3f& d, float tmax, int hero, Sampler& rng, Rgb& beta,
-                              Rgb& r, float majorant_factor = 1);
-
-// An unbiased estimate of the transmittance along o + t d, t in [0, tmax] (closed form where
-// the extinction is constant, unless majorant_factor > 1 asks for ratio tracking).
-Rgb estimate_transmittance(const Medium& m, const Vec3f& o, const Vec3f& d, float tmax, Sampler& rng, float majorant_factor = 1);
-
-// exp(-sigma_t d) per channel, with exp(-0 x inf) = 1.
-Rgb homogeneous_transmittance(const Rgb& sigma_t, float distance);
+// free_flight.hpp's sampling and transmittance in RGB, hero channel `hero`.
+inline FreeFlight sample_free_flight(const Medium& m, const Vec3f& o, const Vec3f& d, float tmax, int hero, Sampler& rng, Rgb& beta,
+                                     Rgb& r, float majorant_factor = 1) {
+    return sample_free_flight(MediumRgb{m}, o, d, tmax, hero, rng, beta, r, majorant_factor);
+}
+inline Rgb estimate_transmittance(const Medium& m, const Vec3f& o, const Vec3f& d, float tmax, Sampler& rng, float majorant_factor = 1) {
+    return estimate_transmittance(MediumRgb{m}, o, d, tmax, rng, majorant_factor);
+}
 
 // The density of the free-flight distance t in a homogeneous medium for hero channel h (its
 // sampling pdf): sigma_t,h exp(-sigma_t,h t); the probability of passing tmax is exp(-sigma_t,h tmax).

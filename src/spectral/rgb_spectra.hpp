@@ -65,4 +65,15 @@ private:
     RgbUnboundedSpectrum unbounded_;
 };
 
+// The same spectra at a path's 4 wavelengths, as spectral mode evaluates every RGB input
+// (materials, media, emitters): a reflectance (RgbAlbedoSpectrum; a colour above 1 as
+// RgbUnboundedSpectrum), any non-negative value (RgbUnboundedSpectrum) and an emitter's radiance
+// (RgbIlluminantSpectrum). The table's lookups go through a direct-mapped per-thread cache keyed
+// by the exact RGB bits, so a constant colour is looked up once per thread (a hit pays the
+// 4-lane sigmoid only) and a textured one per hit; the cache returns exactly what the lookup
+// would, so images do not depend on threads.
+Spectrum4 reflectance_spectrum(const Rgb& rgb, const SampledWavelengths& wl);
+Spectrum4 unbounded_spectrum(const Rgb& rgb, const SampledWavelengths& wl);
+Spectrum4 illuminant_spectrum(const Rgb& rgb, const SampledWavelengths& wl);
+
 }  // namespace pathlab

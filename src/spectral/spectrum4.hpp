@@ -55,6 +55,11 @@ struct Spectrum4 {
     }
 };
 
+// The free functions RGB colours have (core/vec.hpp), so that code written once for both reads alike.
+constexpr bool is_black(const Spectrum4& s) { return s.is_black(); }
+inline bool is_finite(const Spectrum4& s) { return s.is_finite(); }
+constexpr float max_component(const Spectrum4& s) { return s.max_value(); }
+
 // a / b with 0 where b is 0 (a pdf lane of a terminated wavelength).
 constexpr Spectrum4 safe_div(Spectrum4 a, const Spectrum4& b) {
     for (int i = 0; i < kSpectrumLanes; ++i) a[i] = b[i] != 0 ? a[i] / b[i] : 0.0f;

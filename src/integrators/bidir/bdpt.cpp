@@ -6,20 +6,23 @@
 #include <atomic>
 
 #include "integrators/bidir/strategy_images.hpp"
+#include "integrators/common/light_path_start.hpp"
 #include "integrators/integrators.hpp"
 
 namespace pathlab {
 namespace {
 
 // The BSDF of surface vertex v for light leaving towards the world direction w (the mode of v's
-// subpath: radiance on the camera side, importance on the light side).
+// subpath: radiance on the camera side, importance on the light side), at the wavelengths wl.
 // Also the solid-angle density with which v's BSDF samples w (which the MIS weight needs).
-Rgb bsdf_towards(const PathVertex& v, const Vec3f& w, float& pdfW) {
-    return v.sp.material->eval_and_pdf(v.sp, v.sp.wi, v.sp.frame.to_local(w), pdfW);
+template <class Wl>
+ColourAt<Wl> bsdf_towards(const PathVertexBase& v, const Vec3f& w, float& pdfW, const Wl& wl) {
+    const Vec3f wo = v.sp.frame.to_local(w);
+    return bsdf_colour(v.sp, wo, v.sp.material->eval_and_pdf(v.sp, v.sp.wi, wo, pdfW), wl);
 }
 
 // |cos| at v of the world direction w, with the shading normal (1 for points).
-float cos_at(const PathVertex& v, const Vec3f& w) {
+float cos_at(const PathVertexBase& v, const Vec3f& w) {
     return v.kind == VertexKind::Surface ? std::abs(dot(v.sp.frame.n, w)) : (v.has_normal() ? std::abs(dot(v.n, w)) : 1.0f);
 }
 
@@ -32,19 +35,22 @@ float cos_at(const PathVertex& v, const Vec3f& w) {
 
 }  // namespace
 
-Bdpt::Bdpt(const IntegratorOptions& options, BdptFaults faults)
+template <class T>
+Bdpt<T>::Bdpt(const IntegratorOptions& options, BdptFaults faults)
     : options_(limited_to_length(options)), faults_(faults),
       max_bounces_(options_.max_depth < 0 ? kMaxBounces : std::min(options_.max_depth, kMaxBounces)) {
     if (!options.strategies_dir.empty())
         strategies_ = std::make_unique<StrategyImages>(std::min(options.strategies_depth, max_bounces_), options.strategies_dir);
 }
 
-Bdpt::~Bdpt() = default;
+template <class T>
+Bdpt<T>::~Bdpt() = default;
 
-void Bdpt::random_walk(const RenderContext& ctx, Ray ray, Sampler& sampler, Rgb beta, float pdfW, int max_vertices,
-                       TransportMode mode, std::vector<PathVertex>& path) const {
+template <class T>
+void Bdpt<T>::random_walk(const RenderContext& ctx, Ray ray, Sampler& sampler, Colour beta, float pdfW, int max_vertices,
+                          TransportMode mode, Wavelengths wl, Subpath& path) const {
     const Scene& scene = ctx.scene;
-    Rgb scatter(1.0f);  // the throughput of the scattering alone, for Russian roulette
+    Colour scatter(1.0f);  // the throughput of the scattering alone, for Russian roulette
     for (int bounces = 0;; ++bounces) {
         if (int(path.size()) >= max_vertices) return;
         const size_t prev = path.size() - 1;
@@ -52,18 +58,19 @@ void Bdpt::random_walk(const RenderContext& ctx, Ray ray, Sampler& sampler, Rgb 
         if (!scene.intersect(ray, hit)) {
             // A camera ray that escapes reaches the environment: a light vertex at infinity.
             if (mode == TransportMode::Radiance && scene.environment_light() >= 0) {
-                PathVertex v;
+                Vertex v;
                 v.kind = VertexKind::Light;
                 v.infinite = true;
                 v.dir = normalize(ray.d);
                 v.light = scene.environment_light();
                 v.beta = beta;
+                v.dispersed = wl.secondary_terminated();
                 v.pdf_fwd = pdfW;  // per unit solid angle
                 path.push_back(v);
             }
             return;
         }
-        PathVertex v;
+        Vertex v;
         v.kind = VertexKind::Surface;
         v.sp = make_shading_point(scene, hit, normalize(ray.d), mode);
         v.p = hit.p;
@@ -71,18 +78,24 @@ void Bdpt::random_walk(const RenderContext& ctx, Ray ray, Sampler& sampler, Rgb 
         v.emitter_n = hit.ng;
         v.light = hit.light;
         v.beta = beta;
+        v.dispersed = wl.secondary_terminated();
         v.pdf_fwd = to_area_density(pdfW, path[prev], v);
         path.push_back(v);
-        PathVertex& cur = path.back();
+        Vertex& cur = path.back();
         if (cur.sp.material->is_black() || int(path.size()) >= max_vertices) return;
 
         cur.sp.reverse_pdf = true;
-        const auto s = cur.sp.material->sample(cur.sp, cur.sp.wi, sampler.next2d());
+        const auto s = bsdf_sample(cur.sp, sampler.next2d(), wl);
         cur.sp.reverse_pdf = false;
         if (!s) return;
-        const Rgb weight = s->f * (std::abs(s->wo.z) / s->pdfW);
+        const Colour weight = bsdf_sample_colour(cur.sp, *s, wl) * (std::abs(s->wo.z) / s->pdfW);
         beta *= weight;
         scatter *= weight;
+        if (wl.secondary_terminated()) {
+            // Dispersion here or before: the next vertex and all after it carry the hero alone.
+            beta = hero_lane(beta);
+            scatter = hero_lane(scatter);
+        }
         pdfW = s->pdfW;
         float pdf_rev = s->pdf_rev;
         if (s->delta) {
@@ -102,47 +115,47 @@ void Bdpt::random_walk(const RenderContext& ctx, Ray ray, Sampler& sampler, Rgb 
     }
 }
 
-void Bdpt::camera_subpath(const RenderContext& ctx, size_t pixel, Sampler& sampler, std::vector<PathVertex>& path,
-                          const Vec2f* shift) const {
+template <class T>
+void Bdpt<T>::camera_subpath(const RenderContext& ctx, size_t pixel, Sampler& sampler, const Wavelengths& wl, Subpath& path,
+                             const Vec2f* shift) const {
     path.clear();
-    PathVertex c;
+    Vertex c;
     c.kind = VertexKind::Camera;
     c.p = ctx.camera.position();
-    c.beta = Rgb(1.0f);
+    c.beta = Colour(1.0f);
     c.pdf_fwd = 1;
     path.push_back(c);
     const Vec2f jitter = shift ? (sampler.next2d(), *shift) : sampler.next2d();
     const float x = float(pixel % size_t(ctx.width)), y = float(pixel / size_t(ctx.width));
     const Ray ray = ctx.camera.generate(x + jitter.x, y + jitter.y);
     // We cos / (pdfA pdfW) = 1 for the pinhole: the camera path starts with throughput 1.
-    random_walk(ctx, ray, sampler, Rgb(1.0f), ctx.camera.pdf_direction(ray.d), max_camera_vertices(), TransportMode::Radiance, path);
+    random_walk(ctx, ray, sampler, Colour(1.0f), ctx.camera.pdf_direction(ray.d), max_camera_vertices(), TransportMode::Radiance, wl, path);
 }
 
-void Bdpt::light_subpath(const RenderContext& ctx, Sampler& sampler, std::vector<PathVertex>& path) const {
+template <class T>
+void Bdpt<T>::light_subpath(const RenderContext& ctx, Sampler& sampler, const Wavelengths& wl, Subpath& path) const {
     path.clear();
     const Scene& scene = ctx.scene;
-    const LightChoice choice = scene.choose_light(sampler.next1d());
-    const Vec2f u_pos = sampler.next2d(), u_dir = sampler.next2d();
-    if (choice.index < 0) return;
-    const Light& light = scene.lights()[size_t(choice.index)];
-    const auto es = sample_emission(light, u_pos, u_dir, scene.scene_sphere());
-    if (!es || is_black(es->Le) || !(es->pdfA > 0) || !(es->pdfW > 0)) return;
-    const uint32_t flags = light_flags(light);
-    PathVertex l;
+    const auto start = start_light_path(scene, sampler);
+    if (!start) return;
+    const LightChoice& choice = start->choice;
+    const EmissionSample* es = &start->emission;
+    const uint32_t flags = start->flags;
+    Vertex l;
     l.kind = VertexKind::Light;
     l.p = es->origin;
     l.infinite = (flags & kLightInfinite) != 0;
-    l.delta_light = is_delta_light(light);
+    l.delta_light = is_delta_light(*start->light);
     l.dir = -es->direction;
     l.n = (flags & kLightSurface) ? es->normal : Vec3f(0.0f);
     l.emitter_n = es->normal;
     l.light = choice.index;
-    l.beta = es->Le;
+    l.beta = light_colour(scene, choice.index, es->Le, wl);
     l.pdf_fwd = choice.pmf * es->pdfA;
     path.push_back(l);
-    const Rgb beta = es->Le * (es->cos / (choice.pmf * es->pdfA * es->pdfW));
+    const Colour beta = l.beta * (es->cos / (choice.pmf * es->pdfA * es->pdfW));
     const Ray ray = (flags & kLightSurface) ? spawn_ray(es->origin, es->normal, es->direction) : Ray{es->origin, es->direction, kInf};
-    random_walk(ctx, ray, sampler, beta, es->pdfW, max_light_vertices(), TransportMode::Importance, path);
+    random_walk(ctx, ray, sampler, beta, es->pdfW, max_light_vertices(), TransportMode::Importance, wl, path);
     if (l.infinite) {
         // From infinity the first hit's density is that of the entry disk, projected; the light
         // vertex's own density is that of its direction under light sampling.
@@ -151,21 +164,22 @@ void Bdpt::light_subpath(const RenderContext& ctx, Sampler& sampler, std::vector
     }
 }
 
-float Bdpt::mis_weight(const RenderContext& ctx, std::vector<PathVertex>& light, int s, std::vector<PathVertex>& camera, int t,
-                       const PathVertex& sampled, const EdgeDensities& known, const MergeMis* vm) const {
+template <class T>
+float Bdpt<T>::mis_weight(const RenderContext& ctx, Subpath& light, int s, Subpath& camera, int t, const Vertex& sampled,
+                          const EdgeDensities& known, const MergeMis* vm) const {
     if (s + t == 2) return 1.0f;
     const Scene& scene = ctx.scene;
     // The strategy's own vertices: the sampled endpoint (y_0 for s = 1, z_0 for t = 1: the only
     // vertex of its side the walk reads), and the densities across the new edge.
-    PathVertex end = sampled;
-    PathVertex* const ys = s == 1 ? &end : light.data();
-    PathVertex* const zs = t == 1 ? &end : camera.data();
-    PathVertex* qs = s > 0 ? &ys[s - 1] : nullptr;
-    PathVertex* pt = &zs[t - 1];
-    PathVertex* qs_minus = s > 1 ? &ys[s - 2] : nullptr;
-    PathVertex* pt_minus = t > 1 ? &zs[t - 2] : nullptr;
+    Vertex end = sampled;
+    Vertex* const ys = s == 1 ? &end : light.data();
+    Vertex* const zs = t == 1 ? &end : camera.data();
+    Vertex* qs = s > 0 ? &ys[s - 1] : nullptr;
+    Vertex* pt = &zs[t - 1];
+    Vertex* qs_minus = s > 1 ? &ys[s - 2] : nullptr;
+    Vertex* pt_minus = t > 1 ? &zs[t - 2] : nullptr;
     struct Saved {
-        PathVertex* v;
+        Vertex* v;
         float pdf_rev;
         bool delta;
     };
@@ -207,32 +221,33 @@ float Bdpt::mis_weight(const RenderContext& ctx, std::vector<PathVertex>& light,
     return w;
 }
 
-StrategyResult Bdpt::connect(const RenderContext& ctx, std::vector<PathVertex>& light, int s, std::vector<PathVertex>& camera, int t,
-                             Sampler& sampler, const MergeMis* vm) const {
+template <class T>
+StrategyResult<T> Bdpt<T>::connect(const RenderContext& ctx, Subpath& light, int s, Subpath& camera, int t, Sampler& sampler,
+                                   const Wavelengths& wl, const MergeMis* vm) const {
     const Scene& scene = ctx.scene;
-    StrategyResult r;
-    PathVertex sampled;
+    StrategyResult<T> r;
+    Vertex sampled;
     EdgeDensities known;  // the BSDF densities across the new edge, from the evaluations below
-    const PathVertex& pt = camera[size_t(t - 1)];
+    const Vertex& pt = camera[size_t(t - 1)];
     // A camera subpath that escaped ends at infinity: only s = 0 can use that vertex.
     if (t > 1 && s != 0 && pt.kind == VertexKind::Light) return r;
     if (s == 0) {
         if (pt.kind == VertexKind::Light) {
-            r.L = pt.beta * scene.escaped_radiance(pt.dir);
+            r.L = pt.beta * escaped_radiance(scene, pt.dir, wl);
         } else if (pt.light >= 0) {
             const Vec3f w = normalize(camera[size_t(t - 2)].p - pt.p);
-            if (dot(pt.emitter_n, w) > 0) r.L = pt.beta * surface_radiance(scene.lights()[size_t(pt.light)]);
+            if (dot(pt.emitter_n, w) > 0) r.L = pt.beta * light_colour(scene, pt.light, surface_radiance(scene.lights()[size_t(pt.light)]), wl);
         }
     } else if (t == 1) {
-        const PathVertex& qs = light[size_t(s - 1)];
+        const Vertex& qs = light[size_t(s - 1)];
         if (!qs.connectible() || qs.kind != VertexKind::Surface) return r;
         const auto k = ctx.camera.connect(qs.p);
         if (!k) return r;
         sampled.kind = VertexKind::Camera;
         sampled.p = ctx.camera.position();
-        sampled.beta = Rgb(k->We / k->pdfW);
-        r.L = qs.beta * bsdf_towards(qs, k->wi, known.qs_to_pt) * sampled.beta * cos_at(qs, k->wi);
-        if (is_black(r.L) || scene.occluded(qs.segment_to(sampled))) return StrategyResult{};
+        sampled.beta = Colour(k->We / k->pdfW);
+        r.L = qs.beta * bsdf_towards(qs, k->wi, known.qs_to_pt, wl) * sampled.beta * cos_at(qs, k->wi);
+        if (is_black(r.L) || scene.occluded(qs.segment_to(sampled))) return StrategyResult<T>{};
         r.splat = true;
         r.raster = k->raster;
     } else if (s == 1) {
@@ -252,28 +267,30 @@ StrategyResult Bdpt::connect(const RenderContext& ctx, std::vector<PathVertex>& 
         sampled.n = (flags & kLightSurface) ? ls->normal : Vec3f(0.0f);
         sampled.emitter_n = ls->normal;
         sampled.light = choice.index;
-        sampled.beta = ls->Le / (choice.pmf * ls->pdfW);
+        sampled.beta = light_colour(scene, choice.index, ls->Le, wl) / (choice.pmf * ls->pdfW);
         sampled.pdf_fwd = pdf_light_origin(scene, sampled, pt);
-        r.L = pt.beta * bsdf_towards(pt, ls->wi, known.pt_to_qs) * sampled.beta * cos_at(pt, ls->wi);
-        if (is_black(r.L) || scene.occluded(pt.segment_to(sampled))) return StrategyResult{};
+        r.L = pt.beta * bsdf_towards(pt, ls->wi, known.pt_to_qs, wl) * sampled.beta * cos_at(pt, ls->wi);
+        if (is_black(r.L) || scene.occluded(pt.segment_to(sampled))) return StrategyResult<T>{};
     } else {
-        const PathVertex& qs = light[size_t(s - 1)];
+        const Vertex& qs = light[size_t(s - 1)];
         if (!qs.connectible() || !pt.connectible() || qs.kind != VertexKind::Surface) return r;
         const Vec3f d = qs.p - pt.p;
         const float dist2 = dot(d, d);
         if (!(dist2 > 0)) return r;
         const Vec3f w = d / std::sqrt(dist2);  // from pt towards qs
         const float G = cos_at(pt, w) * cos_at(qs, w) / dist2;
-        r.L = qs.beta * bsdf_towards(qs, -w, known.qs_to_pt) * bsdf_towards(pt, w, known.pt_to_qs) * pt.beta * G;
-        if (is_black(r.L) || scene.occluded(pt.segment_to(qs))) return StrategyResult{};
+        r.L = qs.beta * bsdf_towards(qs, -w, known.qs_to_pt, wl) * bsdf_towards(pt, w, known.pt_to_qs, wl) * pt.beta * G;
+        if (is_black(r.L) || scene.occluded(pt.segment_to(qs))) return StrategyResult<T>{};
     }
     if (is_black(r.L)) return r;
+    // A path through a dispersive vertex on either side is the hero's estimate, once.
+    if ((s >= 2 && light[size_t(s - 1)].dispersed) || (t >= 2 && camera[size_t(t - 1)].dispersed)) r.L = hero_only(r.L);
     r.weight = mis_weight(ctx, light, s, camera, t, sampled, known, vm);
     return r;
 }
 
-PassCounters Bdpt::render_passes(const RenderContext& ctx, Film& film, uint64_t first, int count, const PassProgress& progress) {
-    if (ctx.spectral) return render_spectral_passes(ctx, film, first, count, progress);  // bdpt_spectral.cpp
+template <class T>
+PassCounters Bdpt<T>::render_passes(const RenderContext& ctx, Film& film, uint64_t first, int count, const PassProgress& progress) {
     const size_t pixels = ctx.pixel_count(), per_chunk = chunk_size(pixels);
     const int chunks = int((pixels + per_chunk - 1) / per_chunk);
     const int strategies_depth = strategies_ ? strategies_->max_length() : -1;
@@ -295,21 +312,28 @@ PassCounters Bdpt::render_passes(const RenderContext& ctx, Film& film, uint64_t 
                 for (size_t pixel = size_t(c) * per_chunk; pixel < std::min(pixels, size_t(c + 1) * per_chunk); ++pixel) {
                     Sampler camera_sampler(ctx.seed, pixel, pass, ctx.sampler);
                     Sampler light_sampler(ctx.seed, sample_stream(pixel, 1), pass, ctx.sampler);
-                    camera_subpath(ctx, pixel, camera_sampler, camera, filtered ? &shift : nullptr);
-                    light_subpath(ctx, light_sampler, light);
+                    // The camera sample's wavelengths (as PixelIntegrator's), for both subpaths.
+                    const Wavelengths wl = T::camera_wavelengths(camera_sampler);
+                    camera_subpath(ctx, pixel, camera_sampler, wl, camera, filtered ? &shift : nullptr);
+                    light_subpath(ctx, light_sampler, wl, light);
+                    // The pixel's own contributions (t >= 2) are summed and converted once; each
+                    // light-tracing splat (t = 1) on its own.
+                    typename T::SampleSum own(0.0f);
                     for_each_connection(
-                        ctx, pixel, pass, light, camera, nullptr,
-                        [&](int s, int t, const StrategyResult& r) {
-                            const Rgb value = r.L * r.weight;
+                        ctx, pixel, pass, light, camera, wl, nullptr,
+                        [&](int s, int t, const StrategyResult<T>& r) {
+                            const Colour value = r.L * r.weight;
                             if (!is_finite(value)) return void(++chunk_invalid);
                             const uint32_t target = r.splat ? uint32_t(ctx.camera.pixel_of(r.raster)) : uint32_t(pixel);
-                            if (r.splat && filtered) splats.add_at(r.raster, value);
-                            else if (r.splat) splats.add(target, value);
-                            else pass_.pixel(pixel) += Vec3d(value);
+                            if (r.splat && filtered) splats.add_at(r.raster, Rgb(film_colour(value, wl)));
+                            else if (r.splat) splats.add(target, Rgb(film_colour(value, wl)));
+                            else accumulate(own, value);
                             if (s + t - 2 <= strategies_depth)
-                                strategies_->chunk(c).push_back({target, uint16_t(StrategyImages::index(s, t)), value, r.L});
+                                strategies_->chunk(c).push_back({target, uint16_t(StrategyImages::index(s, t)), Rgb(film_colour(value, wl)),
+                                                                 Rgb(film_colour(r.L, wl))});
                         },
                         [](int) {});
+                    pass_.pixel(pixel) += film_colour(own, wl);
                 }
                 rays += Scene::rays_traced_by_this_thread() - rays_before;
                 invalid += chunk_invalid;
@@ -322,15 +346,18 @@ PassCounters Bdpt::render_passes(const RenderContext& ctx, Film& film, uint64_t 
     return {rays.load(), invalid.load()};
 }
 
-void Bdpt::finish(const RenderContext&) {
+template <class T>
+void Bdpt<T>::finish(const RenderContext&) {
     if (strategies_) strategies_->write();
 }
 
+template class Bdpt<RgbTransport>;
+template class Bdpt<SpectralTransport>;
+
 const IntegratorInfo& bdpt_integrator() {
     static const IntegratorInfo info{"bdpt", {"bpt"}, "bidirectional path tracing: every connection strategy (s, t), combined by MIS",
-                                     false, true, path_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
-                                         return std::make_unique<Bdpt>(o);
-                                     }, false, true, /*spectral=*/true};
+                                     false, true, path_params(), [](const IntegratorOptions& o) { return make_for_transport<Bdpt>(o); },
+                                     /*any_camera=*/false};
     return info;
 }
 

@@ -27,6 +27,16 @@
 //
 // `--strategies DIR` also writes, for paths of up to --strategies-depth bounces, one image per
 // strategy, weighted and unweighted (strategy_images.hpp).
+//
+// Spectral mode (the SpectralTransport instantiation, docs/spectral.md): each pixel sample draws
+// its wavelengths as the pixel integrators do and traces BOTH subpaths at them, so that a
+// connection multiplies throughputs lane by lane at the same wavelengths; the weights depend on
+// the geometry and densities only. A subpath that scatters at a dispersive interface continues
+// with the hero wavelength alone (its vertices from there on are `dispersed`); a strategy whose
+// path contains such a vertex, on either side, is the hero's estimate: hero_only(L), the factor 4
+// of terminate_secondary() applied once for the whole path, even when both subpaths met
+// dispersion (they share the hero). A pixel's own contributions are summed at the wavelengths
+// and converted once; each light-tracing splat on its own.
 #pragma once
 
 #include <tbb/enumerable_thread_specific.h>
@@ -35,7 +45,6 @@
 #include <vector>
 
 #include "integrators/bidir/path_vertex.hpp"
-#include "integrators/bidir/spectral_subpath.hpp"
 #include "integrators/common/path_rules.hpp"
 #include "integrators/integrator.hpp"
 #include "render/pass_image.hpp"
@@ -50,19 +59,11 @@ struct BdptFaults {
     bool specular_pdf_rev_missing = false;  // a Dirac vertex's reverse density left unset (0)
 };
 
-// What one strategy gives for one sample: the unweighted contribution, its MIS weight, and for
-// t = 1 the raster position it lands on.
+// What one strategy gives for one sample: the unweighted contribution (a path through
+// dispersion already as hero_only()), its MIS weight, and for t = 1 the raster position it lands on.
+template <class T>
 struct StrategyResult {
-    Rgb L{0.0f};
-    float weight = 0;
-    bool splat = false;
-    Vec2f raster;
-};
-
-// The same in spectral mode: the contribution at the camera sample's wavelengths (a path through
-// dispersion already as hero_only(), hero_only.hpp).
-struct SpectralStrategyResult {
-    Spectrum4 L{0.0f};
+    ColourOf<T> L{0.0f};
     float weight = 0;
     bool splat = false;
     Vec2f raster;
@@ -75,8 +76,14 @@ struct EdgeDensities {
     float qs_to_pt = -1;  // y_{s-1}'s BSDF sampling the direction to z_{t-1}
 };
 
+template <class T>
 class Bdpt final : public Integrator {
 public:
+    using Colour = ColourOf<T>;
+    using Wavelengths = WavelengthsOf<T>;
+    using Vertex = PathVertex<T>;
+    using Subpath = std::vector<Vertex>;
+
     explicit Bdpt(const IntegratorOptions& options, BdptFaults faults = {});
     ~Bdpt() override;
 
@@ -84,26 +91,26 @@ public:
                                const PassProgress& progress) override;
     void finish(const RenderContext& ctx) override;
 
-    // The subpaths of one sample (for the tests and the per-pixel loop).
+    // The subpaths of one sample at its wavelengths wl (for the tests and the per-pixel loop).
     // `shift`: with a reconstruction filter, the pass's lattice shift replaces the pixel's jitter.
-    void camera_subpath(const RenderContext& ctx, size_t pixel, Sampler& sampler, std::vector<PathVertex>& path,
+    void camera_subpath(const RenderContext& ctx, size_t pixel, Sampler& sampler, const Wavelengths& wl, Subpath& path,
                         const Vec2f* shift = nullptr) const;
-    void light_subpath(const RenderContext& ctx, Sampler& sampler, std::vector<PathVertex>& path) const;
+    void light_subpath(const RenderContext& ctx, Sampler& sampler, const Wavelengths& wl, Subpath& path) const;
     // Strategy (s, t) on the subpaths (which it may modify temporarily); `vm`: the merging
     // strategies that also take part in its MIS weight (vcm).
-    StrategyResult connect(const RenderContext& ctx, std::vector<PathVertex>& light, int s, std::vector<PathVertex>& camera, int t,
-                           Sampler& sampler, const MergeMis* vm = nullptr) const;
+    StrategyResult<T> connect(const RenderContext& ctx, Subpath& light, int s, Subpath& camera, int t, Sampler& sampler,
+                              const Wavelengths& wl, const MergeMis* vm = nullptr) const;
     // The MIS weight of strategy (s, t); `sampled` replaces y_0 (s = 1) or z_0 (t = 1).
-    float mis_weight(const RenderContext& ctx, std::vector<PathVertex>& light, int s, std::vector<PathVertex>& camera, int t,
-                     const PathVertex& sampled, const EdgeDensities& known = {}, const MergeMis* vm = nullptr) const;
+    float mis_weight(const RenderContext& ctx, Subpath& light, int s, Subpath& camera, int t, const Vertex& sampled,
+                     const EdgeDensities& known = {}, const MergeMis* vm = nullptr) const;
 
     // Every connection strategy of one pixel sample, in bdpt's order and from its random
     // streams: strategy(s, t, result) for each one with a contribution, and after_vertex(t) once
     // those ending at camera vertex t are done. `vm`: merging strategies in the weights (vcm);
     // with vm->connections off only s = 0 is evaluated.
     template <typename Strategy, typename AfterVertex>
-    void for_each_connection(const RenderContext& ctx, size_t pixel, uint64_t pass, std::vector<PathVertex>& light,
-                             std::vector<PathVertex>& camera, const MergeMis* vm, Strategy&& strategy, AfterVertex&& after_vertex) const {
+    void for_each_connection(const RenderContext& ctx, size_t pixel, uint64_t pass, Subpath& light, Subpath& camera, const Wavelengths& wl,
+                             const MergeMis* vm, Strategy&& strategy, AfterVertex&& after_vertex) const {
         for (int t = 1; t <= int(camera.size()); ++t) {
             Sampler sampler(ctx.seed, sample_stream(pixel, 1 + uint64_t(t)), pass, ctx.sampler);
             // s = 1 samples its own light point: it exists even when the light subpath does not
@@ -114,7 +121,7 @@ public:
                 if ((s == 1 && t == 1) || depth < 0 || depth > max_bounces_) continue;
                 if (options_.only_length >= 0 && depth != options_.only_length) continue;
                 if (options_.hide_emitters && depth == 0) continue;
-                const StrategyResult r = connect(ctx, light, s, camera, t, sampler, vm);
+                const StrategyResult<T> r = connect(ctx, light, s, camera, t, sampler, wl, vm);
                 if (!is_black(r.L)) strategy(s, t, r);
             }
             after_vertex(t);
@@ -129,36 +136,6 @@ public:
     bool power_heuristic() const { return options_.mis_power; }
     int max_bounces() const { return max_bounces_; }
 
-    // Spectral mode (bdpt_spectral.cpp): the subpaths of one sample at its wavelengths wl (both
-    // subpaths at the camera sample's), and strategy (s, t) on them, in RGB mode's order, random
-    // streams and MIS weights.
-    void camera_subpath_spectral(const RenderContext& ctx, size_t pixel, Sampler& sampler, const SampledWavelengths& wl,
-                                 SpectralSubpath& path, const Vec2f* shift = nullptr) const;
-    void light_subpath_spectral(const RenderContext& ctx, Sampler& sampler, const SampledWavelengths& wl, SpectralSubpath& path) const;
-    // `vm`: the merging strategies that also take part in the MIS weight (spectral vcm).
-    SpectralStrategyResult connect_spectral(const RenderContext& ctx, SpectralSubpath& light, int s, SpectralSubpath& camera, int t,
-                                            Sampler& sampler, const SampledWavelengths& wl, const MergeMis* vm = nullptr) const;
-    // for_each_connection in spectral mode: the same strategies, order and random streams,
-    // evaluated by connect_spectral (strategy(s, t, SpectralStrategyResult)).
-    template <typename Strategy, typename AfterVertex>
-    void for_each_connection_spectral(const RenderContext& ctx, size_t pixel, uint64_t pass, SpectralSubpath& light,
-                                      SpectralSubpath& camera, const SampledWavelengths& wl, const MergeMis* vm, Strategy&& strategy,
-                                      AfterVertex&& after_vertex) const {
-        for (int t = 1; t <= int(camera.size()); ++t) {
-            Sampler sampler(ctx.seed, sample_stream(pixel, 1 + uint64_t(t)), pass, ctx.sampler);
-            const int s_max = !vm || vm->connections ? std::max(1, int(light.size())) : 0;
-            for (int s = 0; s <= s_max; ++s) {
-                const int depth = s + t - 2;
-                if ((s == 1 && t == 1) || depth < 0 || depth > max_bounces_) continue;
-                if (options_.only_length >= 0 && depth != options_.only_length) continue;
-                if (options_.hide_emitters && depth == 0) continue;
-                const SpectralStrategyResult r = connect_spectral(ctx, light, s, camera, t, sampler, wl, vm);
-                if (!r.L.is_black()) strategy(s, t, r);
-            }
-            after_vertex(t);
-        }
-    }
-
     // The per-strategy films (null without --strategies).
     const StrategyImages* strategy_images() const { return strategies_.get(); }
 
@@ -166,19 +143,17 @@ public:
     int max_light_vertices() const { return max_bounces_ + 1; }
 
 private:
-    void random_walk(const RenderContext& ctx, Ray ray, Sampler& sampler, Rgb beta, float pdfW, int max_vertices,
-                     TransportMode mode, std::vector<PathVertex>& path) const;
-    void random_walk_spectral(const RenderContext& ctx, Ray ray, Sampler& sampler, Spectrum4 beta, float pdfW, int max_vertices,
-                              TransportMode mode, SampledWavelengths wl, SpectralSubpath& path) const;
-    PassCounters render_spectral_passes(const RenderContext& ctx, Film& film, uint64_t first, int count, const PassProgress& progress);
+    void random_walk(const RenderContext& ctx, Ray ray, Sampler& sampler, Colour beta, float pdfW, int max_vertices, TransportMode mode,
+                     Wavelengths wl, Subpath& path) const;
 
     IntegratorOptions options_;
     BdptFaults faults_;
     int max_bounces_;
     PassImage pass_;
-    tbb::enumerable_thread_specific<std::pair<std::vector<PathVertex>, std::vector<PathVertex>>> subpaths_;  // camera, light
-    tbb::enumerable_thread_specific<std::pair<SpectralSubpath, SpectralSubpath>> spectral_subpaths_;  // camera, light
+    tbb::enumerable_thread_specific<std::pair<Subpath, Subpath>> subpaths_;  // camera, light
     std::unique_ptr<StrategyImages> strategies_;
 };
+extern template class Bdpt<RgbTransport>;
+extern template class Bdpt<SpectralTransport>;
 
 }  // namespace pathlab

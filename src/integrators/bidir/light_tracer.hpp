@@ -32,6 +32,7 @@ struct LightTracerFaults {
     bool drop_emission_pdf = false;     // leave out 1 / (pdfA pdfW) of the emission sample
 };
 
+template <class T>
 class LightTracer final : public Integrator {
 public:
     explicit LightTracer(const IntegratorOptions& options, LightTracerFaults faults = {})
@@ -41,10 +42,9 @@ public:
                                const PassProgress& progress) override;
 
     // One light path: splats its contributions (pixel, value) into `out`; counts NaN/Inf ones.
+    // In spectral mode the path draws its own wavelengths (from the stream of a camera sample's,
+    // forked from its sampler) and each splat is the film's estimator of its value.
     void trace(const RenderContext& ctx, Sampler& sampler, SplatList& out, uint64_t& invalid) const;
-    // The same in spectral mode (light_tracer_spectral.cpp): the path draws its own wavelengths
-    // and each splat is the film's estimator of its spectral value.
-    void trace_spectral(const RenderContext& ctx, Sampler& sampler, SplatList& out, uint64_t& invalid) const;
 
     // Light paths per chunk of a pass: a function of the pass size only, so that chunking (and
     // with it the order in which splats are added) never depends on the thread count.
@@ -56,5 +56,7 @@ private:
     bool hide_emitters_ = false;
     PassImage pass_;
 };
+extern template class LightTracer<RgbTransport>;
+extern template class LightTracer<SpectralTransport>;
 
 }  // namespace pathlab

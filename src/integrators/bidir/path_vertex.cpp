@@ -4,13 +4,13 @@
 
 namespace pathlab {
 
-Ray PathVertex::segment_to(const PathVertex& to) const {
+Ray PathVertexBase::segment_to(const PathVertexBase& to) const {
     const Vec3f offset_n = kind == VertexKind::Surface ? sp.ng : n;
     if (to.infinite) return is_black(offset_n) ? Ray{p, to.dir, kInf} : spawn_ray(p, offset_n, to.dir);
     return spawn_segment(p, offset_n, to.p, to.kind == VertexKind::Surface ? to.sp.ng : to.n);
 }
 
-float to_area_density(float pdfW, const PathVertex& from, const PathVertex& to) {
+float to_area_density(float pdfW, const PathVertexBase& from, const PathVertexBase& to) {
     if (to.infinite) return pdfW;
     const Vec3f d = to.p - from.p;
     const float dist2 = dot(d, d);
@@ -23,12 +23,12 @@ float to_area_density(float pdfW, const PathVertex& from, const PathVertex& to) 
 namespace {
 
 // The unit direction from `from` towards `to` (for a vertex at infinity, its direction).
-Vec3f direction(const PathVertex& from, const PathVertex& to) { return to.infinite ? to.dir : normalize(to.p - from.p); }
+Vec3f direction(const PathVertexBase& from, const PathVertexBase& to) { return to.infinite ? to.dir : normalize(to.p - from.p); }
 
 }  // namespace
 
-float pdf_next(const Scene& scene, const PerspectiveCamera& camera, const PathVertex* prev, const PathVertex& cur,
-               const PathVertex& next) {
+float pdf_next(const Scene& scene, const PerspectiveCamera& camera, const PathVertexBase* prev, const PathVertexBase& cur,
+               const PathVertexBase& next) {
     if (cur.kind == VertexKind::Light) return pdf_light_emission(scene, cur, next);
     const Vec3f wn = direction(cur, next);
     float pdfW = 0;
@@ -42,7 +42,7 @@ float pdf_next(const Scene& scene, const PerspectiveCamera& camera, const PathVe
     return to_area_density(pdfW, cur, next);
 }
 
-float pdf_light_emission(const Scene& scene, const PathVertex& v, const PathVertex& next) {
+float pdf_light_emission(const Scene& scene, const PathVertexBase& v, const PathVertexBase& next) {
     if (v.light < 0) return 0.0f;
     const SceneSphere sphere = scene.scene_sphere();
     if (v.infinite) {
@@ -61,7 +61,7 @@ float pdf_light_emission(const Scene& scene, const PathVertex& v, const PathVert
     return pdf;
 }
 
-float pdf_light_origin(const Scene& scene, const PathVertex& v, const PathVertex& from) {
+float pdf_light_origin(const Scene& scene, const PathVertexBase& v, const PathVertexBase& from) {
     if (v.light < 0) return 0.0f;
     const Light& light = scene.lights()[size_t(v.light)];
     if (v.infinite) {
@@ -70,13 +70,6 @@ float pdf_light_origin(const Scene& scene, const PathVertex& v, const PathVertex
     }
     const Vec3f w = normalize(from.p - v.p);
     return scene.light_pmf(v.light) * pdf_emission(light, v.p, v.emitter_n, w, scene.scene_sphere()).pdfA;
-}
-
-float mis_weight_ratio_walk(const PathVertex* light, int s, const PathVertex* camera, int t, bool power, const MergeMis* vm) {
-    if (s + t == 2) return 1.0f;  // a light seen directly: only s = 0 samples it (s = t = 1 is not used)
-    const double sum = mis_ratio_sum([light](int i) { return mis_vertex(light[i]); }, s, [camera](int i) { return mis_vertex(camera[i]); },
-                                     t, power, vm);
-    return float(1 / (1 + sum));
 }
 
 }  // namespace pathlab

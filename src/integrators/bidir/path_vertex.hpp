@@ -16,23 +16,28 @@
 #include <vector>
 
 #include "integrators/common/shading.hpp"
+#include "integrators/common/transport.hpp"
 
 namespace pathlab {
 
 enum class VertexKind : unsigned char { Camera, Light, Surface };
 
-struct PathVertex {
+// A vertex apart from the colour its subpath carries there (what the densities and the MIS
+// weights read).
+struct PathVertexBase {
     VertexKind kind = VertexKind::Surface;
     Vec3f p;                 // position (on the entry disk for a light at infinity)
     Vec3f n{0.0f};           // geometric normal for the G term (zero: a point, e.g. the pinhole)
     Vec3f emitter_n{0.0f};   // the emitter's own normal (its emitting side), where it is one
     Vec3f dir{0.0f};         // at infinity: the unit direction from the scene towards the light
     ShadingPoint sp;         // surface vertices: material, frame, arrival direction, mode
-    Rgb beta{0.0f};          // throughput of the subpath up to and including this vertex
     float pdf_fwd = 0, pdf_rev = 0;
     bool delta = false;      // scattered by a Dirac lobe here
     bool infinite = false;   // a light at infinity
     bool delta_light = false;  // a point or directional light
+    // Reached through a dispersive interface (spectral mode): its subpath carries the hero
+    // wavelength alone from here on (the throughput's other lanes are 0).
+    bool dispersed = false;
     int light = -1;          // the light of a light vertex, or of the emitter a surface lies on
 
     bool has_normal() const { return !is_black(n); }
@@ -46,23 +51,29 @@ struct PathVertex {
         return false;
     }
     // Where a connecting ray leaves this vertex for `to` (offset off its surface).
-    Ray segment_to(const PathVertex& to) const;
+    Ray segment_to(const PathVertexBase& to) const;
+};
+
+// A vertex of a subpath of transport T.
+template <class T>
+struct PathVertex : PathVertexBase {
+    ColourOf<T> beta{0.0f};  // throughput of the subpath up to and including this vertex
 };
 
 // The solid-angle density pdfW at `from` of the direction to `to`, as an area density at `to`
 // (kept in solid angle if `to` is at infinity).
-float to_area_density(float pdfW, const PathVertex& from, const PathVertex& to);
+float to_area_density(float pdfW, const PathVertexBase& from, const PathVertexBase& to);
 
 // The density with which `cur` samples `next`, having been reached from `prev` (null for the
 // first vertex of a subpath); per unit area at `next`.
-float pdf_next(const Scene& scene, const PerspectiveCamera& camera, const PathVertex* prev, const PathVertex& cur,
-               const PathVertex& next);
+float pdf_next(const Scene& scene, const PerspectiveCamera& camera, const PathVertexBase* prev, const PathVertexBase& cur,
+               const PathVertexBase& next);
 // The density with which the light at vertex `v` (a light vertex, or a surface on an emitter)
 // emits towards `next`, per unit area at `next`.
-float pdf_light_emission(const Scene& scene, const PathVertex& v, const PathVertex& next);
+float pdf_light_emission(const Scene& scene, const PathVertexBase& v, const PathVertexBase& next);
 // The density with which light sampling chooses and samples `v` as a light's origin (its
 // position for finite lights, its direction for lights at infinity), looking from `from`.
-float pdf_light_origin(const Scene& scene, const PathVertex& v, const PathVertex& from);
+float pdf_light_origin(const Scene& scene, const PathVertexBase& v, const PathVertexBase& from);
 
 // What the MIS weights read of a vertex (so that a weight can be computed with some of a
 // path's densities replaced, without copying its vertices).
@@ -71,7 +82,7 @@ struct MisVertex {
     bool delta, delta_light;
     bool surface;  // a surface vertex (where vertex merging may happen)
 };
-inline MisVertex mis_vertex(const PathVertex& v) { return {v.pdf_fwd, v.pdf_rev, v.delta, v.delta_light, v.kind == VertexKind::Surface}; }
+inline MisVertex mis_vertex(const PathVertexBase& v) { return {v.pdf_fwd, v.pdf_rev, v.delta, v.delta_light, v.kind == VertexKind::Surface}; }
 
 // Vertex merging (vcm, bpm; Georgiev et al. 2012): the strategies a path can also be sampled by.
 // Merging at vertex x (a non-Dirac surface vertex with at least one light vertex before it and
@@ -128,7 +139,12 @@ double mis_ratio_sum(const LightAt& light, int s, const CameraAt& camera, int t,
 // of light[0..s) and camera[0..t), from their stored densities: Veach's ratio walk. `light`
 // and `camera` hold the subpaths with the connecting vertices' densities already updated for
 // this strategy (see Bdpt::mis_weight); vertices are left unchanged.
-float mis_weight_ratio_walk(const PathVertex* light, int s, const PathVertex* camera, int t, bool power,
-                            const MergeMis* vm = nullptr);
+template <class Vertex>
+float mis_weight_ratio_walk(const Vertex* light, int s, const Vertex* camera, int t, bool power, const MergeMis* vm = nullptr) {
+    if (s + t == 2) return 1.0f;  // a light seen directly: only s = 0 samples it (s = t = 1 is not used)
+    const double sum = mis_ratio_sum([light](int i) { return mis_vertex(light[i]); }, s, [camera](int i) { return mis_vertex(camera[i]); },
+                                     t, power, vm);
+    return float(1 / (1 + sum));
+}
 
 }  // namespace pathlab

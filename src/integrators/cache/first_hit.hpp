@@ -27,30 +27,37 @@ inline std::optional<PhongMaterial> cached_diffuse(const ShadingPoint& sp) {
     return phong;
 }
 
-// indirect_irradiance(sp, sampler) returns E_indirect at the first hit sp.
-template <typename IndirectIrradiance>
-Rgb first_hit_radiance(const Scene& scene, const Ray& ray, Sampler& sampler, const PathRules& rules, bool hide_emitters,
-                       IndirectIrradiance&& indirect_irradiance) {
+// indirect_irradiance(sp, sampler, wl) returns E_indirect at the first hit sp in the path's
+// colour (wl: its wavelengths).
+template <class Wl, typename IndirectIrradiance>
+ColourAt<Wl> first_hit_radiance(const Scene& scene, const Ray& ray, Sampler& sampler, const PathRules& rules, bool hide_emitters, Wl& wl,
+                                IndirectIrradiance&& indirect_irradiance) {
+    using Colour = ColourAt<Wl>;
     Intersection hit;
-    if (!scene.intersect(ray, hit)) return hide_emitters ? Rgb(0.0f) : scene.escaped_radiance(ray.d);
-    Rgb L = hide_emitters ? Rgb(0.0f) : emitted_radiance(scene, hit, -ray.d);
+    if (!scene.intersect(ray, hit)) return hide_emitters ? Colour(0.0f) : escaped_radiance(scene, ray.d, wl);
+    Colour L = hide_emitters ? Colour(0.0f) : emitted_radiance(scene, hit, -ray.d, wl);
     const ShadingPoint sp = make_shading_point(scene, hit, ray.d);
     const std::optional<PhongMaterial> phong = sp.material->is_black() ? std::nullopt : cached_diffuse(sp);
-    if (!phong) return pt_mis_from_hit(scene, hit, ray.d, 0, sampler, rules, false, -1, L);
+    if (!phong) return pt_mis_from_hit(scene, hit, ray.d, 0, sampler, rules, wl, false, -1, L);
     if (!rules.may_bounce(0)) return L;
     // Direct light: pt-mis's MIS pair.
-    L += estimate_light_sample(scene, sp, sampler, /*mis=*/true);
-    const auto s = sp.material->sample(sp, sp.wi, sampler.next2d());
+    L += estimate_light_sample(scene, sp, sampler, /*mis=*/true, wl);
+    const auto s = bsdf_sample(sp, sampler.next2d(), wl);
     EmitterHit found;
-    if (s) L += estimate_bsdf_sample_mis(scene, sp, *s, found);
+    Colour f(0.0f);
+    if (s) {
+        f = bsdf_sample_colour(sp, *s, wl);
+        L += estimate_bsdf_sample_mis(scene, sp, *s, f, found, wl);
+    }
     if (!rules.may_bounce(1)) return L;
     // Indirect diffuse light from the cache.
-    L += phong->diffuse * kInvPi * indirect_irradiance(sp, sampler);
+    const Colour rho_d = reflectance_colour(phong->diffuse, wl);
+    L += rho_d * kInvPi * indirect_irradiance(sp, sampler, wl);
     // The Phong lobe's indirect light: the BSDF sample, weighted by the lobe alone.
     if (!s || s->delta || !found.hit) return L;
-    Rgb beta = max(s->f - phong->diffuse * kInvPi, Rgb(0.0f)) * (std::abs(s->wo.z) / s->pdfW);
+    Colour beta = max(f - rho_d * kInvPi, Colour(0.0f)) * (std::abs(s->wo.z) / s->pdfW);
     if (is_black(beta) || !rules.survive_roulette(1, beta, sampler)) return L;
-    return L + beta * pt_mis_from_hit(scene, found.isect, sp.frame.to_world(s->wo), 1, sampler, rules);
+    return L + beta * pt_mis_from_hit(scene, found.isect, sp.frame.to_world(s->wo), 1, sampler, rules, wl);
 }
 
 }  // namespace pathlab

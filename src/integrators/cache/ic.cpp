@@ -21,16 +21,19 @@ uint64_t record_stream(size_t pixel) { return uint64_t(pixel) + (uint64_t(5) << 
 
 }  // namespace
 
-IrradianceCaching::IrradianceCaching(const IntegratorOptions& options)
+template <class T>
+IrradianceCaching<T>::IrradianceCaching(const IntegratorOptions& options)
     : options_(options), rules_(options), cache_(options.ic_error, 1.0f, options.ic_gradients) {
     const int rays = std::max(4, options.ic_rays);
     M_ = std::max(1, int(std::lround(std::sqrt(double(rays) / kPi))));
     N_ = std::max(1, int(std::lround(double(rays) / M_)));
 }
 
-float IrradianceCaching::footprint(const Vec3f& p) const { return std::max(1e-6f, length(p - camera_position_) * pixel_angle_); }
+template <class T>
+float IrradianceCaching<T>::footprint(const Vec3f& p) const { return std::max(1e-6f, length(p - camera_position_) * pixel_angle_); }
 
-void IrradianceCaching::clamp_radius(IrradianceRecord& r, float scene_radius) const {
+template <class T>
+void IrradianceCaching<T>::clamp_radius(IrradianceRecord& r, float scene_radius) const {
     const float a = std::max(cache_.error_threshold(), 1e-6f), f = footprint(r.p);
     // Without the screen-space clamps: the harmonic mean distance, at most the scene's radius
     // (a record whose rays all escaped would otherwise cover everything).
@@ -43,29 +46,35 @@ void IrradianceCaching::clamp_radius(IrradianceRecord& r, float scene_radius) co
     r.R = R;
 }
 
-IrradianceRecord IrradianceCaching::make_record(const Scene& scene, const ShadingPoint& sp, Sampler& sampler) const {
+template <class T>
+IrradianceRecord IrradianceCaching<T>::make_record(const Scene& scene, const ShadingPoint& sp, Sampler& sampler) const {
+    // Records hold RGB (in spectral mode too).
+    RgbWavelengths rgb;
     IrradianceRecord r = gather_record(sp.p, sp.frame, M_, N_, sampler, [&](const Vec3f& d, float& distance) {
         Intersection hit;
         if (!scene.intersect(spawn_ray(sp.p, sp.ng, d), hit)) return Rgb(0.0f);  // the environment: direct light
         distance = length(hit.p - sp.p);
-        return pt_mis_from_hit(scene, hit, d, 1, sampler, rules_);
+        return pt_mis_from_hit(scene, hit, d, 1, sampler, rules_, rgb);
     });
     clamp_radius(r, scene.bounds_radius());
     return r;
 }
 
-Rgb IrradianceCaching::indirect_irradiance(const Scene& scene, const ShadingPoint& sp, Sampler& sampler) const {
+template <class T>
+ColourOf<T> IrradianceCaching<T>::indirect_irradiance(const Scene& scene, const ShadingPoint& sp, Sampler& sampler,
+                                                      WavelengthsOf<T>& wl) const {
     Rgb E;
-    if (cache_.interpolate(sp.p, sp.frame.n, E)) return E;
+    if (cache_.interpolate(sp.p, sp.frame.n, E)) return illuminant_colour(E, wl);
     // One cosine-distributed gather ray: E = pi L, unbiased.
     const Vec3f local = square_to_cosine_hemisphere(sampler.next2d());
     const Vec3f d = sp.frame.to_world(local);
     Intersection hit;
-    if (!scene.intersect(spawn_ray(sp.p, sp.ng, d), hit)) return Rgb(0.0f);
-    return pt_mis_from_hit(scene, hit, d, 1, sampler, rules_) * kPi;
+    if (!scene.intersect(spawn_ray(sp.p, sp.ng, d), hit)) return ColourOf<T>(0.0f);
+    return pt_mis_from_hit(scene, hit, d, 1, sampler, rules_, wl) * kPi;
 }
 
-void IrradianceCaching::prepare(const RenderContext& ctx, const PassProgress& progress) {
+template <class T>
+void IrradianceCaching<T>::prepare(const RenderContext& ctx, const PassProgress& progress) {
     // The cache depends on the scene, the image and the seed: a continued render keeps it.
     if (prepared_scene_ == &ctx.scene && prepared_seed_ == ctx.seed && prepared_width_ == ctx.width && prepared_height_ == ctx.height &&
         cache_.size() > 0)
@@ -116,12 +125,14 @@ void IrradianceCaching::prepare(const RenderContext& ctx, const PassProgress& pr
     build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-Rgb IrradianceCaching::radiance(const Scene& scene, const Ray& ray, Sampler& sampler) const {
-    return first_hit_radiance(scene, ray, sampler, rules_, options_.hide_emitters,
-                              [&](const ShadingPoint& sp, Sampler& s) { return indirect_irradiance(scene, sp, s); });
+template <class T>
+ColourOf<T> IrradianceCaching<T>::radiance(const Scene& scene, const Ray& ray, Sampler& sampler, WavelengthsOf<T>& wl) const {
+    return first_hit_radiance(scene, ray, sampler, rules_, options_.hide_emitters, wl,
+                              [&](const ShadingPoint& sp, Sampler& s, WavelengthsOf<T>& w) { return indirect_irradiance(scene, sp, s, w); });
 }
 
-void IrradianceCaching::finish(const RenderContext& ctx) {
+template <class T>
+void IrradianceCaching<T>::finish(const RenderContext& ctx) {
     if (options_.ic_records_path.empty()) return;
     // Where the records are: the cache's own view of the indirect diffuse light (rho_d/pi E at
     // the pixel centres' first hits, one stop brighter; black where no record covers them), and
@@ -143,9 +154,13 @@ void IrradianceCaching::finish(const RenderContext& ctx) {
     write_image(img, options_.ic_records_path);
 }
 
-std::vector<IntegratorStatistic> IrradianceCaching::statistics() const {
+template <class T>
+std::vector<IntegratorStatistic> IrradianceCaching<T>::statistics() const {
     return {{"records", double(cache_.size())}, {"records_gathered", double(gathered_)}, {"cache_seconds", build_seconds_}};
 }
+
+template class IrradianceCaching<RgbTransport>;
+template class IrradianceCaching<SpectralTransport>;
 
 namespace {
 
@@ -167,9 +182,8 @@ std::vector<ParamInfo> ic_params() {
 
 const IntegratorInfo& ic_integrator() {
     static const IntegratorInfo info{"ic", {"irrcache"}, "irradiance caching with gradients (Ward): cached indirect diffuse light at first hits, pt-mis elsewhere",
-                                     false, true, ic_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
-                                         return std::make_unique<IrradianceCaching>(o);
-                                     }, false, true, /*spectral=*/true};
+                                     false, true, ic_params(), [](const IntegratorOptions& o) { return make_for_transport<IrradianceCaching>(o); },
+                                     false, true};
     return info;
 }
 

@@ -16,6 +16,13 @@
 // render the cache is only read: a first hit that no record covers (jittered samples near edges)
 // gets one gather ray, pi L, unbiased and noisier. --ic-error 0 makes that every point's gather:
 // ic is then pt-mis with one diffuse gather ray.
+//
+// Spectral mode (docs/spectral.md "Spectral ic and pbgi"): exact at the wavelengths are the first
+// hit's emission and direct light, the Phong lobe's indirect light, pt-mis wherever the cache does
+// not serve, and the gather ray where no record covers a point. Approximated: the cached indirect
+// irradiance, which the cache holds in RGB (records gathered in RGB), is seen as an emitter's RGB
+// is (illuminant_colour), so its film colour is the cached RGB (to the table's error) but its
+// spectral shape is a guess.
 #pragma once
 
 #include "integrators/cache/irradiance_cache.hpp"
@@ -25,21 +32,20 @@
 
 namespace pathlab {
 
-class IrradianceCaching final : public PixelIntegrator {
+template <class T>
+class IrradianceCaching final : public PixelIntegrator<T> {
 public:
     explicit IrradianceCaching(const IntegratorOptions& options);
 
     void prepare(const RenderContext& ctx, const PassProgress& progress) override;
-    Rgb radiance(const Scene& scene, const Ray& ray, Sampler& sampler) const override;
-    // Spectral mode (cache_spectral.cpp): the cached indirect irradiance upsampled as an illuminant.
-    Spectrum4 radiance_spectral(const Scene& scene, const Ray& ray, Sampler& sampler, SampledWavelengths& wl) const override;
+    ColourOf<T> radiance(const Scene& scene, const Ray& ray, Sampler& sampler, WavelengthsOf<T>& wl) const override;
     void finish(const RenderContext& ctx) override;
     std::vector<IntegratorStatistic> statistics() const override;
 
     // A record gathered at sp (clamped as the cache's are; the clamps need prepare()'s camera).
     IrradianceRecord make_record(const Scene& scene, const ShadingPoint& sp, Sampler& sampler) const;
     // The indirect irradiance at the first hit sp: interpolated from the cache, else one gather ray.
-    Rgb indirect_irradiance(const Scene& scene, const ShadingPoint& sp, Sampler& sampler) const;
+    ColourOf<T> indirect_irradiance(const Scene& scene, const ShadingPoint& sp, Sampler& sampler, WavelengthsOf<T>& wl) const;
     const IrradianceCache& cache() const { return cache_; }
     // The hemisphere's strata: M in theta, N in phi (M N close to --ic-rays, N about pi M).
     int strata_theta() const { return M_; }
@@ -61,5 +67,7 @@ private:
     uint64_t prepared_seed_ = 0;
     int prepared_width_ = 0, prepared_height_ = 0;
 };
+extern template class IrradianceCaching<RgbTransport>;
+extern template class IrradianceCaching<SpectralTransport>;
 
 }  // namespace pathlab

@@ -15,19 +15,22 @@ constexpr float kBounceCutoff = 0.1f;
 
 }  // namespace
 
-PointBasedGi::PointBasedGi(const IntegratorOptions& options, SurfelTreeFaults faults)
+template <class T>
+PointBasedGi<T>::PointBasedGi(const IntegratorOptions& options, SurfelTreeFaults faults)
     : options_(options), rules_(options), faults_(faults) {
     settings_.cutoff = options.pbgi_cutoff;
     settings_.resolution = options.pbgi_resolution;
 }
 
-int PointBasedGi::bounces() const {
+template <class T>
+int PointBasedGi<T>::bounces() const {
     // A first hit's gather reaches paths of 1 + bounces bounces.
     const int b = std::max(1, options_.pbgi_bounces);
     return options_.max_depth < 0 ? b : std::max(1, std::min(b, options_.max_depth - 1));
 }
 
-void PointBasedGi::prepare(const RenderContext& ctx, const PassProgress& progress) {
+template <class T>
+void PointBasedGi<T>::prepare(const RenderContext& ctx, const PassProgress& progress) {
     // The cloud depends on the scene and the seed, the corners on the image too.
     const bool same_cloud = prepared_scene_ == &ctx.scene && prepared_seed_ == ctx.seed && !tree_.surfels().empty();
     if (same_cloud && width_ == ctx.width && height_ == ctx.height) return;
@@ -93,7 +96,8 @@ void PointBasedGi::prepare(const RenderContext& ctx, const PassProgress& progres
     if (progress) progress(1.0);
 }
 
-Rgb PointBasedGi::indirect_irradiance(const ShadingPoint& sp, const Vec3f& d) const {
+template <class T>
+Rgb PointBasedGi<T>::indirect_irradiance(const ShadingPoint& sp, const Vec3f& d) const {
     const Vec3f& x = sp.p;
     const Vec3f& n = sp.frame.n;
     if (!corners_.empty() && camera_) {
@@ -124,15 +128,20 @@ Rgb PointBasedGi::indirect_irradiance(const ShadingPoint& sp, const Vec3f& d) co
     return tree_.gather(x, n, settings_);
 }
 
-Rgb PointBasedGi::radiance(const Scene& scene, const Ray& ray, Sampler& sampler) const {
+template <class T>
+ColourOf<T> PointBasedGi<T>::radiance(const Scene& scene, const Ray& ray, Sampler& sampler, WavelengthsOf<T>& wl) const {
     if (tree_.surfels().empty()) {
         // Not prepared (or direct light only): no indirect diffuse light from the cloud.
-        return first_hit_radiance(scene, ray, sampler, rules_, options_.hide_emitters, [](const ShadingPoint&, Sampler&) { return Rgb(0.0f); });
+        return first_hit_radiance(scene, ray, sampler, rules_, options_.hide_emitters, wl,
+                                  [](const ShadingPoint&, Sampler&, WavelengthsOf<T>&) { return ColourOf<T>(0.0f); });
     }
-    return first_hit_radiance(scene, ray, sampler, rules_, options_.hide_emitters, [&](const ShadingPoint& sp, Sampler&) { return indirect_irradiance(sp, ray.d); });
+    return first_hit_radiance(scene, ray, sampler, rules_, options_.hide_emitters, wl, [&](const ShadingPoint& sp, Sampler&, WavelengthsOf<T>& w) {
+        return illuminant_colour(indirect_irradiance(sp, ray.d), w);
+    });
 }
 
-std::vector<IntegratorStatistic> PointBasedGi::statistics() const {
+template <class T>
+std::vector<IntegratorStatistic> PointBasedGi<T>::statistics() const {
     const double g = double(std::max<uint64_t>(corner_counters_.gathers, 1));
     return {{"surfels", double(tree_.surfels().size())},
             {"nodes", double(tree_.node_count())},
@@ -144,6 +153,9 @@ std::vector<IntegratorStatistic> PointBasedGi::statistics() const {
             {"surfels_per_gather", double(corner_counters_.surfels) / g},
             {"own_gathers", double(own_gathers_.load())}};
 }
+
+template class PointBasedGi<RgbTransport>;
+template class PointBasedGi<SpectralTransport>;
 
 namespace {
 
@@ -163,9 +175,8 @@ std::vector<ParamInfo> pbgi_params() {
 
 const IntegratorInfo& pbgi_integrator() {
     static const IntegratorInfo info{"pbgi", {}, "point-based global illumination (Christensen): indirect diffuse light at first hits gathered from a surfel octree, pt-mis elsewhere",
-                                     false, true, pbgi_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
-                                         return std::make_unique<PointBasedGi>(o);
-                                     }, /*any_camera=*/false, /*any_filter=*/true, /*spectral=*/true};
+                                     false, true, pbgi_params(), [](const IntegratorOptions& o) { return make_for_transport<PointBasedGi>(o); },
+                                     /*any_camera=*/false, /*any_filter=*/true};
     return info;
 }
 

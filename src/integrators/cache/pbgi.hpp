@@ -17,6 +17,8 @@
 // the same surface (normals within 18 degrees, the corner within 3 degrees of the tangent plane),
 // and a gather of its own where none does (silhouettes). The gathers have no noise: the surfels'
 // direct-light noise is fixed by the seed, and pbgi converges to its own biased image.
+// Spectral mode: the cloud and its gathers hold RGB; a first hit sees the gathered irradiance as
+// an emitter's RGB is seen (illuminant_colour), as ic does (ic.hpp).
 #pragma once
 
 #include <atomic>
@@ -30,14 +32,13 @@
 
 namespace pathlab {
 
-class PointBasedGi final : public PixelIntegrator {
+template <class T>
+class PointBasedGi final : public PixelIntegrator<T> {
 public:
     explicit PointBasedGi(const IntegratorOptions& options, SurfelTreeFaults faults = {});
 
     void prepare(const RenderContext& ctx, const PassProgress& progress) override;
-    Rgb radiance(const Scene& scene, const Ray& ray, Sampler& sampler) const override;
-    // Spectral mode (cache_spectral.cpp): the cached indirect irradiance upsampled as an illuminant.
-    Spectrum4 radiance_spectral(const Scene& scene, const Ray& ray, Sampler& sampler, SampledWavelengths& wl) const override;
+    ColourOf<T> radiance(const Scene& scene, const Ray& ray, Sampler& sampler, WavelengthsOf<T>& wl) const override;
     std::vector<IntegratorStatistic> statistics() const override;
 
     // The indirect irradiance at the first hit sp of the camera ray with direction d.
@@ -69,5 +70,7 @@ private:
     const Scene* prepared_scene_ = nullptr;
     uint64_t prepared_seed_ = 0;
 };
+extern template class PointBasedGi<RgbTransport>;
+extern template class PointBasedGi<SpectralTransport>;
 
 }  // namespace pathlab

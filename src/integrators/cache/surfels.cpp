@@ -96,12 +96,13 @@ void light_surfels(const Scene& scene, std::vector<Surfel>& surfels, int samples
             sp.frame = Frame(sp.ng);
             sp.wi = Vec3f(0, 0, 1);
             Vec3d sum(0.0);
+            RgbWavelengths rgb;  // the cloud holds RGB (in spectral mode too)
             for (int k = 0; k < samples; ++k) {
                 Sampler sampler(seed, surfel_stream(i, side), uint64_t(k), kind);
-                Rgb L = estimate_light_sample(scene, sp, sampler, /*mis=*/true);
+                Rgb L = estimate_light_sample(scene, sp, sampler, /*mis=*/true, rgb);
                 if (const auto b = lambert.sample(sp, sp.wi, sampler.next2d())) {
                     EmitterHit found;
-                    L += estimate_bsdf_sample_mis(scene, sp, *b, found);
+                    L += estimate_bsdf_sample_mis(scene, sp, *b, b->f, found, rgb);
                 }
                 sum += Vec3d(L);
             }

@@ -6,32 +6,46 @@
 #include "samplers/sampler.hpp"
 #include "core/sampling.hpp"
 #include "integrators/common/shading.hpp"
+#include "integrators/common/transport.hpp"
 
 namespace pathlab {
 
 // One light chosen with probability proportional to power, one point or direction sampled on
-// it, one shadow ray. Returns f * Le * cos(theta) / (pmf * pdfW). With `mis`, the result is
-// weighted by the balance heuristic against BSDF sampling of the same direction (both
-// densities in solid angle, the light's including its selection probability); delta lights
-// cannot be found by BSDF sampling and keep weight 1.
-inline Rgb estimate_light_sample(const Scene& scene, const ShadingPoint& sp, Sampler& sampler, bool mis) {
+// it, one shadow ray. Returns f * Le * cos(theta) / (pmf * pdfW) in the path's colour (wl:
+// transport.hpp). With `mis`, the result is weighted by the balance heuristic against BSDF
+// sampling of the same direction (both densities in solid angle, the light's including its
+// selection probability); delta lights cannot be found by BSDF sampling and keep weight 1.
+template <class Wl>
+ColourAt<Wl> estimate_light_sample(const Scene& scene, const ShadingPoint& sp, Sampler& sampler, bool mis, Wl& wl) {
+    using Colour = ColourAt<Wl>;
     const LightChoice choice = scene.choose_light(sampler.next1d());
     const Vec2f u = sampler.next2d();
-    if (choice.index < 0) return Rgb(0.0f);
+    if (choice.index < 0) return Colour(0.0f);
     const auto ls = sample_light(scene.lights()[size_t(choice.index)], sp.p, u);
-    if (!ls || is_black(ls->Le)) return Rgb(0.0f);
+    if (!ls || is_black(ls->Le)) return Colour(0.0f);
     // Lights behind the surface reach it only through a transmitting material (rough glass).
-    if (dot(ls->wi, sp.ng) <= 0 && !sp.material->is_dielectric()) return Rgb(0.0f);
+    if (dot(ls->wi, sp.ng) <= 0 && !sp.material->is_dielectric()) return Colour(0.0f);
     const Vec3f wo = sp.frame.to_local(ls->wi);
+    // The BSDF in RGB first (a shadow ray is traced only where it is not black), its colour once
+    // the light is known to be visible; a dispersive interface (which reduces wl to the hero) at once.
     float pdf_bsdf;
-    const Rgb f = sp.material->eval_and_pdf(sp, sp.wi, wo, pdf_bsdf);
-    if (is_black(f)) return Rgb(0.0f);
+    const bool dispersive = changes_wavelengths(*sp.material, wl);
+    Colour f(0.0f);
+    Rgb f_rgb(0.0f);
+    if (dispersive) [[unlikely]] {
+        f = bsdf_eval(sp, wo, wl, pdf_bsdf);
+        if (is_black(f)) return Colour(0.0f);
+    } else {
+        f_rgb = sp.material->eval_and_pdf(sp, sp.wi, wo, pdf_bsdf);
+        if (is_black(f_rgb)) return Colour(0.0f);
+    }
     const Ray shadow = std::isinf(ls->distance) ? spawn_ray(sp.p, sp.ng, ls->wi)
                                                 : spawn_segment(sp.p, sp.ng, ls->point, ls->normal);
-    if (scene.occluded(shadow)) return Rgb(0.0f);
+    if (scene.occluded(shadow)) return Colour(0.0f);
+    if (!dispersive) f = bsdf_colour(sp, wo, f_rgb, wl);
     const float pdf_light = choice.pmf * ls->pdfW;
     const float weight = (mis && !ls->delta) ? balance_heuristic(pdf_light, pdf_bsdf) : 1.0f;
-    return f * ls->Le * (std::abs(wo.z) * weight / pdf_light);
+    return f * light_colour(scene, choice.index, ls->Le, wl) * (std::abs(wo.z) * weight / pdf_light);
 }
 
 // What a ray leaving a shading point finds: the surface it hits (if any), the radiance emitted
@@ -67,13 +81,16 @@ inline EmitterHit trace_to_emitter(const Scene& scene, const Ray& ray, const Vec
 
 // The BSDF-sampled half of MIS direct lighting: traces the sampled direction and returns the
 // emission it finds weighted by the balance heuristic against light sampling (weight 1 for a
-// delta BSDF sample, which light sampling cannot produce). `found` receives the hit, for path
-// tracers that continue from it.
-inline Rgb estimate_bsdf_sample_mis(const Scene& scene, const ShadingPoint& sp, const BsdfSample& s, EmitterHit& found) {
+// delta BSDF sample, which light sampling cannot produce); `f` is the sample's colour
+// (bsdf_sample_colour). `found` receives the hit, for path tracers that continue from it.
+template <class Wl>
+ColourAt<Wl> estimate_bsdf_sample_mis(const Scene& scene, const ShadingPoint& sp, const BsdfSample& s, const ColourAt<Wl>& f,
+                                      EmitterHit& found, const Wl& wl) {
     found = trace_to_emitter(scene, sp.spawn(s.wo), sp.p);
-    if (is_black(found.Le)) return Rgb(0.0f);
+    if (is_black(found.Le)) return ColourAt<Wl>(0.0f);
     const float weight = s.delta ? 1.0f : balance_heuristic(s.pdfW, found.pdf_light);
-    return s.f * found.Le * (std::abs(s.wo.z) * weight / s.pdfW);
+    const int light = found.hit ? found.isect.light : scene.environment_light();
+    return f * light_colour(scene, light, found.Le, wl) * (std::abs(s.wo.z) * weight / s.pdfW);
 }
 
 }  // namespace pathlab

@@ -1,7 +1,5 @@
-// The first vertex of a light path (light tracing, bdpt's light subpaths, photons): a light
-// chosen by power, then a point and a direction from its emission sampling, drawing the same
-// random numbers in the same order as the RGB integrators' own copies of these lines (whose
-// object code stays as it was: docs/spectral.md).
+// The first vertex of a light path (light tracing, bdpt's light subpaths and with them the
+// photons): a light chosen by power, then a point and a direction from its emission sampling.
 #pragma once
 
 #include <optional>

@@ -45,19 +45,12 @@ public:
     // May a path that has made `bounces` bounces make one more?
     bool may_bounce(int bounces) const { return bounces < max_depth_; }
 
-    // Called after bounce number `bounces` (1-based) updated beta; false ends the path.
-    bool survive_roulette(int bounces, Rgb& beta, Sampler& sampler) const {
+    // Called after bounce number `bounces` (1-based) updated beta (RGB or spectral: q from its
+    // largest channel or lane); false ends the path.
+    template <class Colour>
+    bool survive_roulette(int bounces, Colour& beta, Sampler& sampler) const {
         if (rr_depth_ < 0 || bounces < rr_depth_) return true;
         const float q = std::clamp(max_component(beta), 0.05f, 1.0f);
-        if (sampler.next1d() >= q) return false;
-        beta /= q;
-        return true;
-    }
-
-    // The same in spectral mode: q from the largest lane of the throughput.
-    bool survive_roulette(int bounces, Spectrum4& beta, Sampler& sampler) const {
-        if (rr_depth_ < 0 || bounces < rr_depth_) return true;
-        const float q = std::clamp(beta.max_value(), 0.05f, 1.0f);
         if (sampler.next1d() >= q) return false;
         beta /= q;
         return true;

@@ -6,7 +6,6 @@
 // BSDF sampling (weight 1).
 #include "integrators/integrators.hpp"
 #include "integrators/common/direct_lighting.hpp"
-#include "integrators/common/spectral_direct_lighting.hpp"
 
 namespace pathlab {
 
@@ -22,35 +21,22 @@ std::vector<ParamInfo> direct_params() {
             {"strict_normals", ParamType::Boolean, "false", "accepted and ignored (noted): pathlab's shading-normal handling is its own", "strictNormals"}};
 }
 
-class DirectMis final : public PixelIntegrator {
+template <class T>
+class DirectMis final : public PixelIntegrator<T> {
 public:
-    explicit DirectMis(bool hide) : hide_(hide) {}
-    Rgb radiance(const Scene& scene, const Ray& ray, Sampler& sampler) const override {
+    explicit DirectMis(const IntegratorOptions& o) : hide_(o.hide_emitters) {}
+    ColourOf<T> radiance(const Scene& scene, const Ray& ray, Sampler& sampler, WavelengthsOf<T>& wl) const override {
+        using Colour = ColourOf<T>;
         Intersection hit;
-        if (!scene.intersect(ray, hit)) return hide_ ? Rgb(0.0f) : scene.escaped_radiance(ray.d);
-        Rgb L = hide_ ? Rgb(0.0f) : emitted_radiance(scene, hit, -ray.d);
+        if (!scene.intersect(ray, hit)) return hide_ ? Colour(0.0f) : escaped_radiance(scene, ray.d, wl);
+        Colour L = hide_ ? Colour(0.0f) : emitted_radiance(scene, hit, -ray.d, wl);
         const ShadingPoint sp = make_shading_point(scene, hit, ray.d);
         if (sp.material->is_black()) return L;
-        L += estimate_light_sample(scene, sp, sampler, /*mis=*/true);
+        L += estimate_light_sample(scene, sp, sampler, /*mis=*/true, wl);
         if (!scene.has_hittable_emitters()) return L;  // only delta lights: the BSDF ray finds nothing
-        if (const auto s = sp.material->sample(sp, sp.wi, sampler.next2d())) {
+        if (const auto s = bsdf_sample(sp, sampler.next2d(), wl)) {
             EmitterHit found;
-            L += estimate_bsdf_sample_mis(scene, sp, *s, found);
-        }
-        return L;
-    }
-    // Spectral mode: the same samples, their values at the wavelengths wl (spectral_direct_lighting.hpp).
-    Spectrum4 radiance_spectral(const Scene& scene, const Ray& ray, Sampler& sampler, SampledWavelengths& wl) const override {
-        Intersection hit;
-        if (!scene.intersect(ray, hit)) return hide_ ? Spectrum4(0.0f) : escaped_spectrum(scene, ray.d, wl);
-        Spectrum4 L = hide_ ? Spectrum4(0.0f) : emitted_spectrum(scene, hit, -ray.d, wl);
-        const ShadingPoint sp = make_shading_point(scene, hit, ray.d);
-        if (sp.material->is_black()) return L;
-        L += estimate_light_sample_spectral(scene, sp, sampler, /*mis=*/true, wl);
-        if (!scene.has_hittable_emitters()) return L;
-        if (const auto s = spectral_sample(sp, sampler.next2d(), wl)) {
-            EmitterHit found;
-            L += estimate_bsdf_sample_mis_spectral(scene, sp, *s, spectral_sample_value(sp, *s, wl), found, wl);
+            L += estimate_bsdf_sample_mis(scene, sp, *s, bsdf_sample_colour(sp, *s, wl), found, wl);
         }
         return L;
     }
@@ -62,14 +48,8 @@ private:
 }  // namespace
 
 const IntegratorInfo& direct_mis_integrator() {
-    static const IntegratorInfo info = [] {
-        IntegratorInfo i{"direct-mis", {"3", "direct"}, "light + BRDF sampling combined by MIS (balance heuristic)",
-                         false, true, direct_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
-                             return std::make_unique<DirectMis>(o.hide_emitters);
-                         }};
-        i.spectral = true;
-        return i;
-    }();
+    static const IntegratorInfo info{"direct-mis", {"3", "direct"}, "light + BRDF sampling combined by MIS (balance heuristic)",
+                         false, true, direct_params(), [](const IntegratorOptions& o) { return make_for_transport<DirectMis>(o); }};
     return info;
 }
 

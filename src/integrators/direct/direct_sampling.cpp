@@ -7,57 +7,52 @@
 // black in scenes lit only by point lights (0, 1): correct, and why MIS exists.
 #include "integrators/integrators.hpp"
 #include "integrators/common/direct_lighting.hpp"
-#include "integrators/direct/direct_sampling_spectral.hpp"
 
 namespace pathlab {
 namespace {
 
 enum class Strategy { UniformHemisphere, CosineHemisphere, Brdf };
-static_assert(int(Strategy::UniformHemisphere) == int(DirectSamplingStrategy::UniformHemisphere) &&
-              int(Strategy::CosineHemisphere) == int(DirectSamplingStrategy::CosineHemisphere) &&
-              int(Strategy::Brdf) == int(DirectSamplingStrategy::Brdf));
 
-class DirectBySampling final : public PixelIntegrator {
+template <class T>
+class DirectBySampling final : public PixelIntegrator<T> {
 public:
-    DirectBySampling(Strategy s, bool hide) : strategy_(s), hide_(hide) {}
+    DirectBySampling(const IntegratorOptions& o, Strategy s) : strategy_(s), hide_(o.hide_emitters) {}
 
-    Rgb radiance(const Scene& scene, const Ray& ray, Sampler& sampler) const override {
+    ColourOf<T> radiance(const Scene& scene, const Ray& ray, Sampler& sampler, WavelengthsOf<T>& wl) const override {
+        using Colour = ColourOf<T>;
         Intersection hit;
-        if (!scene.intersect(ray, hit)) return hide_ ? Rgb(0.0f) : scene.escaped_radiance(ray.d);
-        Rgb L = hide_ ? Rgb(0.0f) : emitted_radiance(scene, hit, -ray.d);
+        if (!scene.intersect(ray, hit)) return hide_ ? Colour(0.0f) : escaped_radiance(scene, ray.d, wl);
+        Colour L = hide_ ? Colour(0.0f) : emitted_radiance(scene, hit, -ray.d, wl);
         const ShadingPoint sp = make_shading_point(scene, hit, ray.d);
         if (sp.material->is_black()) return L;
 
         const Vec2f u = sampler.next2d();
         Vec3f wo;
-        Rgb f;
+        Colour f;
         float pdfW = 0;
         switch (strategy_) {
             case Strategy::UniformHemisphere:
                 wo = square_to_uniform_hemisphere(u);
                 pdfW = uniform_hemisphere_pdf(wo);
-                f = sp.material->eval(sp, sp.wi, wo);
+                f = bsdf_eval(sp, wo, wl);
                 break;
             case Strategy::CosineHemisphere:
                 wo = square_to_cosine_hemisphere(u);
                 pdfW = cosine_hemisphere_pdf(wo);
-                f = sp.material->eval(sp, sp.wi, wo);
+                f = bsdf_eval(sp, wo, wl);
                 break;
             case Strategy::Brdf: {
-                const auto s = sp.material->sample(sp, sp.wi, u);
+                const auto s = bsdf_sample(sp, u, wl);
                 if (!s) return L;
-                wo = s->wo, f = s->f, pdfW = s->pdfW;
+                wo = s->wo, f = bsdf_sample_colour(sp, *s, wl), pdfW = s->pdfW;
                 break;
             }
         }
         if (!(pdfW > 0) || is_black(f)) return L;
         const EmitterHit e = trace_to_emitter(scene, sp.spawn(wo), sp.p);
-        return L + f * e.Le * (std::abs(wo.z) / pdfW);
-    }
-
-    // Spectral mode (direct_sampling_spectral.cpp, a file of its own so that this one compiles as before).
-    Spectrum4 radiance_spectral(const Scene& scene, const Ray& ray, Sampler& sampler, SampledWavelengths& wl) const override {
-        return direct_sampling_spectral(scene, ray, sampler, wl, DirectSamplingStrategy(int(strategy_)), hide_);
+        if (is_black(e.Le)) return L;
+        const int light = e.hit ? e.isect.light : scene.environment_light();
+        return L + f * light_colour(scene, light, e.Le, wl) * (std::abs(wo.z) / pdfW);
     }
 
 private:
@@ -70,13 +65,9 @@ private:
 namespace {
 
 IntegratorInfo direct_sampling_info(const char* name, const char* alias, const char* summary, Strategy strategy) {
-    IntegratorInfo i{name, {alias}, summary, true, true,
-                     {{"hide_emitters", ParamType::Boolean, "false", "emitters (and the environment) seen directly are black", "hideEmitters"}},
-                     [strategy](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
-                         return std::make_unique<DirectBySampling>(strategy, o.hide_emitters);
-                     }};
-    i.spectral = true;
-    return i;
+    return {name, {alias}, summary, true, true,
+            {{"hide_emitters", ParamType::Boolean, "false", "emitters (and the environment) seen directly are black", "hideEmitters"}},
+            [strategy](const IntegratorOptions& o) { return make_for_transport<DirectBySampling>(o, strategy); }};
 }
 
 }  // namespace

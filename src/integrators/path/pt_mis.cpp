@@ -11,27 +11,28 @@
 #include "integrators/path/pt_mis.hpp"
 
 #include "integrators/common/direct_lighting.hpp"
-#include "integrators/common/spectral_shading.hpp"
-#include "integrators/path/pt_mis_spectral.hpp"
 #include "integrators/integrators.hpp"
-#include "integrators/common/path_rules.hpp"
 
 namespace pathlab {
 
-Rgb pt_mis_from_hit(const Scene& scene, Intersection hit, Vec3f dir, int first_bounce, Sampler& sampler, const PathRules& rules,
-                    bool three_rays, int only_length, Rgb L) {
+template <class Wl>
+ColourAt<Wl> pt_mis_from_hit(const Scene& scene, Intersection hit, Vec3f dir, int first_bounce, Sampler& sampler, const PathRules& rules,
+                             Wl& wl, bool three_rays, int only_length, ColourAt<Wl> L) {
+    using Colour = ColourAt<Wl>;
     const auto counts = [only_length](int length) { return only_length < 0 || only_length == length; };
-    Rgb beta(1.0f);
+    Colour beta(1.0f);
     for (int bounces = first_bounce; rules.may_bounce(bounces); ++bounces) {
         const ShadingPoint sp = make_shading_point(scene, hit, dir);
         if (sp.material->is_black()) break;
         // Paths of bounces + 1 bounces ending on a light: the MIS pair.
-        const Rgb direct = estimate_light_sample(scene, sp, sampler, /*mis=*/true);
+        const Colour direct = estimate_light_sample(scene, sp, sampler, /*mis=*/true, wl);
         if (counts(bounces + 1)) L += beta * direct;
-        const auto s = sp.material->sample(sp, sp.wi, sampler.next2d());
+        const auto s = bsdf_sample(sp, sampler.next2d(), wl);
         EmitterHit found;
+        Colour f(0.0f);  // the continuation's BSDF value
         if (s) {
-            const Rgb found_emission = estimate_bsdf_sample_mis(scene, sp, *s, found);
+            f = bsdf_sample_colour(sp, *s, wl);
+            const Colour found_emission = estimate_bsdf_sample_mis(scene, sp, *s, f, found, wl);
             if (counts(bounces + 1)) L += beta * found_emission;
         }
         if (!rules.may_bounce(bounces + 1)) break;
@@ -42,13 +43,14 @@ Rgb pt_mis_from_hit(const Scene& scene, Intersection hit, Vec3f dir, int first_b
         if (!three_rays && !s) break;
         BsdfSample next = s ? *s : BsdfSample{};
         if (three_rays) {
-            const auto c = sp.material->sample(sp, sp.wi, sampler.next2d());
+            const auto c = bsdf_sample(sp, sampler.next2d(), wl);
             if (!c) break;
             next = *c;
+            f = bsdf_sample_colour(sp, next, wl);
             found.hit = scene.intersect(sp.spawn(next.wo), found.isect);
         }
         if (!found.hit) break;  // escaped: the environment was counted by the MIS pair
-        beta *= next.f * (std::abs(next.wo.z) / next.pdfW);
+        beta *= f * (std::abs(next.wo.z) / next.pdfW);
         if (!rules.survive_roulette(bounces + 1, beta, sampler)) break;
         hit = found.isect;
         dir = sp.frame.to_world(next.wo);
@@ -56,26 +58,24 @@ Rgb pt_mis_from_hit(const Scene& scene, Intersection hit, Vec3f dir, int first_b
     return L;
 }
 
+template Rgb pt_mis_from_hit(const Scene&, Intersection, Vec3f, int, Sampler&, const PathRules&, RgbWavelengths&, bool, int, Rgb);
+template Spectrum4 pt_mis_from_hit(const Scene&, Intersection, Vec3f, int, Sampler&, const PathRules&, SampledWavelengths&, bool, int,
+                                   Spectrum4);
+
 namespace {
 
-class PtMis final : public PixelIntegrator {
+template <class T>
+class PtMis final : public PixelIntegrator<T> {
 public:
     PtMis(const IntegratorOptions& o, bool separate_continuation)
         : rules_(limited_to_length(o)), three_rays_(separate_continuation), only_length_(o.only_length), hide_(o.hide_emitters) {}
 
-    Rgb radiance(const Scene& scene, const Ray& camera_ray, Sampler& sampler) const override {
+    ColourOf<T> radiance(const Scene& scene, const Ray& camera_ray, Sampler& sampler, WavelengthsOf<T>& wl) const override {
+        using Colour = ColourOf<T>;
         Intersection hit;
-        if (!scene.intersect(camera_ray, hit)) return counts(0) ? scene.escaped_radiance(camera_ray.d) : Rgb(0.0f);
-        const Rgb emitted = counts(0) ? emitted_radiance(scene, hit, -camera_ray.d) : Rgb(0.0f);
-        return pt_mis_from_hit(scene, hit, camera_ray.d, 0, sampler, rules_, three_rays_, only_length_, emitted);
-    }
-
-    Spectrum4 radiance_spectral(const Scene& scene, const Ray& camera_ray, Sampler& sampler, SampledWavelengths& wl) const override {
-        Intersection hit;
-        if (!scene.intersect(camera_ray, hit))
-            return counts(0) ? escaped_spectrum(scene, camera_ray.d, wl) : Spectrum4(0.0f);
-        const Spectrum4 emitted = counts(0) ? emitted_spectrum(scene, hit, -camera_ray.d, wl) : Spectrum4(0.0f);
-        return pt_mis_spectral_from_hit(scene, hit, camera_ray.d, 0, sampler, rules_, three_rays_, only_length_, emitted, wl);
+        if (!scene.intersect(camera_ray, hit)) return counts(0) ? escaped_radiance(scene, camera_ray.d, wl) : Colour(0.0f);
+        const Colour emitted = counts(0) ? emitted_radiance(scene, hit, -camera_ray.d, wl) : Colour(0.0f);
+        return pt_mis_from_hit(scene, hit, camera_ray.d, 0, sampler, rules_, wl, three_rays_, only_length_, emitted);
     }
 
 private:
@@ -90,25 +90,13 @@ private:
 }  // namespace
 
 const IntegratorInfo& pt_mis3_integrator() {
-    static const IntegratorInfo info = [] {
-        IntegratorInfo i{"pt-mis3", {"4b"}, "path tracing, MIS direct lighting at every bounce + a third continuation ray",
-                         false, true, path_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
-                             return std::make_unique<PtMis>(o, true);
-                         }};
-        i.spectral = true;
-        return i;
-    }();
+    static const IntegratorInfo info{"pt-mis3", {"4b"}, "path tracing, MIS direct lighting at every bounce + a third continuation ray",
+                                     false, true, path_params(), [](const IntegratorOptions& o) { return make_for_transport<PtMis>(o, true); }};
     return info;
 }
 const IntegratorInfo& pt_mis_integrator() {
-    static const IntegratorInfo info = [] {
-        IntegratorInfo i{"pt-mis", {"4c", "path"}, "path tracing, MIS direct lighting whose BRDF ray continues the path",
-                         false, true, path_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
-                             return std::make_unique<PtMis>(o, false);
-                         }};
-        i.spectral = true;
-        return i;
-    }();
+    static const IntegratorInfo info{"pt-mis", {"4c", "path"}, "path tracing, MIS direct lighting whose BRDF ray continues the path",
+                                     false, true, path_params(), [](const IntegratorOptions& o) { return make_for_transport<PtMis>(o, false); }};
     return info;
 }
 

@@ -1,18 +1,22 @@
 // The path tracing loop of pt-mis and pt-mis3, for integrators that continue a path with it
-// (ic traces its records' hemisphere rays and its glossy bounces so).
+// (ic traces its records' hemisphere rays and its glossy bounces so, volpath renders scenes
+// without media with it).
 #pragma once
 
 #include "integrators/common/path_rules.hpp"
+#include "integrators/common/transport.hpp"
 #include "scene/scene.hpp"
 
 namespace pathlab {
 
 // The radiance leaving the surface `hit` towards -dir, without the emission there, estimated as
-// pt-mis does from that vertex on (pt-mis3 with `three_rays`): for a path that has already made
-// `bounces` bounces (the depth limit and Russian roulette count from there). `only_length` >= 0:
-// only paths of that many bounces (in all) count. Returns L plus that radiance (added in the
-// order pt-mis adds it).
-Rgb pt_mis_from_hit(const Scene& scene, Intersection hit, Vec3f dir, int bounces, Sampler& sampler, const PathRules& rules,
-                    bool three_rays = false, int only_length = -1, Rgb L = Rgb(0.0f));
+// pt-mis does from that vertex on (pt-mis3 with `three_rays`), in the colour of a path carrying
+// wavelengths wl (common/transport.hpp): for a path that has already made `bounces` bounces (the
+// depth limit and Russian roulette count from there). `only_length` >= 0: only paths of that
+// many bounces (in all) count. Returns L plus that radiance (added in the order pt-mis adds it).
+// Instantiated for RgbWavelengths and SampledWavelengths.
+template <class Wl>
+ColourAt<Wl> pt_mis_from_hit(const Scene& scene, Intersection hit, Vec3f dir, int bounces, Sampler& sampler, const PathRules& rules, Wl& wl,
+                             bool three_rays = false, int only_length = -1, ColourAt<Wl> L = ColourAt<Wl>(0.0f));
 
 }  // namespace pathlab

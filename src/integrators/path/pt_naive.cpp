@@ -6,48 +6,28 @@
 #include "integrators/common/direct_lighting.hpp"
 #include "integrators/integrators.hpp"
 #include "integrators/common/path_rules.hpp"
-#include "integrators/common/spectral_shading.hpp"
 
 namespace pathlab {
 namespace {
 
-class PtNaive final : public PixelIntegrator {
+template <class T>
+class PtNaive final : public PixelIntegrator<T> {
 public:
     explicit PtNaive(const IntegratorOptions& o) : rules_(o), hide_(o.hide_emitters) {}
 
-    Rgb radiance(const Scene& scene, const Ray& camera_ray, Sampler& sampler) const override {
-        Rgb L(0.0f), beta(1.0f);
+    ColourOf<T> radiance(const Scene& scene, const Ray& camera_ray, Sampler& sampler, WavelengthsOf<T>& wl) const override {
+        ColourOf<T> L(0.0f), beta(1.0f);
         Ray ray = camera_ray;
         for (int bounces = 0;; ++bounces) {
             Intersection hit;
             const bool seen = bounces > 0 || !hide_;
-            if (!scene.intersect(ray, hit)) return seen ? L + beta * scene.escaped_radiance(ray.d) : L;
-            if (seen) L += beta * emitted_radiance(scene, hit, -normalize(ray.d));
+            if (!scene.intersect(ray, hit)) return seen ? L + beta * escaped_radiance(scene, ray.d, wl) : L;
+            if (seen) L += beta * emitted_radiance(scene, hit, -normalize(ray.d), wl);
             const ShadingPoint sp = make_shading_point(scene, hit, normalize(ray.d));
             if (sp.material->is_black() || !rules_.may_bounce(bounces)) return L;
-            const auto s = sp.material->sample(sp, sp.wi, sampler.next2d());
+            const auto s = bsdf_sample(sp, sampler.next2d(), wl);
             if (!s) return L;
-            beta *= s->f * (std::abs(s->wo.z) / s->pdfW);
-            if (!rules_.survive_roulette(bounces + 1, beta, sampler)) return L;
-            ray = sp.spawn(s->wo);
-        }
-    }
-
-    // Spectral mode: the same path (spectral_shading.hpp), its values at the wavelengths wl.
-    Spectrum4 radiance_spectral(const Scene& scene, const Ray& camera_ray, Sampler& sampler, SampledWavelengths& wl) const override {
-        Spectrum4 L(0.0f), beta(1.0f);
-        Ray ray = camera_ray;
-        for (int bounces = 0;; ++bounces) {
-            Intersection hit;
-            const bool seen = bounces > 0 || !hide_;
-            if (!scene.intersect(ray, hit))
-                return seen ? L + beta * escaped_spectrum(scene, ray.d, wl) : L;
-            if (seen) L += beta * emitted_spectrum(scene, hit, -normalize(ray.d), wl);
-            const ShadingPoint sp = make_shading_point(scene, hit, normalize(ray.d));
-            if (sp.material->is_black() || !rules_.may_bounce(bounces)) return L;
-            const auto s = spectral_sample(sp, sampler.next2d(), wl);
-            if (!s) return L;
-            beta *= spectral_sample_value(sp, *s, wl) * (std::abs(s->wo.z) / s->pdfW);
+            beta *= bsdf_sample_colour(sp, *s, wl) * (std::abs(s->wo.z) / s->pdfW);
             if (!rules_.survive_roulette(bounces + 1, beta, sampler)) return L;
             ray = sp.spawn(s->wo);
         }
@@ -61,12 +41,8 @@ private:
 }  // namespace
 
 const IntegratorInfo& pt_naive_integrator() {
-    static const IntegratorInfo info = [] {
-        IntegratorInfo i{"pt-naive", {"4a"}, "path tracing by BRDF sampling, Russian roulette", true, true, path_params(),
-                         [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> { return std::make_unique<PtNaive>(o); }};
-        i.spectral = true;
-        return i;
-    }();
+    static const IntegratorInfo info{"pt-naive", {"4a"}, "path tracing by BRDF sampling, Russian roulette", true, true, path_params(),
+                                     [](const IntegratorOptions& o) { return make_for_transport<PtNaive>(o); }};
     return info;
 }
 

@@ -18,8 +18,13 @@ struct VolpathSettings {
     // (volpath's own loop draws pt-mis's numbers and does its arithmetic, tested with this off),
     // without the walk's bookkeeping (measured at up to 15%, docs/volumes.md, "Cost").
     bool pt_mis_without_media = true;
+    // > 1: free flights and transmittances in every medium by delta and ratio tracking against
+    // this multiple of the majorant (null collisions in homogeneous media too): another
+    // free-flight strategy with the same expectation, for the tests.
+    float majorant_factor = 1;
 };
 
+// volpath for the transport the options ask for (IntegratorOptions::spectral).
 std::unique_ptr<Integrator> make_volpath(const IntegratorOptions& options, VolpathSettings settings = {});
 
 }  // namespace pathlab

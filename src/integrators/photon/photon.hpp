@@ -1,19 +1,44 @@
 // A photon: where a light subpath met a non-Dirac surface, the direction it came from and the
 // power it carries (the light subpath's throughput there, for one light path; divided by the
-// number of light paths when density is estimated).
+// number of light paths when density is estimated), in the colour of transport T.
 #pragma once
 
 #include <cstdint>
 
-#include "core/vec.hpp"
+#include "integrators/common/transport.hpp"
 
 namespace pathlab {
 
+template <class T>
 struct Photon {
     Vec3f p;
-    Vec3f wi;        // world direction back towards where the photon came from
-    Rgb power;       // throughput of its light path up to here
-    uint16_t vertex; // its index j on the light subpath (y_0 is on the light): j - 1 bounces before it
+    Vec3f wi;                 // world direction back towards where the photon came from
+    ColourOf<T> power;        // throughput of its light path up to here
+    uint16_t vertex;          // its index j on the light subpath (y_0 is on the light): j - 1 bounces before it
+    bool dispersed = false;   // its light path met a dispersive interface: it carries the hero alone
+};
+
+// The sum of f(x, wo, wi_p) power_p (times any weight) over the photons merged at one camera
+// vertex, in transport T's colour. Spectral mode keeps photons that carry the hero alone apart
+// (docs/spectral.md "Spectral photon mapping"): the factor 4 of terminate_secondary belongs once
+// to the whole camera + light path, so a dispersed photon's lane 0 counts 4 times against a camera
+// path of 4 lanes and once against a dispersed camera path (whose hero pdf is p/4 already). RGB
+// photons are never dispersed.
+template <class T>
+class MergeSum {
+public:
+    void add(const ColourOf<T>& c, bool dispersed) {
+        if (dispersed) hero_ += c, any_hero_ = true;
+        else full_ += c;
+    }
+    ColourOf<T> total(const WavelengthsOf<T>& camera_wl) const {
+        if (!any_hero_) return full_;
+        return full_ + hero_lane(hero_) * (camera_wl.secondary_terminated() ? 1.0f : 4.0f);
+    }
+
+private:
+    ColourOf<T> full_{0.0f}, hero_{0.0f};
+    bool any_hero_ = false;
 };
 
 }  // namespace pathlab

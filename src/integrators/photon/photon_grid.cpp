@@ -7,20 +7,20 @@
 
 namespace pathlab {
 
-void PhotonGrid::build(const std::vector<Photon>& photons, float radius) {
-    photons_ = &photons;
+void PhotonGrid::build(Positions photons, float radius) {
+    positions_ = photons;
     // A little over 2r, so that a ball of radius r around a query is within the 2 x 2 x 2 cells
     // it visits even after rounding.
     cell_size_ = 2 * radius * 1.0001f;
     inv_cell_ = 1 / cell_size_;
     lo_ = Vec3f(kInf);
-    for (const Photon& p : photons) lo_ = min(lo_, p.p);
+    for (size_t i = 0; i < photons.size(); ++i) lo_ = min(lo_, photons[i]);
     if (photons.empty()) lo_ = Vec3f(0.0f);
     // As many table cells as photons (at least 1): short lists, few collisions.
     cell_ends_.assign(std::max<size_t>(1, photons.size()), 0);
     std::vector<uint32_t> cell_of(photons.size());
     for (size_t i = 0; i < photons.size(); ++i) {
-        const Vec3f c = (photons[i].p - lo_) * inv_cell_;
+        const Vec3f c = (photons[i] - lo_) * inv_cell_;
         cell_of[i] = uint32_t(cell_index(int(std::floor(c.x)), int(std::floor(c.y)), int(std::floor(c.z))));
         ++cell_ends_[cell_of[i]];
     }
@@ -35,11 +35,11 @@ void PhotonGrid::build(const std::vector<Photon>& photons, float radius) {
 
 namespace {
 
-// nanoflann's view of the photons.
+// nanoflann's view of the items.
 struct PhotonCloud {
-    const std::vector<Photon>* photons;
-    size_t kdtree_get_point_count() const { return photons->size(); }
-    float kdtree_get_pt(size_t i, size_t dim) const { return (*photons)[i].p[int(dim)]; }
+    Positions positions;
+    size_t kdtree_get_point_count() const { return positions.size(); }
+    float kdtree_get_pt(size_t i, size_t dim) const { return positions[i][int(dim)]; }
     template <class BBox> bool kdtree_get_bbox(BBox&) const { return false; }
 };
 
@@ -65,8 +65,8 @@ struct Collector {
 struct PhotonKdTree::Index {
     PhotonCloud cloud;
     KdIndex tree;
-    explicit Index(const std::vector<Photon>& photons)
-        : cloud{&photons}, tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(10)) {
+    explicit Index(Positions positions)
+        : cloud{positions}, tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(10)) {
         tree.buildIndex();
     }
 };
@@ -74,14 +74,11 @@ struct PhotonKdTree::Index {
 PhotonKdTree::PhotonKdTree() = default;
 PhotonKdTree::~PhotonKdTree() = default;
 
-void PhotonKdTree::build(const std::vector<Photon>& photons, float) {
-    photons_ = &photons;
-    index_ = std::make_unique<Index>(photons);
-}
+void PhotonKdTree::build(Positions positions, float) { index_ = std::make_unique<Index>(positions); }
 
 void PhotonKdTree::within(const Vec3f& q, float r, std::vector<uint32_t>& out) const {
     out.clear();
-    if (!index_ || photons_->empty()) return;
+    if (!index_ || index_->cloud.positions.empty()) return;
     Collector c{r * r, out};
     const float query[3] = {q.x, q.y, q.z};
     nanoflann::SearchParams params;
@@ -91,7 +88,7 @@ void PhotonKdTree::within(const Vec3f& q, float r, std::vector<uint32_t>& out) c
 }
 
 size_t PhotonKdTree::nearest(const Vec3f& q, size_t k, uint32_t* indices, float* dist2) const {
-    if (!index_ || photons_->empty()) return 0;
+    if (!index_ || index_->cloud.positions.empty()) return 0;
     const float query[3] = {q.x, q.y, q.z};
     return index_->tree.knnSearch(query, k, indices, dist2);
 }

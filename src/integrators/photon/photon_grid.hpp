@@ -3,22 +3,39 @@
 //                 sorted by cell with a counting sort; a query visits the 2 x 2 x 2 cells its
 //                 ball can touch;
 //   PhotonKdTree  nanoflann's k-d tree (a maintained library), radius search with a callback.
-// Both call f(photon) for exactly the photons within distance r of q (|p - q|^2 <= r^2), in an
-// order fixed by the photons' order: results do not depend on threads.
+// Both search any array of items with a position `p` (photons of either transport, surfel
+// centres), without a copy of it, and call f(i) for exactly the indices i of the items within
+// distance r of q (|p - q|^2 <= r^2), in an order fixed by the items' order: results do not
+// depend on threads.
 #pragma once
 
 #include <cmath>
 #include <memory>
 #include <vector>
 
-#include "integrators/photon/photon.hpp"
+#include "core/vec.hpp"
 
 namespace pathlab {
 
+// Where the positions of n items lie in memory: the first one's, and the distance between two.
+struct Positions {
+    const char* first = nullptr;
+    size_t stride = 0, count = 0;
+
+    template <class P> static Positions of(const std::vector<P>& items) {
+        return {items.empty() ? nullptr : reinterpret_cast<const char*>(&items.front().p), sizeof(P), items.size()};
+    }
+    const Vec3f& operator[](size_t i) const { return *reinterpret_cast<const Vec3f*>(first + i * stride); }
+    size_t size() const { return count; }
+    bool empty() const { return count == 0; }
+};
+
 class PhotonGrid {
 public:
-    // `radius`: the largest query radius to come.
-    void build(const std::vector<Photon>& photons, float radius);
+    // `radius`: the largest query radius to come. The items must stay where they are while the
+    // grid is searched.
+    template <class P> void build(const std::vector<P>& items, float radius) { build(Positions::of(items), radius); }
+    void build(Positions positions, float radius);
     template <typename F> void for_each_within(const Vec3f& q, float r, F&& f) const;
     size_t memory_bytes() const { return cell_ends_.capacity() * sizeof(uint32_t) + order_.capacity() * sizeof(uint32_t); }
 
@@ -26,7 +43,7 @@ private:
     size_t cell_index(int x, int y, int z) const {
         return size_t((uint32_t(x) * 73856093u) ^ (uint32_t(y) * 19349663u) ^ (uint32_t(z) * 83492791u)) % cell_ends_.size();
     }
-    const std::vector<Photon>* photons_ = nullptr;
+    Positions positions_;
     Vec3f lo_{0.0f};
     float cell_size_ = 1, inv_cell_ = 1;
     std::vector<uint32_t> cell_ends_;  // photons of cell c: order_[cell_ends_[c-1] .. cell_ends_[c])
@@ -34,7 +51,7 @@ private:
 };
 
 template <typename F> void PhotonGrid::for_each_within(const Vec3f& q, float r, F&& f) const {
-    if (!photons_ || photons_->empty()) return;
+    if (positions_.empty()) return;
     const float r2 = r * r;
     // The cell holding q, and the neighbours on the side of q's position within it.
     const Vec3f c = (q - lo_) * inv_cell_;
@@ -54,9 +71,9 @@ template <typename F> void PhotonGrid::for_each_within(const Vec3f& q, float r, 
                 visited[n_visited++] = cell;
                 const uint32_t begin = cell == 0 ? 0 : cell_ends_[cell - 1], end = cell_ends_[cell];
                 for (uint32_t k = begin; k < end; ++k) {
-                    const Photon& ph = (*photons_)[order_[k]];
-                    const Vec3f d = ph.p - q;
-                    if (dot(d, d) <= r2) f(ph);
+                    const uint32_t i = order_[k];
+                    const Vec3f d = positions_[i] - q;
+                    if (dot(d, d) <= r2) f(i);
                 }
             }
 }
@@ -65,27 +82,26 @@ class PhotonKdTree {
 public:
     PhotonKdTree();
     ~PhotonKdTree();
-    void build(const std::vector<Photon>& photons, float radius);
+    template <class P> void build(const std::vector<P>& items, float radius) { build(Positions::of(items), radius); }
+    void build(Positions positions, float radius);
     template <typename F> void for_each_within(const Vec3f& q, float r, F&& f) const;
 
-    // The k photons nearest to q (fewer if there are fewer), nearest first: their indices and
+    // The k items nearest to q (fewer if there are fewer), nearest first: their indices and
     // squared distances into indices[0..k) and dist2[0..k); returns how many were found.
     size_t nearest(const Vec3f& q, size_t k, uint32_t* indices, float* dist2) const;
-    const Photon& photon(uint32_t i) const { return (*photons_)[i]; }
 
     struct Index;  // nanoflann's, in photon_grid.cpp
 
 private:
-    // Calls back with photon indices (nanoflann's own order), which this sorts.
+    // Calls back with indices (nanoflann's own order), which this sorts.
     void within(const Vec3f& q, float r, std::vector<uint32_t>& out) const;
-    const std::vector<Photon>* photons_ = nullptr;
     std::unique_ptr<Index> index_;
 };
 
 template <typename F> void PhotonKdTree::for_each_within(const Vec3f& q, float r, F&& f) const {
     thread_local std::vector<uint32_t> found;
     within(q, r, found);
-    for (const uint32_t i : found) f((*photons_)[i]);
+    for (const uint32_t i : found) f(i);
 }
 
 }  // namespace pathlab

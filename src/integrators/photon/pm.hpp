@@ -19,12 +19,22 @@
 // limits each photon's light path and the camera path to the gather point; the estimates count a
 // photon only if the whole path it makes stays within the depth (the k-th distance is still that
 // of all photons).
+//
+// Spectral mode (docs/spectral.md "Spectral photon mapping"): photons and camera paths must carry
+// the same wavelengths, and maps built once at fixed wavelengths would fix every pass's colour
+// sampling too, an error more passes never remove. So each pass draws its wavelengths
+// (SpectralTransport::pass_wavelengths), traces pm's full photon count at them (the same light
+// paths, each pass from its own sample index) and builds both maps anew before its camera
+// samples; RGB mode builds them once, before the first pass (its colour is every pass's). The
+// estimator per pass is RGB pm's, with the same bias at a photon count; the price is the photon
+// pass in every pass.
 #pragma once
 
 #include <vector>
 
 #include "integrators/bidir/bdpt.hpp"
 #include "integrators/integrator.hpp"
+#include "integrators/photon/photon.hpp"
 #include "integrators/photon/photon_grid.hpp"
 
 namespace pathlab {
@@ -33,28 +43,40 @@ struct PmFaults {
     bool no_pi_in_kernel = false;  // the radiance estimate divides by r^2 instead of pi r^2
 };
 
-class PhotonMapper final : public PixelIntegrator {
+template <class T>
+class PhotonMapper final : public Integrator {
 public:
     explicit PhotonMapper(const IntegratorOptions& options, PmFaults faults = {});
 
     void prepare(const RenderContext& ctx, const PassProgress& progress = {}) override;
-    Rgb radiance(const Scene& scene, const Ray& ray, Sampler& sampler) const override;
+    PassCounters render_passes(const RenderContext& ctx, Film& film, uint64_t first, int count, const PassProgress& progress) override;
+    std::vector<IntegratorStatistic> statistics() const override;
+
+    // One camera sample's radiance at the wavelengths of the current maps.
+    ColourOf<T> radiance(const Scene& scene, const Ray& ray, Sampler& sampler, WavelengthsOf<T>& wl) const;
 
     size_t global_photons() const { return global_.size(); }
     size_t caustic_photons() const { return caustic_.size(); }
 
 private:
+    // The maps from the light paths of sample index `pass` at the wavelengths wl; returns the rays traced.
+    uint64_t build_maps(const RenderContext& ctx, uint64_t pass, const WavelengthsOf<T>& wl, const PassProgress& progress);
     // The radiance estimate of `map` at the surface point sp (camera vertex t) for its wi.
-    Rgb estimate(const PhotonKdTree& map, size_t k, const ShadingPoint& sp, int t) const;
+    ColourOf<T> estimate(const std::vector<Photon<T>>& photons, const PhotonKdTree& map, size_t k, const ShadingPoint& sp, int t,
+                         const WavelengthsOf<T>& wl) const;
 
     IntegratorOptions options_;
     PmFaults faults_;
     int max_bounces_;
-    Bdpt light_paths_;
-    std::vector<Photon> global_, caustic_;
+    Bdpt<T> light_paths_;
+    std::vector<std::vector<Photon<T>>> chunk_global_, chunk_caustic_;
+    std::vector<Photon<T>> global_, caustic_;
     PhotonKdTree global_map_, caustic_map_;
-    const Scene* prepared_scene_ = nullptr;  // the maps were made for this scene and seed
+    const Scene* prepared_scene_ = nullptr;  // RGB mode: the maps were made for this scene and seed
     uint64_t prepared_seed_ = 0;
+    std::vector<Vec3d> lattice_, filtered_;  // a filtered pass (pixel_filter.hpp)
 };
+extern template class PhotonMapper<RgbTransport>;
+extern template class PhotonMapper<SpectralTransport>;
 
 }  // namespace pathlab

@@ -20,6 +20,11 @@
 // (--alpha, default 2/3) trade bias against noise early on; the result converges for any. The photons are searched with a hashed grid (photon_grid.hpp; measured
 // against a k-d tree in README). Deterministic: photons are stored in chunk order, and every
 // pixel sums its photons in the grid's fixed order.
+//
+// Spectral mode (docs/spectral.md "Spectral photon mapping"): a merge multiplies a camera path's
+// throughput by a photon's power lane by lane, so every path of a pass, camera and light, carries
+// the pass's wavelengths (SpectralTransport::pass_wavelengths); each pixel's pass sample is
+// converted by the film's estimator with its camera path's wavelengths.
 #pragma once
 
 #include <tbb/enumerable_thread_specific.h>
@@ -29,6 +34,7 @@
 
 #include "integrators/bidir/bdpt.hpp"
 #include "integrators/integrator.hpp"
+#include "integrators/photon/photon.hpp"
 #include "integrators/photon/photon_grid.hpp"
 
 namespace pathlab {
@@ -48,6 +54,7 @@ struct SppmFaults {
 // paper's per-hit-point photon statistics), which keeps iterations independent.
 enum class CameraRays { Jittered, PixelCentres };
 
+template <class T>
 class Sppm final : public Integrator {
 public:
     explicit Sppm(const IntegratorOptions& options, SppmFaults faults = {}, CameraRays rays = CameraRays::Jittered);
@@ -61,19 +68,22 @@ public:
 
 private:
     // The photons of one iteration into photons_, in chunk order; returns the rays traced.
-    uint64_t trace_photons(const RenderContext& ctx, uint64_t pass, size_t paths);
-    Rgb camera_sample(const RenderContext& ctx, size_t pixel, uint64_t pass, float r, size_t paths) const;
+    uint64_t trace_photons(const RenderContext& ctx, uint64_t pass, size_t paths, const WavelengthsOf<T>& wl);
+    // One pixel's sample of the iteration, as the film's colour.
+    Vec3d camera_sample(const RenderContext& ctx, size_t pixel, uint64_t pass, float r, size_t paths, const WavelengthsOf<T>& pass_wl) const;
 
     IntegratorOptions options_;
     SppmFaults faults_;
     CameraRays rays_;
     int max_bounces_;
-    Bdpt light_paths_;  // its light subpaths are the photon paths
-    std::vector<std::vector<Photon>> chunk_photons_;
-    std::vector<Photon> photons_;
+    Bdpt<T> light_paths_;  // its light subpaths are the photon paths
+    std::vector<std::vector<Photon<T>>> chunk_photons_;
+    std::vector<Photon<T>> photons_;
     PhotonGrid grid_;
-    tbb::enumerable_thread_specific<std::vector<PathVertex>> paths_;  // each thread's light subpath
-    std::vector<Vec3d> image_;                                        // one iteration's image
+    tbb::enumerable_thread_specific<std::vector<PathVertex<T>>> paths_;  // each thread's light subpath
+    std::vector<Vec3d> image_;                                           // one iteration's image
 };
+extern template class Sppm<RgbTransport>;
+extern template class Sppm<SpectralTransport>;
 
 }  // namespace pathlab

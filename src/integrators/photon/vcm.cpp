@@ -11,25 +11,29 @@
 
 namespace pathlab {
 
-Vcm::Vcm(const IntegratorOptions& options, VcmFaults faults) : options_(limited_to_length(options)), faults_(faults), bdpt_(options_) {}
+template <class T>
+Vcm<T>::Vcm(const IntegratorOptions& options, VcmFaults faults) : options_(limited_to_length(options)), faults_(faults), bdpt_(options_) {}
 
-size_t Vcm::light_vertex_count() const {
+template <class T>
+size_t Vcm<T>::light_vertex_count() const {
     size_t n = 0;
     for (const auto& c : chunk_vertices_) n += c.size();
     return n;
 }
 
-size_t Vcm::memory_bytes() const {
-    size_t bytes = grid_.memory_bytes() + photons_.capacity() * sizeof(Photon) + photon_vertex_.capacity() * sizeof(void*) +
+template <class T>
+size_t Vcm<T>::memory_bytes() const {
+    size_t bytes = grid_.memory_bytes() + photons_.capacity() * sizeof(Photon<T>) + photon_vertex_.capacity() * sizeof(void*) +
                    path_begin_.capacity() * sizeof(uint32_t) + path_length_.capacity() * sizeof(uint16_t);
-    for (const auto& c : chunk_vertices_) bytes += c.capacity() * sizeof(PathVertex);
-    for (const auto& c : chunk_photons_) bytes += c.capacity() * sizeof(Photon);
+    for (const auto& c : chunk_vertices_) bytes += c.capacity() * sizeof(Vertex);
+    for (const auto& c : chunk_photons_) bytes += c.capacity() * sizeof(Photon<T>);
     for (const auto& c : chunk_photon_vertex_) bytes += c.capacity() * sizeof(uint32_t);
     return bytes;
 }
 
-uint64_t Vcm::trace_light_paths(const RenderContext& ctx, uint64_t pass) {
-    const size_t paths = ctx.pixel_count(), per_chunk = Bdpt::chunk_size(paths), chunks = (paths + per_chunk - 1) / per_chunk;
+template <class T>
+uint64_t Vcm<T>::trace_light_paths(const RenderContext& ctx, uint64_t pass, const Wavelengths& wl) {
+    const size_t paths = ctx.pixel_count(), per_chunk = Bdpt<T>::chunk_size(paths), chunks = (paths + per_chunk - 1) / per_chunk;
     chunk_vertices_.resize(chunks);
     chunk_photons_.resize(chunks);
     chunk_photon_vertex_.resize(chunks);
@@ -39,21 +43,21 @@ uint64_t Vcm::trace_light_paths(const RenderContext& ctx, uint64_t pass) {
     std::atomic<uint64_t> rays{0};
     tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
         const uint64_t rays_before = Scene::rays_traced_by_this_thread();
-        std::vector<PathVertex>& path = subpaths_.local().second;  // keeps its capacity from pass to pass
-        std::vector<PathVertex>& vertices = chunk_vertices_[c];
-        std::vector<Photon>& photons = chunk_photons_[c];
+        std::vector<Vertex>& path = subpaths_.local().second;  // keeps its capacity from pass to pass
+        std::vector<Vertex>& vertices = chunk_vertices_[c];
+        std::vector<Photon<T>>& photons = chunk_photons_[c];
         std::vector<uint32_t>& photon_vertex = chunk_photon_vertex_[c];
         vertices.clear(), photons.clear(), photon_vertex.clear();
         for (size_t j = c * per_chunk; j < std::min(paths, (c + 1) * per_chunk); ++j) {
             // Light path j is pixel j's, from bdpt's stream: the same path bdpt would connect.
-            Sampler sampler(ctx.seed, Bdpt::sample_stream(j, 1), pass, ctx.sampler);
-            bdpt_.light_subpath(ctx, sampler, path);
+            Sampler sampler(ctx.seed, Bdpt<T>::sample_stream(j, 1), pass, ctx.sampler);
+            bdpt_.light_subpath(ctx, sampler, wl, path);
             path_begin_[j] = uint32_t(vertices.size());
             path_length_[j] = uint16_t(path.size());
             for (size_t v = 1; v < path.size(); ++v) {
-                const PathVertex& y = path[v];
+                const Vertex& y = path[v];
                 if (y.kind != VertexKind::Surface || !y.connectible() || int(v) > max_bounces) continue;
-                photons.push_back({y.p, y.sp.frame.to_world(y.sp.wi), y.beta, uint16_t(v)});
+                photons.push_back({y.p, y.sp.frame.to_world(y.sp.wi), y.beta, uint16_t(v), y.dispersed});
                 photon_vertex.push_back(uint32_t(vertices.size() + v));
             }
             vertices.insert(vertices.end(), path.begin(), path.end());
@@ -69,14 +73,15 @@ uint64_t Vcm::trace_light_paths(const RenderContext& ctx, uint64_t pass) {
     return rays.load();
 }
 
-float Vcm::merge_weight(const PathVertex* y, int s, const std::vector<PathVertex>& camera, int t, const MergeMis& vm) const {
+template <class T>
+float Vcm<T>::merge_weight(const Vertex* y, int s, const std::vector<Vertex>& camera, int t, const MergeMis& vm) const {
     // The path is weighed as the connection (s - 1, t) whose camera endpoint is z = z_{t-1}
     // (standing for the photon's vertex y_{s-1}): z's light-side density is the photon's, and
     // the densities through z of its neighbours are z's BSDF's, between the photon's direction
     // and the camera's. The rest of both subpaths keep their stored densities: the light
     // subpath did arrive at y_{s-1}, the camera subpath at z.
-    const PathVertex& z = camera[size_t(t - 1)];
-    const PathVertex& photon = y[s - 1];
+    const Vertex& z = camera[size_t(t - 1)];
+    const Vertex& photon = y[s - 1];
     const Vec3f wp = z.sp.frame.to_local(photon.sp.frame.to_world(photon.sp.wi));
     const float pdf_to_light = z.sp.material->pdf(z.sp, z.sp.wi, wp);   // z sampling the photon's direction
     const float pdf_to_camera = z.sp.material->pdf(z.sp, wp, z.sp.wi);  // ... and the camera's, from the photon's
@@ -105,37 +110,46 @@ float Vcm::merge_weight(const PathVertex* y, int s, const std::vector<PathVertex
     return total > 0 ? float(own / total) : 0.0f;
 }
 
-Rgb Vcm::merge(const std::vector<PathVertex>& camera, int t, float r, const MergeMis& vm) const {
-    const PathVertex& z = camera[size_t(t - 1)];
+template <class T>
+ColourOf<T> Vcm<T>::merge(const std::vector<Vertex>& camera, int t, float r, const MergeMis& vm, const Wavelengths& wl) const {
+    const Vertex& z = camera[size_t(t - 1)];
     const int max_bounces = bdpt_.max_bounces();
-    Rgb sum(0.0f);
-    grid_.for_each_within(z.p, r, [&](const Photon& ph) {
+    MergeSum<T> sum;
+    grid_.for_each_within(z.p, r, [&](uint32_t k) {
+        const Photon<T>& ph = photons_[k];
         const int s = int(ph.vertex) + 1;
         const int depth = s + t - 3;
         if (depth > max_bounces || (options_.only_length >= 0 && depth != options_.only_length)) return;
-        const Rgb f = z.sp.material->eval(z.sp, z.sp.wi, z.sp.frame.to_local(ph.wi));
+        const Vec3f wo = z.sp.frame.to_local(ph.wi);
+        const Rgb f = z.sp.material->eval(z.sp, z.sp.wi, wo);
         if (is_black(f)) return;
-        const PathVertex* y = photon_vertex_[size_t(&ph - photons_.data())] - ph.vertex;
-        sum += f * ph.power * merge_weight(y, s, camera, t, vm);
+        const Vertex* y = photon_vertex_[k] - ph.vertex;
+        sum.add(bsdf_colour(z.sp, wo, f, wl) * ph.power * merge_weight(y, s, camera, t, vm), ph.dispersed);
     });
-    return z.beta * sum / float(norm_);
+    // The factor 4 once per path: a dispersed photon counts 4 times against a camera path of 4
+    // lanes; against a dispersed camera path once, and that path's own hero_only() gives the 4.
+    Wavelengths camera_wl = wl;
+    if (z.dispersed) camera_wl.terminate_secondary();
+    const Colour m = z.beta * sum.total(camera_wl) / float(norm_);
+    return z.dispersed ? hero_only(m) : m;
 }
 
-PassCounters Vcm::render_passes(const RenderContext& ctx, Film& film, uint64_t first, int count, const PassProgress& progress) {
-    if (ctx.spectral) return render_spectral_passes(ctx, film, first, count, progress);  // vcm_spectral.cpp
-    const size_t pixels = ctx.pixel_count(), per_chunk = Bdpt::chunk_size(pixels);
+template <class T>
+PassCounters Vcm<T>::render_passes(const RenderContext& ctx, Film& film, uint64_t first, int count, const PassProgress& progress) {
+    const size_t pixels = ctx.pixel_count(), per_chunk = Bdpt<T>::chunk_size(pixels);
     const int chunks = int((pixels + per_chunk - 1) / per_chunk);
     const double r1 = initial_photon_radius(ctx, options_), alpha = options_.photon_alpha;
     std::atomic<uint64_t> rays{0}, invalid{0};
     for (int k = 0; k < count; ++k) {
         const uint64_t pass = first + uint64_t(k);
+        const Wavelengths wl = T::pass_wavelengths(ctx.seed, ctx.sampler, pass);
         const float r = float(progressive_radius(r1, alpha, pass + 1));
         MergeMis vm;
         vm.merging = options_.vcm_merging;
         vm.connections = options_.vcm_connections;
         norm_ = double(pixels) * (faults_.no_pi_in_kernel ? 1.0 : kPi) * double(r) * double(r);
         vm.eta = norm_;
-        rays += trace_light_paths(ctx, pass);
+        rays += trace_light_paths(ctx, pass, wl);
         if (vm.merging) grid_.build(photons_, r);
         if (progress) progress((double(k) + 0.25) / count);
         pass_.begin(pixels, chunks);
@@ -146,36 +160,39 @@ PassCounters Vcm::render_passes(const RenderContext& ctx, Film& film, uint64_t f
             // Named references, not a structured binding: lambdas below capture them, which C++20
             // allows for bindings but clang before 16 (Debian 12's is 14: the fuzz build) does not.
             auto& subpaths = subpaths_.local();
-            std::vector<PathVertex>& camera = subpaths.first;
-            std::vector<PathVertex>& light = subpaths.second;
+            std::vector<Vertex>& camera = subpaths.first;
+            std::vector<Vertex>& light = subpaths.second;
             for (int c = range.begin(); c != range.end(); ++c) {
                 const uint64_t rays_before = Scene::rays_traced_by_this_thread();
                 uint64_t chunk_invalid = 0;
                 SplatList& splats = pass_.chunk(c);
-                const auto add = [&](const Rgb& value, bool splat, const Vec2f& raster, size_t pixel) {
-                    if (!is_finite(value)) return void(++chunk_invalid);
-                    if (splat && filtered) splats.add_at(raster, value);
-                    else if (splat) splats.add(uint32_t(ctx.camera.pixel_of(raster)), value);
-                    else pass_.pixel(pixel) += Vec3d(value);
-                };
                 for (size_t pixel = size_t(c) * per_chunk; pixel < std::min(pixels, size_t(c + 1) * per_chunk); ++pixel) {
                     Sampler camera_sampler(ctx.seed, pixel, pass, ctx.sampler);
-                    bdpt_.camera_subpath(ctx, pixel, camera_sampler, camera, filtered ? &shift : nullptr);
+                    bdpt_.camera_subpath(ctx, pixel, camera_sampler, wl, camera, filtered ? &shift : nullptr);
                     // This pixel's light subpath, copied: connections modify it for a moment,
                     // while other threads read the stored one to merge.
-                    const PathVertex* stored = chunk_vertices_[pixel / per_chunk].data() + path_begin_[pixel];
+                    const Vertex* stored = chunk_vertices_[pixel / per_chunk].data() + path_begin_[pixel];
                     light.assign(stored, stored + path_length_[pixel]);
+                    // The pixel's own contributions, summed and converted once; splats (t = 1) on their own.
+                    typename T::SampleSum own(0.0f);
+                    const auto add = [&](const Colour& value, bool splat, const Vec2f& raster) {
+                        if (!is_finite(value)) return void(++chunk_invalid);
+                        if (splat && filtered) splats.add_at(raster, Rgb(film_colour(value, wl)));
+                        else if (splat) splats.add(uint32_t(ctx.camera.pixel_of(raster)), Rgb(film_colour(value, wl)));
+                        else accumulate(own, value);
+                    };
                     // bdpt's connections, then merging at each camera vertex z_{t-1}.
                     bdpt_.for_each_connection(
-                        ctx, pixel, pass, light, camera, &vm,
-                        [&](int, int, const StrategyResult& res) { add(res.L * res.weight, res.splat, res.raster, pixel); },
+                        ctx, pixel, pass, light, camera, wl, &vm,
+                        [&](int, int, const StrategyResult<T>& res) { add(res.L * res.weight, res.splat, res.raster); },
                         [&](int t) {
-                            const PathVertex& z = camera[size_t(t - 1)];
+                            const Vertex& z = camera[size_t(t - 1)];
                             if (vm.merging && t >= 2 && z.kind == VertexKind::Surface && z.connectible()) {
-                                const Rgb m = merge(camera, t, r, vm);
-                                if (!is_black(m)) add(m, false, {}, pixel);
+                                const Colour m = merge(camera, t, r, vm, wl);
+                                if (!is_black(m)) add(m, false, {});
                             }
                         });
+                    pass_.pixel(pixel) += film_colour(own, wl);
                 }
                 rays += Scene::rays_traced_by_this_thread() - rays_before;
                 invalid += chunk_invalid;
@@ -186,6 +203,9 @@ PassCounters Vcm::render_passes(const RenderContext& ctx, Film& film, uint64_t f
     }
     return {rays.load(), invalid.load()};
 }
+
+template class Vcm<RgbTransport>;
+template class Vcm<SpectralTransport>;
 
 namespace {
 
@@ -199,19 +219,20 @@ std::vector<ParamInfo> vcm_params() {
 
 const IntegratorInfo& vcm_integrator() {
     static const IntegratorInfo info{"vcm", {}, "vertex connection and merging: bdpt's connections and photon merging, combined by MIS",
-                                     false, true, vcm_params(), [](const IntegratorOptions& o) -> std::unique_ptr<Integrator> {
-                                         return std::make_unique<Vcm>(o);
-                                     }, false, true, /*spectral=*/true};
+                                     false, true, vcm_params(), [](const IntegratorOptions& o) { return make_for_transport<Vcm>(o); }, false,
+                                     true};
     return info;
 }
 
 const IntegratorInfo& bpm_integrator() {
     static const IntegratorInfo info{"bpm", {}, "bidirectional photon mapping: merging at every camera vertex, combined by MIS (vcm without connections)",
-                                     false, true, vcm_params(), [](IntegratorOptions o) -> std::unique_ptr<Integrator> {
+                                     false, true, vcm_params(),
+                                     [](IntegratorOptions o) {
                                          o.vcm_connections = false;
                                          o.vcm_merging = true;
-                                         return std::make_unique<Vcm>(o);
-                                     }, false, true, /*spectral=*/true};
+                                         return make_for_transport<Vcm>(o);
+                                     },
+                                     false, true};
     return info;
 }
 

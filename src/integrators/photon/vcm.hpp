@@ -23,6 +23,14 @@
 // Depth: merging y_{s-1} at z_{t-1} makes s + t - 3 bounces, limited by --max-depth as in bdpt.
 // Deterministic: light subpaths are traced in fixed chunks and stored in order, the grid's
 // order is fixed, and the camera pass splats (t = 1) through bdpt's per-chunk lists.
+//
+// Spectral mode (docs/spectral.md "Spectral vcm and bpm"): a merge multiplies a camera throughput
+// by a photon's power, and a connection two subpaths' throughputs, lane by lane, so every camera
+// and light path of an iteration carries the pass's wavelengths (pass_wavelengths, as the photon
+// methods). A connection through a dispersive vertex is hero_only() (bdpt.hpp); a merge whose
+// photon or camera vertex was reached through one counts lane 0 times 4, once for the whole path
+// (MergeSum against the camera's wavelengths, then hero_only() when the camera side is the
+// dispersed one).
 #pragma once
 
 #include <tbb/enumerable_thread_specific.h>
@@ -31,8 +39,8 @@
 
 #include "integrators/bidir/bdpt.hpp"
 #include "integrators/integrator.hpp"
+#include "integrators/photon/photon.hpp"
 #include "integrators/photon/photon_grid.hpp"
-#include "integrators/photon/spectral_photons.hpp"
 #include "render/pass_image.hpp"
 
 namespace pathlab {
@@ -43,57 +51,51 @@ struct VcmFaults {
     bool merge_weight_without_light_pdf = false;  // a merge's own density lacks the light side's density of its vertex
 };
 
+template <class T>
 class Vcm final : public Integrator {
 public:
+    using Colour = ColourOf<T>;
+    using Wavelengths = WavelengthsOf<T>;
+    using Vertex = PathVertex<T>;
+
     explicit Vcm(const IntegratorOptions& options, VcmFaults faults = {});
 
     PassCounters render_passes(const RenderContext& ctx, Film& film, uint64_t first, int count,
                                const PassProgress& progress) override;
 
-    // The light subpaths and photons of iteration `pass` (kept until the next); returns the rays traced.
-    uint64_t trace_light_paths(const RenderContext& ctx, uint64_t pass);
+    // The light subpaths and photons of iteration `pass` at its wavelengths (kept until the next);
+    // returns the rays traced.
+    uint64_t trace_light_paths(const RenderContext& ctx, uint64_t pass, const Wavelengths& wl);
     // The merging estimate at camera vertex z_{t-1} (t >= 2) with the current photons, radius r,
     // MIS-weighted against every strategy in `vm` (times the camera throughput).
-    Rgb merge(const std::vector<PathVertex>& camera, int t, float r, const MergeMis& vm) const;
+    Colour merge(const std::vector<Vertex>& camera, int t, float r, const MergeMis& vm, const Wavelengths& wl) const;
     // The MIS weight of merging photon y_{s-1} (light subpath y[0..s)) at camera vertex z_{t-1}.
-    float merge_weight(const PathVertex* y, int s, const std::vector<PathVertex>& camera, int t, const MergeMis& vm) const;
+    float merge_weight(const Vertex* y, int s, const std::vector<Vertex>& camera, int t, const MergeMis& vm) const;
 
-    // Spectral mode (vcm_spectral.cpp): every path of iteration `pass` at the pass's wavelengths.
-    uint64_t trace_light_paths_spectral(const RenderContext& ctx, uint64_t pass, const SampledWavelengths& wl);
-    Spectrum4 merge_spectral(const SpectralSubpath& camera, int t, float r, const MergeMis& vm, const SampledWavelengths& wl) const;
-
-    const Bdpt& bdpt() const { return bdpt_; }
+    const Bdpt<T>& bdpt() const { return bdpt_; }
     size_t photon_count() const { return photons_.size(); }
     size_t light_vertex_count() const;
     // Bytes held for the light vertices and photons of one iteration (the grid included).
     size_t memory_bytes() const;
 
 private:
-    PassCounters render_spectral_passes(const RenderContext& ctx, Film& film, uint64_t first, int count, const PassProgress& progress);
-
     IntegratorOptions options_;
     VcmFaults faults_;
-    Bdpt bdpt_;  // the subpaths, the connections and their weights
+    Bdpt<T> bdpt_;  // the subpaths, the connections and their weights
     // One iteration's light subpaths, per chunk of light paths, and where each path starts.
-    std::vector<std::vector<PathVertex>> chunk_vertices_;
-    std::vector<std::vector<Photon>> chunk_photons_;
+    std::vector<std::vector<Vertex>> chunk_vertices_;
+    std::vector<std::vector<Photon<T>>> chunk_photons_;
     std::vector<std::vector<uint32_t>> chunk_photon_vertex_;  // the light vertex of each photon, in its chunk
     std::vector<uint32_t> path_begin_;                         // light path j: its chunk's vertices from here
     std::vector<uint16_t> path_length_;                        // ... this many
-    std::vector<Photon> photons_;
-    std::vector<const PathVertex*> photon_vertex_;  // photons_[k] is the light vertex *photon_vertex_[k]
+    std::vector<Photon<T>> photons_;
+    std::vector<const Vertex*> photon_vertex_;  // photons_[k] is the light vertex *photon_vertex_[k]
     PhotonGrid grid_;
     PassImage pass_;
-    tbb::enumerable_thread_specific<std::pair<std::vector<PathVertex>, std::vector<PathVertex>>> subpaths_;  // camera, light
+    tbb::enumerable_thread_specific<std::pair<std::vector<Vertex>, std::vector<Vertex>>> subpaths_;  // camera, light
     double norm_ = 1;  // N pi r^2 of the current iteration
-    // Spectral mode: the light subpaths' throughputs beside chunk_vertices_ (same indices), where
-    // each path met dispersion (its index into the path; max(): never), the photons' powers
-    // beside photons_, and the threads' subpaths.
-    std::vector<std::vector<Spectrum4>> chunk_betas_;
-    std::vector<std::vector<SpectralPower>> chunk_powers_;
-    std::vector<int> path_dispersed_from_;
-    std::vector<SpectralPower> powers_;
-    tbb::enumerable_thread_specific<std::pair<SpectralSubpath, SpectralSubpath>> spectral_subpaths_;  // camera, light
 };
+extern template class Vcm<RgbTransport>;
+extern template class Vcm<SpectralTransport>;
 
 }  // namespace pathlab

@@ -1,6 +1,6 @@
-// Participating media in spectral mode (docs/spectral.md, "Spectral direct estimators,
-// eyelight and volpath"): media/medium.hpp's free-flight sampling and transmittance at a path's
-// 4 wavelengths instead of 3 RGB channels.
+// A participating medium at a path's 4 wavelengths (spectral mode, docs/spectral.md): the view
+// free_flight.hpp's sampling and transmittance take, with the hero wavelength (lane 0) as the
+// hero channel.
 //
 // Coefficients: a medium's RGB extinction becomes an unbounded spectrum (RgbUnboundedSpectrum)
 // and its RGB albedo a reflectance spectrum (RgbAlbedoSpectrum), sigma_s(lambda) =
@@ -13,8 +13,7 @@
 // That is unbiased because the 4 wavelengths are exchangeable (the hero and its rotations
 // u + i/4 have the same joint law whichever lane is called the hero), so lane 0 as the hero is
 // the same as a hero chosen uniformly among the 4. A path left with the hero alone (a
-// dispersive interface) divides by r_0 instead (spectral_path_density): only its own technique
-// could have made it.
+// dispersive interface) divides by r_0 instead: only its own technique could have made it.
 //
 // Majorants: constant extinction uses the largest lane at the path's wavelengths (exact). A
 // grid keeps its scalar majorant grid (built over RGB voxels), multiplied by a bound K on how far
@@ -29,11 +28,15 @@
 
 namespace pathlab {
 
-struct SpectralMediumCoefficients {
-    Spectrum4 sigma_t, sigma_s;
+struct MediumAtWavelengths {
+    using Colour = Spectrum4;
+    const Medium& m;
+    const SampledWavelengths& wl;
+    bool constant_extinction(Spectrum4& sigma_t) const;
+    Spectrum4 extinction(const Vec3f& p) const;
+    MediumCoefficientsOf<Spectrum4> coefficients(const Vec3f& p) const;
+    MajorantIterator majorants(const Vec3f& o, const Vec3f& d, float tmax, float factor, float& scale) const;
 };
-// The coefficients at point p and the wavelengths wl.
-SpectralMediumCoefficients spectral_medium_coefficients(const Medium& m, const Vec3f& p, const SampledWavelengths& wl);
 
 // K: for every rgb >= 0, max over [360, 830] nm of RgbUnboundedSpectrum(rgb) <= K max(rgb).
 // Computed once from the table's nodes: the unbounded spectrum looks the table up at rgb / 2
@@ -46,17 +49,6 @@ float unbounded_spectrum_bound();
 // The factor a medium's RGB majorants are multiplied by in spectral mode: 1 where its
 // extinction is a one-channel grid or constant (exact there), else unbounded_spectrum_bound().
 float spectral_majorant_factor(const Medium& m);
-
-// media/medium.hpp's sample_free_flight at the wavelengths wl, hero lane 0.
-FreeFlight sample_free_flight_spectral(const Medium& m, const Vec3f& o, const Vec3f& d, float tmax, Sampler& rng, Spectrum4& beta,
-                                       Spectrum4& r, const SampledWavelengths& wl, float majorant_factor = 1);
-
-// media/medium.hpp's estimate_transmittance at the wavelengths wl.
-Spectrum4 estimate_transmittance_spectral(const Medium& m, const Vec3f& o, const Vec3f& d, float tmax, Sampler& rng,
-                                          const SampledWavelengths& wl, float majorant_factor = 1);
-
-// exp(-sigma_t d) per lane, with exp(-0 x inf) = 1.
-Spectrum4 homogeneous_transmittance(const Spectrum4& sigma_t, float distance);
 
 // The path's density over the common normaliser: mean(r) over the 4 lanes' techniques, or r_0
 // once the path carries the hero alone.

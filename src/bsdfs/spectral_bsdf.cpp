@@ -1,102 +1,14 @@
-#include "integrators/common/spectral_shading.hpp"
+#include "bsdfs/spectral_bsdf.hpp"
 
-#include <array>
-#include <cmath>
-#include <cstring>
 #include <stdexcept>
 #include <vector>
 
 #include <fmt/format.h>
 
 #include "spectral/metals.hpp"
-#include "spectral/rgb_to_spectrum.hpp"
-#include "spectral/tabulated.hpp"
+#include "spectral/rgb_spectra.hpp"
 
 namespace pathlab {
-namespace {
-
-// The table's lookup of rgb, through a direct-mapped per-thread cache keyed by rgb's bits.
-SigmoidPolynomial lookup(const Vec3f& rgb) {
-    struct Entry {
-        std::array<uint32_t, 3> bits{};
-        bool valid = false;
-        SigmoidPolynomial poly;
-    };
-    thread_local std::array<Entry, 256> cache;
-    std::array<uint32_t, 3> bits;
-    std::memcpy(&bits[0], &rgb.x, 4);
-    std::memcpy(&bits[1], &rgb.y, 4);
-    std::memcpy(&bits[2], &rgb.z, 4);
-    const uint64_t h = (uint64_t(bits[0]) * 0x9e3779b97f4a7c15ull) ^ (uint64_t(bits[1]) * 0xc2b2ae3d27d4eb4full) ^
-                       (uint64_t(bits[2]) * 0x165667b19e3779f9ull);
-    Entry& e = cache[size_t((h >> 32) & 255)];
-    if (!e.valid || e.bits != bits) {
-        e.poly = RgbToSpectrumTable::srgb()(rgb);
-        e.bits = bits;
-        e.valid = true;
-    }
-    return e.poly;
-}
-
-Spectrum4 at(const SigmoidPolynomial& poly, const SampledWavelengths& wl) {
-    Spectrum4 s;
-    for (int i = 0; i < kSpectrumLanes; ++i) s[i] = poly(wl[i]);
-    return s;
-}
-
-}  // namespace
-
-Spectrum4 unbounded_spectrum(const Rgb& rgb, const SampledWavelengths& wl) {
-    // RgbUnboundedSpectrum: 2m sigmoid_{rgb / 2m}, m = max(rgb).
-    const float m = std::max(std::max(rgb.x, rgb.y), rgb.z);
-    if (!(m > 0)) return Spectrum4(0.0f);
-    const float scale = 2 * m;
-    return at(lookup(rgb / scale), wl) * scale;
-}
-
-Spectrum4 reflectance_spectrum(const Rgb& rgb, const SampledWavelengths& wl) {
-    if (std::max(std::max(rgb.x, rgb.y), rgb.z) > 1) return unbounded_spectrum(rgb, wl);
-    return at(lookup(rgb), wl);  // RgbAlbedoSpectrum
-}
-
-Spectrum4 illuminant_spectrum(const Rgb& rgb, const SampledWavelengths& wl) {
-    if (is_black(rgb)) return Spectrum4(0.0f);
-    return unbounded_spectrum(rgb, wl) * sample_d65_unit_luminance(wl);
-}
-
-Spectrum4 emission_spectrum(const Scene& scene, int light, const Rgb& Le, const SampledWavelengths& wl) {
-    const EmissionSpectrum* own = scene.light_spectrum(light);
-    if (!own) [[likely]]
-        return illuminant_spectrum(Le, wl);
-    if (is_black(Le)) return Spectrum4(0.0f);
-    // Le is the emitter's colour own->rgb times what the light multiplied it by: a scale, a
-    // falloff, 1/d^2 (grey: it scales the spectrum), or a spot's projected texture (a colour:
-    // it multiplies the spectrum as its upsampled unbounded spectrum). Channels where the
-    // spectrum's colour is 0 (clamped out of the gamut) take the largest channel's factor.
-    const Rgb& c = own->rgb;
-    const int m = c.x >= c.y && c.x >= c.z ? 0 : (c.y >= c.z ? 1 : 2);
-    if (!(c[m] > 0)) return Spectrum4(0.0f);
-    const float k = Le[m] / c[m];
-    Rgb factor;
-    bool grey = true;
-    for (int i = 0; i < 3; ++i) {
-        factor[i] = c[i] > 0 ? Le[i] / c[i] : k;
-        grey = grey && std::abs(factor[i] - k) <= 1e-5f * k;
-    }
-    return own->values.sample(wl) * (grey ? Spectrum4(k) : unbounded_spectrum(factor, wl));
-}
-
-Spectrum4 escaped_spectrum(const Scene& scene, const Vec3f& d, const SampledWavelengths& wl) {
-    const int env = scene.environment_light();
-    if (env < 0) return Spectrum4(0.0f);
-    return emission_spectrum(scene, env, scene.escaped_radiance(d), wl);
-}
-
-Spectrum4 emitted_spectrum(const Scene& scene, const Intersection& hit, const Vec3f& w, const SampledWavelengths& wl) {
-    const Rgb Le = emitted_radiance(scene, hit, w);
-    if (is_black(Le)) return Spectrum4(0.0f);
-    return emission_spectrum(scene, hit.light, Le, wl);
-}
 
 const char* spectral_material_names() {
     return "diffuse, phong, conductor, roughconductor, dielectric, roughdielectric, thindielectric, plastic, roughplastic, "
@@ -242,9 +154,10 @@ Spectrum4 model_value(const MaterialModel& model, const MaterialSpectra* spectra
     if (const auto* b = std::get_if<BlendMaterial>(&model))
         return nested(*b->first, b->uv) * (1 - b->weight) + nested(*b->second, b->uv) * b->weight;
     if (const auto* k = std::get_if<MaskMaterial>(&model)) return nested(*k->inner, k->uv) * k->opacity;
-    // The dielectrics (grey; a dispersive one is evaluated at the hero's index by the callers)
-    // and the smooth conductor (no non-delta value).
-    return Spectrum4(visit_model(model, [&](const auto& x) { return x.eval(wi, wo); }).x);
+    // The rough dielectric is grey (a dispersive one is evaluated at the hero's index by the
+    // callers); the smooth conductor and dielectrics have Dirac lobes only, no value for wo.
+    if (const auto* d = std::get_if<RoughDielectricMaterial>(&model)) return Spectrum4(d->eval(wi, wo).x);
+    return Spectrum4(0.0f);
 }
 
 // The colour of the Dirac lobe that produced the delta sample s (wo) of `model`, in RGB and
@@ -275,9 +188,9 @@ LobeColour delta_lobe_colour(const MaterialModel& model, const MaterialSpectra* 
     return {};  // the smooth and thin dielectrics: grey
 }
 
-const MaterialModel& model_here(const ShadingPoint& sp, MaterialModel& storage) {
-    if (!sp.material->varies) return sp.material->model;
-    storage = sp.material->model_at(sp.uv);
+const MaterialModel& model_here(const Material& m, const BsdfContext& ctx, MaterialModel& storage) {
+    if (!m.varies) return m.model;
+    storage = m.model_at(ctx.uv);
     return storage;
 }
 
@@ -294,51 +207,49 @@ Material at_hero_index(const Material& m, const SampledWavelengths& wl) {
 
 }  // namespace
 
-Spectrum4 spectral_eval(const ShadingPoint& sp, const Vec3f& wo, const Rgb& f_rgb, const SampledWavelengths& wl) {
+Spectrum4 spectral_eval(const Material& m, const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo, const Rgb& f_rgb,
+                        const SampledWavelengths& wl) {
     if (is_black(f_rgb)) return Spectrum4(0.0f);
     MaterialModel storage;
-    const MaterialModel& model = model_here(sp, storage);
+    const MaterialModel& model = model_here(m, ctx, storage);
     if (std::holds_alternative<RoughDielectricMaterial>(model)) return Spectrum4(f_rgb.x);  // grey, the context's factor included
-    Spectrum4 f = model_value(model, sp.material->spectra.get(), sp.wi, wo, wl);
-    if (sp.mode == TransportMode::Importance) f *= sp.material->importance_factor(sp, sp.wi, wo);
+    Spectrum4 f = model_value(model, m.spectra.get(), wi, wo, wl);
+    if (ctx.mode == TransportMode::Importance) f *= m.importance_factor(ctx, wi, wo);
     return f;
 }
 
-Spectrum4 spectral_eval_and_pdf(const ShadingPoint& sp, const Vec3f& wo, SampledWavelengths& wl, float& pdf) {
-    if (is_dispersive(sp.material->model)) [[unlikely]] {
+Spectrum4 spectral_eval_and_pdf(const Material& m, const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo, SampledWavelengths& wl,
+                                float& pdf) {
+    if (is_dispersive(m.model)) [[unlikely]] {
         // The rough dispersive dielectric: its value and density at the hero's index; the path
         // carries the hero alone from here (as at a sampled dispersive interface).
         wl.terminate_secondary();
-        const Material hero = at_hero_index(*sp.material, wl);
-        ShadingPoint at_hero = sp;
-        at_hero.material = &hero;
-        return Spectrum4(hero.eval_and_pdf(at_hero, sp.wi, wo, pdf).x);
+        return Spectrum4(at_hero_index(m, wl).eval_and_pdf(ctx, wi, wo, pdf).x);
     }
-    const Rgb f_rgb = sp.material->eval_and_pdf(sp, sp.wi, wo, pdf);
-    return spectral_eval(sp, wo, f_rgb, wl);
+    const Rgb f_rgb = m.eval_and_pdf(ctx, wi, wo, pdf);
+    return spectral_eval(m, ctx, wi, wo, f_rgb, wl);
 }
 
-std::optional<BsdfSample> spectral_sample(const ShadingPoint& sp, const Vec2f& u, SampledWavelengths& wl) {
-    if (is_dispersive(sp.material->model)) [[unlikely]] {
+std::optional<BsdfSample> spectral_sample(const Material& m, const BsdfContext& ctx, const Vec3f& wi, const Vec2f& u,
+                                          SampledWavelengths& wl) {
+    if (is_dispersive(m.model)) [[unlikely]] {
         // Refraction (and reflection) of the hero wavelength with its index; the other lanes'
         // paths would part from it, so the path keeps the hero alone.
         wl.terminate_secondary();
-        const Material hero = at_hero_index(*sp.material, wl);
-        ShadingPoint at_hero = sp;
-        at_hero.material = &hero;
-        return hero.sample(at_hero, sp.wi, u);
+        return at_hero_index(m, wl).sample(ctx, wi, u);
     }
-    return sp.material->sample(sp, sp.wi, u);
+    return m.sample(ctx, wi, u);
 }
 
-Spectrum4 spectral_sample_value(const ShadingPoint& sp, const BsdfSample& s, const SampledWavelengths& wl) {
+Spectrum4 spectral_sample_value(const Material& m, const BsdfContext& ctx, const Vec3f& wi, const BsdfSample& s,
+                                const SampledWavelengths& wl) {
     if (is_black(s.f)) return Spectrum4(0.0f);
-    if (!s.delta) return spectral_eval(sp, s.wo, s.f, wl);
+    if (!s.delta) return spectral_eval(m, ctx, wi, s.wo, s.f, wl);
     MaterialModel storage;
-    const LobeColour c = delta_lobe_colour(model_here(sp, storage), sp.material->spectra.get(), sp.wi, s.wo, wl);
-    const int m = c.rgb.x >= c.rgb.y && c.rgb.x >= c.rgb.z ? 0 : (c.rgb.y >= c.rgb.z ? 1 : 2);
-    if (!(c.rgb[m] > 0)) return Spectrum4(0.0f);
-    return c.spectral * (s.f[m] / c.rgb[m]);
+    const LobeColour c = delta_lobe_colour(model_here(m, ctx, storage), m.spectra.get(), wi, s.wo, wl);
+    const int k = c.rgb.x >= c.rgb.y && c.rgb.x >= c.rgb.z ? 0 : (c.rgb.y >= c.rgb.z ? 1 : 2);
+    if (!(c.rgb[k] > 0)) return Spectrum4(0.0f);
+    return c.spectral * (s.f[k] / c.rgb[k]);
 }
 
 }  // namespace pathlab

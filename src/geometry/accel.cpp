@@ -95,10 +95,18 @@ RTCRay to_embree(const Ray& r, uint32_t mask) {
     return e;
 }
 
+// Embree chooses its kernels by the CPU (SSE4.2, AVX, AVX2, AVX-512), and they round a hit's
+// distance and barycentrics differently in the last bits: the same render would give other bytes
+// on another CPU. Pinned to AVX2 wherever the CPU has it (x86-64 CPUs since 2013), so renders,
+// checkpoints, merges and MPI ranks agree bit for bit across machines; on older CPUs Embree chooses.
+const char* embree_config() {
+    return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") ? "isa=avx2" : nullptr;
+}
+
 }  // namespace
 
 Accel::Accel() {
-    device_ = rtcNewDevice(nullptr);
+    device_ = rtcNewDevice(embree_config());
     if (!device_) throw std::runtime_error("cannot create an Embree device");
     rtcSetDeviceErrorFunction(device_, embree_error, nullptr);
     scene_ = rtcNewScene(device_);

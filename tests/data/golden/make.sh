@@ -3,6 +3,11 @@
 # They were made once, by the per-pixel estimator core at commit d26934e (before the
 # integrator architecture of issue 14), and must never be re-made to make a test pass: an
 # integrator refactoring that changes any of them has changed an estimator's result.
+# Re-made once, from the same commit d26934e, when Embree was pinned to its AVX2 kernels
+# (src/geometry/accel.cpp): the first set came from a machine whose Embree ran AVX-512 kernels,
+# which round hit points differently in the last bits, so 52 of these images could not be
+# reproduced on an AVX2-only machine. d26934e with that one line patched rendered this set, and
+# the code of issue 35 (integrators written once) renders all 138 bit for bit the same.
 # Usage (from the repository root, with that commit built): tests/data/golden/make.sh build/pathlab
 set -euo pipefail
 bin=${1:-build/pathlab}

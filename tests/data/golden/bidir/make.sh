@@ -2,6 +2,8 @@
 # RGB images of lt and bdpt rendered at commit 7d99cd4, before spectral mode reached them
 # (tests/test_spectral_bidir.cpp, SpectralBidir.RgbImagesAreThoseRenderedBeforeSpectralMode,
 # renders them again and compares bit for bit). Run from the repository root with that build.
+# Re-made once, from the same commit 7d99cd4 with Embree pinned to its AVX2 kernels (see
+# src/geometry/accel.cpp and ../make.sh): the first set came from an AVX-512 machine.
 set -e
 S=scenes/materials/smooth.xml
 for spec in "5-bdpt:5:bdpt" "7-bdpt:7:bdpt" "1-lt:1:lt" "6-lt:6:lt" "smooth-bdpt:$S:bdpt" "smooth-lt:$S:lt"; do

@@ -3,6 +3,8 @@
 // multiple importance sampling.
 #pragma once
 
+#include <optional>
+
 #include "samplers/sampler.hpp"
 #include "core/sampling.hpp"
 #include "integrators/common/shading.hpp"
@@ -46,6 +48,22 @@ ColourAt<Wl> estimate_light_sample(const Scene& scene, const ShadingPoint& sp, S
     const float pdf_light = choice.pmf * ls->pdfW;
     const float weight = (mis && !ls->delta) ? balance_heuristic(pdf_light, pdf_bsdf) : 1.0f;
     return f * light_colour(scene, choice.index, ls->Le, wl) * (std::abs(wo.z) * weight / pdf_light);
+}
+
+// The direct estimators' first hit: `L` becomes what the camera ray sees there (the emitter it
+// hits or the sky; nothing with `hide`), and the shading point is returned unless the ray escaped
+// or the surface is black.
+template <class Wl>
+std::optional<ShadingPoint> first_surface(const Scene& scene, const Ray& ray, bool hide, const Wl& wl, ColourAt<Wl>& L) {
+    Intersection hit;
+    if (!scene.intersect(ray, hit)) {
+        L = hide ? ColourAt<Wl>(0.0f) : escaped_radiance(scene, ray.d, wl);
+        return std::nullopt;
+    }
+    L = hide ? ColourAt<Wl>(0.0f) : emitted_radiance(scene, hit, -ray.d, wl);
+    const ShadingPoint sp = make_shading_point(scene, hit, ray.d);
+    if (sp.material->is_black()) return std::nullopt;
+    return sp;
 }
 
 // What a ray leaving a shading point finds: the surface it hits (if any), the radiance emitted

@@ -13,13 +13,10 @@ class DirectLight final : public PixelIntegrator<T> {
 public:
     explicit DirectLight(const IntegratorOptions& o) : hide_(o.hide_emitters) {}
     ColourOf<T> radiance(const Scene& scene, const Ray& ray, Sampler& sampler, WavelengthsOf<T>& wl) const override {
-        using Colour = ColourOf<T>;
-        Intersection hit;
-        if (!scene.intersect(ray, hit)) return hide_ ? Colour(0.0f) : escaped_radiance(scene, ray.d, wl);
-        Colour L = hide_ ? Colour(0.0f) : emitted_radiance(scene, hit, -ray.d, wl);
-        const ShadingPoint sp = make_shading_point(scene, hit, ray.d);
-        if (sp.material->is_black()) return L;
-        return L + estimate_light_sample(scene, sp, sampler, /*mis=*/false, wl);
+        ColourOf<T> L;
+        const auto sp = first_surface(scene, ray, hide_, wl, L);
+        if (!sp) return L;
+        return L + estimate_light_sample(scene, *sp, sampler, /*mis=*/false, wl);
     }
 
 private:

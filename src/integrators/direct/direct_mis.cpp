@@ -26,12 +26,10 @@ class DirectMis final : public PixelIntegrator<T> {
 public:
     explicit DirectMis(const IntegratorOptions& o) : hide_(o.hide_emitters) {}
     ColourOf<T> radiance(const Scene& scene, const Ray& ray, Sampler& sampler, WavelengthsOf<T>& wl) const override {
-        using Colour = ColourOf<T>;
-        Intersection hit;
-        if (!scene.intersect(ray, hit)) return hide_ ? Colour(0.0f) : escaped_radiance(scene, ray.d, wl);
-        Colour L = hide_ ? Colour(0.0f) : emitted_radiance(scene, hit, -ray.d, wl);
-        const ShadingPoint sp = make_shading_point(scene, hit, ray.d);
-        if (sp.material->is_black()) return L;
+        ColourOf<T> L;
+        const auto first = first_surface(scene, ray, hide_, wl, L);
+        if (!first) return L;
+        const ShadingPoint& sp = *first;
         L += estimate_light_sample(scene, sp, sampler, /*mis=*/true, wl);
         if (!scene.has_hittable_emitters()) return L;  // only delta lights: the BSDF ray finds nothing
         if (const auto s = bsdf_sample(sp, sampler.next2d(), wl)) {

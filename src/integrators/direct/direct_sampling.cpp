@@ -20,11 +20,10 @@ public:
 
     ColourOf<T> radiance(const Scene& scene, const Ray& ray, Sampler& sampler, WavelengthsOf<T>& wl) const override {
         using Colour = ColourOf<T>;
-        Intersection hit;
-        if (!scene.intersect(ray, hit)) return hide_ ? Colour(0.0f) : escaped_radiance(scene, ray.d, wl);
-        Colour L = hide_ ? Colour(0.0f) : emitted_radiance(scene, hit, -ray.d, wl);
-        const ShadingPoint sp = make_shading_point(scene, hit, ray.d);
-        if (sp.material->is_black()) return L;
+        Colour L;
+        const auto first = first_surface(scene, ray, hide_, wl, L);
+        if (!first) return L;
+        const ShadingPoint& sp = *first;
 
         const Vec2f u = sampler.next2d();
         Vec3f wo;

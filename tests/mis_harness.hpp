@@ -219,8 +219,10 @@ public:
     }
     // Subpaths with the densities their random walks record (pdf_fwd from the predecessor,
     // pdf_rev from the successor on the same subpath); the vertices at the new edge get NaN,
-    // which bdpt must overwrite.
-    void subpaths(const FullPath& f, int s, std::vector<PathVertex<RgbTransport>>& light, std::vector<PathVertex<RgbTransport>>& camera) const {
+    // which bdpt must overwrite. Their running MIS quantities are made as bdpt's subpaths make
+    // them, for the heuristic (power) and the merging strategies vm.
+    void subpaths(const FullPath& f, int s, std::vector<PathVertex<RgbTransport>>& light, std::vector<PathVertex<RgbTransport>>& camera,
+                  bool power = false, const MergeMis* vm = nullptr) const {
         const int n = k(f), t = n + 1 - s;
         camera.clear(), light.clear();
         for (int j = 0; j < t; ++j) {
@@ -238,6 +240,8 @@ public:
             if (i >= s - 2) v.pdf_rev = NAN;
             light.push_back(v);
         }
+        set_running_mis(light.data(), int(light.size()), /*light_side=*/true, MisRules(power, vm));
+        set_running_mis(camera.data(), int(camera.size()), /*light_side=*/false, MisRules(power, vm));
     }
     PathVertex<RgbTransport> sampled_end(const FullPath& f, int s) const {
         if (s == 1) {

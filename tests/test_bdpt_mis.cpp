@@ -32,9 +32,11 @@ void expect_weights(const MisHarness& h, const FullPath& f, const std::string& w
             if (!h.valid(f, s)) continue;
             ++strategies;
             std::vector<PathVertex<RgbTransport>> light, camera;
-            h.subpaths(f, s, light, camera);
+            h.subpaths(f, s, light, camera, power);
             const float w = h.bdpt(power).mis_weight(h.ctx(), light, s, camera, n + 1 - s, h.sampled_end(f, s));
+            const float oracle = h.bdpt(power).mis_weight_oracle(h.ctx(), light, s, camera, n + 1 - s, h.sampled_end(f, s));
             const double expected = h.direct_weight(f, s, power);
+            EXPECT_NEAR(w, oracle, 1e-5 * oracle + 1e-12) << what << (power ? " (power)" : " (balance)") << ", s=" << s << ": running vs walk";
             ASSERT_FALSE(std::isnan(w)) << what << " s=" << s;
             EXPECT_GE(w, 0.0f) << what;
             EXPECT_LE(w, 1.0f) << what;

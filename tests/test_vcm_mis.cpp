@@ -4,7 +4,9 @@
 // written out from their definitions, the merge's being the VCM report's: the density of the
 // connection whose camera endpoint is x_j, times the light side's area density of x_j, times
 // eta = light paths x pi r^2. The weights sum to 1, with connections on (vcm) and off (bpm), for
-// several eta; a merge weight that leaves out the light side's density is caught.
+// several eta; a merge weight that leaves out the light side's density is caught. The weights
+// vcm renders with (running quantities, O(1) per connection and per merged photon) equal those
+// of Veach's ratio walk (the oracle) to 1e-5 relative.
 #include "integrators/photon/vcm.hpp"
 #include "mis_harness.hpp"
 
@@ -42,18 +44,25 @@ public:
 
     float connection_weight(const FullPath& f, int s) const {
         std::vector<PathVertex<RgbTransport>> light, camera;
-        h_.subpaths(f, s, light, camera);
-        return vcm_.bdpt().mis_weight(h_.ctx(), light, s, camera, h_.k(f) + 1 - s, h_.sampled_end(f, s), {}, &vm_);
+        h_.subpaths(f, s, light, camera, power_, &vm_);
+        const int t = h_.k(f) + 1 - s;
+        const float w = vcm_.bdpt().mis_weight(h_.ctx(), light, s, camera, t, h_.sampled_end(f, s), {}, &vm_);
+        const float oracle = vcm_.bdpt().mis_weight_oracle(h_.ctx(), light, s, camera, t, h_.sampled_end(f, s), {}, &vm_);
+        EXPECT_NEAR(w, oracle, 1e-5 * oracle + 1e-12) << "connection s=" << s << ": running vs walk";
+        return w;
     }
     // The photon x_j on the light subpath x_k .. x_j, merged at x_j on the camera subpath x_0 .. x_j.
     float merge_weight(const FullPath& f, int j) const {
         const int s = h_.k(f) - j + 1;
         std::vector<PathVertex<RgbTransport>> light, camera, unused;
-        h_.subpaths(f, s, light, unused);
-        h_.subpaths(f, s - 1, unused, camera);
+        h_.subpaths(f, s, light, unused, power_, &vm_);
+        h_.subpaths(f, s - 1, unused, camera, power_, &vm_);
         // As the light walk stores it: 0 after a Dirac vertex.
         if (h_.specular(f, j + 1)) light.back().pdf_fwd = 0;
-        return vcm_.merge_weight(light.data(), s, camera, j + 1, vm_);
+        const float w = vcm_.merge_weight(light.data(), s, camera, j + 1, vm_);
+        const float oracle = vcm_.merge_weight_oracle(light.data(), s, camera, j + 1, vm_);
+        EXPECT_NEAR(w, oracle, 1e-5 * oracle + 1e-12) << "merge at x_" << j << ": running vs walk";
+        return w;
     }
 
 private:

@@ -117,7 +117,7 @@ void Bdpt<T>::random_walk(const RenderContext& ctx, Ray ray, Sampler& sampler, C
 
 template <class T>
 void Bdpt<T>::camera_subpath(const RenderContext& ctx, size_t pixel, Sampler& sampler, const Wavelengths& wl, Subpath& path,
-                             const Vec2f* shift) const {
+                             const Vec2f* shift, const MergeMis* vm) const {
     path.clear();
     Vertex c;
     c.kind = VertexKind::Camera;
@@ -130,10 +130,11 @@ void Bdpt<T>::camera_subpath(const RenderContext& ctx, size_t pixel, Sampler& sa
     const Ray ray = ctx.camera.generate(x + jitter.x, y + jitter.y);
     // We cos / (pdfA pdfW) = 1 for the pinhole: the camera path starts with throughput 1.
     random_walk(ctx, ray, sampler, Colour(1.0f), ctx.camera.pdf_direction(ray.d), max_camera_vertices(), TransportMode::Radiance, wl, path);
+    set_running_mis(path.data(), int(path.size()), /*light_side=*/false, MisRules(options_.mis_power, vm));
 }
 
 template <class T>
-void Bdpt<T>::light_subpath(const RenderContext& ctx, Sampler& sampler, const Wavelengths& wl, Subpath& path) const {
+void Bdpt<T>::light_subpath(const RenderContext& ctx, Sampler& sampler, const Wavelengths& wl, Subpath& path, const MergeMis* vm) const {
     path.clear();
     const Scene& scene = ctx.scene;
     const auto start = start_light_path(scene, sampler);
@@ -162,18 +163,53 @@ void Bdpt<T>::light_subpath(const RenderContext& ctx, Sampler& sampler, const Wa
         if (path.size() > 1) path[1].pdf_fwd = es->pdfA * (path[1].has_normal() ? std::abs(dot(path[1].n, es->direction)) : 1.0f);
         path[0].pdf_fwd = pdf_light_origin(scene, path[0], path[0]);
     }
+    set_running_mis(path.data(), int(path.size()), /*light_side=*/true, MisRules(options_.mis_power, vm));
+}
+
+template <class T>
+ConnectionDensities Bdpt<T>::connection_densities(const RenderContext& ctx, const Vertex* ys, int s, const Vertex* zs, int t,
+                                                  const EdgeDensities& known) const {
+    const Scene& scene = ctx.scene;
+    const Vertex* qs = s > 0 ? &ys[s - 1] : nullptr;
+    const Vertex* pt = &zs[t - 1];
+    const Vertex* qs_minus = s > 1 ? &ys[s - 2] : nullptr;
+    const Vertex* pt_minus = t > 1 ? &zs[t - 2] : nullptr;
+    ConnectionDensities d;
+    if (s == 0) d.camera_end = pdf_light_origin(scene, *pt, *pt_minus);
+    else if (known.qs_to_pt >= 0) d.camera_end = to_area_density(known.qs_to_pt, *qs, *pt);
+    else d.camera_end = pdf_next(scene, ctx.camera, qs_minus, *qs, *pt);
+    if (pt_minus) d.camera_prev = s > 0 ? pdf_next(scene, ctx.camera, qs, *pt, *pt_minus) : pdf_light_emission(scene, *pt, *pt_minus);
+    if (qs) d.light_end = known.pt_to_qs >= 0 ? to_area_density(known.pt_to_qs, *pt, *qs) : pdf_next(scene, ctx.camera, pt_minus, *pt, *qs);
+    if (qs_minus) d.light_prev = pdf_next(scene, ctx.camera, pt, *qs, *qs_minus);
+    return d;
 }
 
 template <class T>
 float Bdpt<T>::mis_weight(const RenderContext& ctx, Subpath& light, int s, Subpath& camera, int t, const Vertex& sampled,
                           const EdgeDensities& known, const MergeMis* vm) const {
     if (s + t == 2) return 1.0f;
-    const Scene& scene = ctx.scene;
-    // The strategy's own vertices: the sampled endpoint (y_0 for s = 1, z_0 for t = 1: the only
-    // vertex of its side the walk reads), and the densities across the new edge.
+    if (faults_.any()) return mis_weight_oracle(ctx, light, s, camera, t, sampled, known, vm);
+    // The strategy's own vertices: the sampled endpoint (y_0 for s = 1, z_0 for t = 1), and the
+    // densities across the new edge; the rest from the running quantities (path_vertex.hpp).
+    const Vertex* const ys = s == 1 ? &sampled : light.data();
+    const Vertex* const zs = t == 1 ? &sampled : camera.data();
+    const ConnectionDensities d = connection_densities(ctx, ys, s, zs, t, known);
+    const MisRules rules(options_.mis_power, vm);
+    double sum = 0;
+    if (s >= 1) sum += light_side_sum(ys, s - 1, d.light_end, d.light_prev, rules);
+    if (t >= 2) sum += camera_side_sum(zs, t - 1, zs[t - 1].pdf_fwd, d.camera_end, d.camera_end, s >= 1, d.camera_prev, rules);
+    return float(1 / (1 + sum));
+}
+
+template <class T>
+float Bdpt<T>::mis_weight_oracle(const RenderContext& ctx, Subpath& light, int s, Subpath& camera, int t, const Vertex& sampled,
+                                 const EdgeDensities& known, const MergeMis* vm) const {
+    if (s + t == 2) return 1.0f;
+    // The connection's densities written onto the vertices for the walk, and restored after.
     Vertex end = sampled;
     Vertex* const ys = s == 1 ? &end : light.data();
     Vertex* const zs = t == 1 ? &end : camera.data();
+    const ConnectionDensities d = connection_densities(ctx, ys, s, zs, t, known);
     Vertex* qs = s > 0 ? &ys[s - 1] : nullptr;
     Vertex* pt = &zs[t - 1];
     Vertex* qs_minus = s > 1 ? &ys[s - 2] : nullptr;
@@ -189,12 +225,10 @@ float Bdpt<T>::mis_weight(const RenderContext& ctx, Subpath& light, int s, Subpa
     // The connected vertices are not Dirac here (the connection evaluated their BSDFs).
     pt->delta = false;
     if (qs) qs->delta = false;
-    if (s == 0) pt->pdf_rev = pdf_light_origin(scene, *pt, *pt_minus);
-    else if (known.qs_to_pt >= 0) pt->pdf_rev = to_area_density(known.qs_to_pt, *qs, *pt);
-    else pt->pdf_rev = pdf_next(scene, ctx.camera, qs_minus, *qs, *pt);
-    if (pt_minus) pt_minus->pdf_rev = s > 0 ? pdf_next(scene, ctx.camera, qs, *pt, *pt_minus) : pdf_light_emission(scene, *pt, *pt_minus);
-    if (qs) qs->pdf_rev = known.pt_to_qs >= 0 ? to_area_density(known.pt_to_qs, *pt, *qs) : pdf_next(scene, ctx.camera, pt_minus, *pt, *qs);
-    if (qs_minus) qs_minus->pdf_rev = pdf_next(scene, ctx.camera, pt, *qs, *qs_minus);
+    pt->pdf_rev = d.camera_end;
+    if (pt_minus) pt_minus->pdf_rev = d.camera_prev;
+    if (qs) qs->pdf_rev = d.light_end;
+    if (qs_minus) qs_minus->pdf_rev = d.light_prev;
 
     float w = 0;
     if (faults_.drop_nee_strategy && s != 1) {

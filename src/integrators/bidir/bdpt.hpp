@@ -9,9 +9,11 @@
 //   else    an inner connection with a shadow ray.
 // s = t = 1 (a light connected to the camera) is not used: emitters seen directly come from
 // s = 0, t = 2 alone. The strategies that produce one path are combined by multiple importance
-// sampling, the balance heuristic by default or the power heuristic (`--mis power`), with the
-// weights computed by Veach's ratio walk over the densities stored on the vertices
-// (path_vertex.hpp), as pbrt formulates it. Dirac lobes (mirrors, glass, the coating of
+// sampling, the balance heuristic by default or the power heuristic (`--mis power`). The weights
+// are Veach's ratio form over the densities stored on the vertices (path_vertex.hpp), evaluated
+// in O(1) per connection from running quantities carried along each subpath (Georgiev et al.,
+// "Implementing Vertex Connection and Merging"); the ratio walk itself is kept as the tests'
+// oracle (mis_weight_oracle). Dirac lobes (mirrors, glass, the coating of
 // plastic), delta lights (point, spot, ies, directional), the environment (constant or a map)
 // and one-sided emitters each enter the densities as path_vertex.hpp says.
 //
@@ -57,6 +59,7 @@ class StrategyImages;
 struct BdptFaults {
     bool drop_nee_strategy = false;      // MIS weights leave the s = 1 strategies out of their sums
     bool specular_pdf_rev_missing = false;  // a Dirac vertex's reverse density left unset (0)
+    bool any() const { return drop_nee_strategy || specular_pdf_rev_missing; }
 };
 
 // What one strategy gives for one sample: the unweighted contribution (a path through
@@ -76,6 +79,12 @@ struct EdgeDensities {
     float qs_to_pt = -1;  // y_{s-1}'s BSDF sampling the direction to z_{t-1}
 };
 
+// The area densities that a connection gives the vertices at its new edge, from the other side:
+// its camera endpoint z_{t-1} and the one before it, its light endpoint y_{s-1} and the one before.
+struct ConnectionDensities {
+    float camera_end = 0, camera_prev = 0, light_end = 0, light_prev = 0;
+};
+
 template <class T>
 class Bdpt final : public Integrator {
 public:
@@ -91,18 +100,28 @@ public:
                                const PassProgress& progress) override;
     void finish(const RenderContext& ctx) override;
 
-    // The subpaths of one sample at its wavelengths wl (for the tests and the per-pixel loop).
+    // The subpaths of one sample at its wavelengths wl (for the tests and the per-pixel loop),
+    // with their running MIS quantities for the strategies `vm` adds (vcm; none: bdpt's).
     // `shift`: with a reconstruction filter, the pass's lattice shift replaces the pixel's jitter.
     void camera_subpath(const RenderContext& ctx, size_t pixel, Sampler& sampler, const Wavelengths& wl, Subpath& path,
-                        const Vec2f* shift = nullptr) const;
-    void light_subpath(const RenderContext& ctx, Sampler& sampler, const Wavelengths& wl, Subpath& path) const;
+                        const Vec2f* shift = nullptr, const MergeMis* vm = nullptr) const;
+    void light_subpath(const RenderContext& ctx, Sampler& sampler, const Wavelengths& wl, Subpath& path,
+                       const MergeMis* vm = nullptr) const;
     // Strategy (s, t) on the subpaths (which it may modify temporarily); `vm`: the merging
     // strategies that also take part in its MIS weight (vcm).
     StrategyResult<T> connect(const RenderContext& ctx, Subpath& light, int s, Subpath& camera, int t, Sampler& sampler,
                               const Wavelengths& wl, const MergeMis* vm = nullptr) const;
-    // The MIS weight of strategy (s, t); `sampled` replaces y_0 (s = 1) or z_0 (t = 1).
+    // The MIS weight of strategy (s, t); `sampled` replaces y_0 (s = 1) or z_0 (t = 1). From the
+    // subpaths' running quantities (made with the same `vm`) in O(1).
     float mis_weight(const RenderContext& ctx, Subpath& light, int s, Subpath& camera, int t, const Vertex& sampled,
                      const EdgeDensities& known = {}, const MergeMis* vm = nullptr) const;
+    // The same weight by Veach's ratio walk over both subpaths: the oracle of the tests (and the
+    // weight of the deliberate faults).
+    float mis_weight_oracle(const RenderContext& ctx, Subpath& light, int s, Subpath& camera, int t, const Vertex& sampled,
+                            const EdgeDensities& known = {}, const MergeMis* vm = nullptr) const;
+    // The densities strategy (s, t) gives the vertices at its new edge.
+    ConnectionDensities connection_densities(const RenderContext& ctx, const Vertex* ys, int s, const Vertex* zs, int t,
+                                             const EdgeDensities& known) const;
 
     // Every connection strategy of one pixel sample, in bdpt's order and from its random
     // streams: strategy(s, t, result) for each one with a contribution, and after_vertex(t) once

@@ -39,10 +39,14 @@ struct PathVertexBase {
     // wavelength alone from here on (the throughput's other lanes are 0).
     bool dispersed = false;
     int light = -1;          // the light of a light vertex, or of the emitter a surface lies on
+    // The running MIS quantity (set_running_mis): the part of a strategy's MIS sum that comes
+    // from this subpath's vertices two or more before this one, as a connection or merge ending
+    // here needs it (the VCM report's dVCM / dVC / dVM, folded into one number).
+    double mis_running = 0;
 
     bool has_normal() const { return !is_black(n); }
     // Whether a strategy may connect a new edge here.
-    bool connectible() const {
+    [[gnu::always_inline]] bool connectible() const {
         switch (kind) {
             case VertexKind::Camera: return true;
             case VertexKind::Light: return !(delta_light && infinite);  // not a directional light
@@ -145,6 +149,94 @@ float mis_weight_ratio_walk(const Vertex* light, int s, const Vertex* camera, in
     const double sum = mis_ratio_sum([light](int i) { return mis_vertex(light[i]); }, s, [camera](int i) { return mis_vertex(camera[i]); },
                                      t, power, vm);
     return float(1 / (1 + sum));
+}
+
+// ---- MIS weights from running quantities (Georgiev et al., "Implementing Vertex Connection
+// and Merging", 2012) --------------------------------------------------------------------------
+// The ratio walk above costs O(path length) per connection and per merged photon. The same sums
+// are carried along each subpath instead: mis_running of vertex m holds what the walk adds for
+// the strategies whose endpoint lies at vertex m - 1 or before, with the densities that a
+// connection or merge at m leaves unchanged (every pdf_fwd, and pdf_rev of vertices m - 2 and
+// before), as a factor of the ratios at m and m - 1 that the connection decides. A connection
+// then completes the sum from its endpoint's neighbourhood in O(1):
+//   light side, endpoint y_e:  h(Q'_e) (c_e + mc_e h(phi_e eta) + h(Q'_{e-1}) X_e)
+//   camera side, endpoint z_e: mc_e h(psi_e eta) + h(R'_e) (c_e + mc_{e-1} h(rev'_{e-1} eta) + h(R'_{e-1}) Y_e)
+// with Q, R = pdf_rev / pdf_fwd (0 read as 1, a Dirac lobe), c / mc whether a connection / a
+// merge exists there, phi_i the light side's own density of y_i (1 after a Dirac vertex), psi_i
+// the light side's density of z_i, X / Y the running quantities. The walk stays as the oracle
+// (tests/test_bdpt_mis.cpp compares both).
+
+// The parameters of the heuristic a subpath's running quantities are made for.
+struct MisRules {
+    bool power = false;
+    bool merging = false, connections = true;
+    double eta = 0;
+    MisRules(bool power_heuristic, const MergeMis* vm) : power(power_heuristic) {
+        if (vm) merging = vm->merging, connections = vm->connections, eta = vm->eta;
+    }
+    double h(double r) const { return power ? r * r : r; }
+    static double remap0(double f) { return f != 0 ? f : 1.0; }
+};
+
+// Fills mis_running of every vertex of a complete subpath (light or camera side), from its
+// stored densities; a vertex reads pdf_rev only of vertices two or more before it.
+template <class Vertex>
+void set_running_mis(Vertex* v, int n, bool light_side, const MisRules& m) {
+    double prefix = 0;  // the walk's sum up to vertex i, all of whose densities are final
+    for (int k = 0; k < n; ++k) {
+        v[k].mis_running = 0;
+        const int i = k - 1;  // the vertex the new quantity ends at
+        if (i < 0) continue;
+        if (light_side) {
+            // X_k = c_i + mc_i h(phi_i eta) + P_{i-1};  P_i = h(Q_i) X_k
+            const bool delta_before = i > 0 ? v[i - 1].delta : v[0].delta_light;
+            double x = prefix;
+            if ((m.connections || i == 0) && !v[i].delta && !delta_before) x += 1;
+            if (m.merging && i >= 1 && v[i].kind == VertexKind::Surface && !v[i].delta)
+                x += m.h((v[i - 1].delta ? 1.0 : double(v[i].pdf_fwd)) * m.eta);
+            v[k].mis_running = x;
+            prefix = m.h(MisRules::remap0(v[i].pdf_rev) / MisRules::remap0(v[i].pdf_fwd)) * x;
+        } else {
+            // Y_k = c_i + S_{i-1};  S_i = mc_i h(psi_i eta) + h(R_i) Y_k (the pinhole z_0 is no endpoint)
+            if (i == 0) continue;
+            double y = prefix;
+            if (m.connections && !v[i].delta && !v[i - 1].delta) y += 1;
+            v[k].mis_running = y;
+            prefix = m.h(MisRules::remap0(v[i].pdf_rev) / MisRules::remap0(v[i].pdf_fwd)) * y;
+            if (m.merging && v[i].kind == VertexKind::Surface && !v[i].delta)
+                prefix += m.h((v[k].delta ? 1.0 : double(v[i].pdf_rev)) * m.eta);
+        }
+    }
+}
+
+// The light side's part of the MIS sum of a connection ending at y_e (e = s - 1, not Dirac
+// there), with the densities rev_e of y_e and rev_prev of y_{e-1} that the connection gives.
+template <class Vertex>
+double light_side_sum(const Vertex* y, int e, double rev_e, double rev_prev, const MisRules& m) {
+    const double q = m.h(MisRules::remap0(rev_e) / MisRules::remap0(y[e].pdf_fwd));
+    if (e == 0) return y[0].delta_light ? 0.0 : q;
+    double inner = m.h(MisRules::remap0(rev_prev) / MisRules::remap0(y[e - 1].pdf_fwd)) * y[e].mis_running;
+    if (m.connections && !y[e - 1].delta) inner += 1;
+    if (m.merging && y[e].kind == VertexKind::Surface) inner += m.h((y[e - 1].delta ? 1.0 : double(y[e].pdf_fwd)) * m.eta);
+    return q * inner;
+}
+
+// The camera side's part of the MIS sum of a strategy ending at z_e (e = t - 1 >= 1, not Dirac
+// there): z_e's light-side density rev_e (merging at z_e counts with psi_e, its density from the
+// light side or 1 after a Dirac light vertex; merge_here: the strategy has a light vertex), and
+// z_{e-1}'s, rev_prev. `fwd_e` is z_e's own density (a merge's camera endpoint has its own).
+template <class Vertex>
+double camera_side_sum(const Vertex* z, int e, double fwd_e, double rev_e, double psi_e, bool merge_here, double rev_prev,
+                       const MisRules& m) {
+    double inner = 0;
+    if (e >= 2) {
+        inner = m.h(MisRules::remap0(rev_prev) / MisRules::remap0(z[e - 1].pdf_fwd)) * z[e].mis_running;
+        if (m.merging && z[e - 1].kind == VertexKind::Surface && !z[e - 1].delta) inner += m.h(rev_prev * m.eta);
+    }
+    if (m.connections && !z[e - 1].delta) inner += 1;
+    double sum = m.h(MisRules::remap0(rev_e) / MisRules::remap0(fwd_e)) * inner;
+    if (merge_here && m.merging && z[e].kind == VertexKind::Surface) sum += m.h(psi_e * m.eta);
+    return sum;
 }
 
 }  // namespace pathlab

@@ -9,6 +9,7 @@ namespace pathlab {
 
 void PhotonGrid::build(Positions photons, float radius) {
     positions_ = photons;
+    sorted_ = false;
     // A little over 2r, so that a ball of radius r around a query is within the 2 x 2 x 2 cells
     // it visits even after rounding.
     cell_size_ = 2 * radius * 1.0001f;
@@ -18,17 +19,17 @@ void PhotonGrid::build(Positions photons, float radius) {
     if (photons.empty()) lo_ = Vec3f(0.0f);
     // As many table cells as photons (at least 1): short lists, few collisions.
     cell_ends_.assign(std::max<size_t>(1, photons.size()), 0);
-    std::vector<uint32_t> cell_of(photons.size());
+    cell_of_.resize(photons.size());
     for (size_t i = 0; i < photons.size(); ++i) {
         const Vec3f c = (photons[i] - lo_) * inv_cell_;
-        cell_of[i] = uint32_t(cell_index(int(std::floor(c.x)), int(std::floor(c.y)), int(std::floor(c.z))));
-        ++cell_ends_[cell_of[i]];
+        cell_of_[i] = uint32_t(cell_index(int(std::floor(c.x)), int(std::floor(c.y)), int(std::floor(c.z))));
+        ++cell_ends_[cell_of_[i]];
     }
     // Counting sort: cell_ends_[c] becomes the end of cell c's run; photons keep their order.
     uint32_t sum = 0;
     for (uint32_t& e : cell_ends_) sum += e, e = sum;
     order_.resize(photons.size());
-    for (size_t i = photons.size(); i-- > 0;) order_[--cell_ends_[cell_of[i]]] = uint32_t(i);
+    for (size_t i = photons.size(); i-- > 0;) order_[--cell_ends_[cell_of_[i]]] = uint32_t(i);
     for (size_t c = 0; c + 1 < cell_ends_.size(); ++c) cell_ends_[c] = cell_ends_[c + 1];
     cell_ends_.back() = uint32_t(photons.size());
 }

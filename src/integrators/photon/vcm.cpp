@@ -23,63 +23,121 @@ size_t Vcm<T>::light_vertex_count() const {
 
 template <class T>
 size_t Vcm<T>::memory_bytes() const {
-    size_t bytes = grid_.memory_bytes() + photons_.capacity() * sizeof(Photon<T>) + photon_vertex_.capacity() * sizeof(void*) +
+    size_t bytes = grid_.memory_bytes() + photons_.capacity() * sizeof(MergeVertex<T>) + chunk_photons_.capacity() * sizeof(size_t) +
                    path_begin_.capacity() * sizeof(uint32_t) + path_length_.capacity() * sizeof(uint16_t);
     for (const auto& c : chunk_vertices_) bytes += c.capacity() * sizeof(Vertex);
-    for (const auto& c : chunk_photons_) bytes += c.capacity() * sizeof(Photon<T>);
-    for (const auto& c : chunk_photon_vertex_) bytes += c.capacity() * sizeof(uint32_t);
     return bytes;
 }
 
+namespace {
+
+// Whether light vertex y_j is stored as a photon (merging needs a non-Dirac surface).
+template <class Vertex>
+bool is_photon(const Vertex& y, size_t j, int max_bounces) {
+    return j >= 1 && y.kind == VertexKind::Surface && y.connectible() && int(j) <= max_bounces;
+}
+
+}  // namespace
+
 template <class T>
-uint64_t Vcm<T>::trace_light_paths(const RenderContext& ctx, uint64_t pass, const Wavelengths& wl) {
+MergeVertex<T> Vcm<T>::merge_vertex(const Vertex* y, int j) {
+    const Vertex& v = y[j];
+    const Vertex& prev = y[j - 1];
+    MergeVertex<T> m;
+    m.p = v.p;
+    m.wi = v.sp.frame.to_world(v.sp.wi);
+    m.power = v.beta;
+    m.vertex = uint16_t(j);
+    m.dispersed = v.dispersed;
+    m.pdf_fwd = v.pdf_fwd;
+    m.prev_pdf_fwd = prev.pdf_fwd;
+    m.prev_g = to_area_density(1.0f, v, prev);
+    m.mis_running = float(v.mis_running);
+    m.prev_delta = prev.delta;
+    return m;
+}
+
+template <class T>
+uint64_t Vcm<T>::trace_light_paths(const RenderContext& ctx, uint64_t pass, const Wavelengths& wl, const MergeMis& vm) {
     const size_t paths = ctx.pixel_count(), per_chunk = Bdpt<T>::chunk_size(paths), chunks = (paths + per_chunk - 1) / per_chunk;
     chunk_vertices_.resize(chunks);
-    chunk_photons_.resize(chunks);
-    chunk_photon_vertex_.resize(chunks);
+    chunk_photons_.resize(chunks + 1);
     path_begin_.resize(paths);
     path_length_.resize(paths);
     const int max_bounces = bdpt_.max_bounces();
     std::atomic<uint64_t> rays{0};
+    // The light subpaths, chunk by chunk, and how many merge vertices each chunk has.
     tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
         const uint64_t rays_before = Scene::rays_traced_by_this_thread();
         std::vector<Vertex>& path = subpaths_.local().second;  // keeps its capacity from pass to pass
         std::vector<Vertex>& vertices = chunk_vertices_[c];
-        std::vector<Photon<T>>& photons = chunk_photons_[c];
-        std::vector<uint32_t>& photon_vertex = chunk_photon_vertex_[c];
-        vertices.clear(), photons.clear(), photon_vertex.clear();
+        vertices.clear();
+        size_t photons = 0;
         for (size_t j = c * per_chunk; j < std::min(paths, (c + 1) * per_chunk); ++j) {
             // Light path j is pixel j's, from bdpt's stream: the same path bdpt would connect.
             Sampler sampler(ctx.seed, Bdpt<T>::sample_stream(j, 1), pass, ctx.sampler);
-            bdpt_.light_subpath(ctx, sampler, wl, path);
+            bdpt_.light_subpath(ctx, sampler, wl, path, &vm);
             path_begin_[j] = uint32_t(vertices.size());
             path_length_[j] = uint16_t(path.size());
-            for (size_t v = 1; v < path.size(); ++v) {
-                const Vertex& y = path[v];
-                if (y.kind != VertexKind::Surface || !y.connectible() || int(v) > max_bounces) continue;
-                photons.push_back({y.p, y.sp.frame.to_world(y.sp.wi), y.beta, uint16_t(v), y.dispersed});
-                photon_vertex.push_back(uint32_t(vertices.size() + v));
-            }
+            for (size_t v = 1; v < path.size(); ++v) photons += is_photon(path[v], v, max_bounces);
             vertices.insert(vertices.end(), path.begin(), path.end());
         }
+        chunk_photons_[c + 1] = photons;
         rays += Scene::rays_traced_by_this_thread() - rays_before;
     });
-    photons_.clear();
-    photon_vertex_.clear();
-    for (size_t c = 0; c < chunks; ++c) {
-        photons_.insert(photons_.end(), chunk_photons_[c].begin(), chunk_photons_[c].end());
-        for (const uint32_t v : chunk_photon_vertex_[c]) photon_vertex_.push_back(&chunk_vertices_[c][v]);
+    // One array of merge vertices, each chunk writing its own range (in path order).
+    chunk_photons_[0] = 0;
+    for (size_t c = 0; c < chunks; ++c) chunk_photons_[c + 1] += chunk_photons_[c];
+    photons_.resize(vm.merging ? chunk_photons_[chunks] : 0);
+    if (vm.merging) {
+        tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+            size_t k = chunk_photons_[c];
+            const std::vector<Vertex>& vertices = chunk_vertices_[c];
+            for (size_t j = c * per_chunk; j < std::min(paths, (c + 1) * per_chunk); ++j) {
+                const Vertex* y = vertices.data() + path_begin_[j];
+                for (size_t v = 1; v < path_length_[j]; ++v)
+                    if (is_photon(y[v], v, max_bounces)) photons_[k++] = merge_vertex(y, int(v));
+            }
+        });
     }
     return rays.load();
 }
 
 template <class T>
-float Vcm<T>::merge_weight(const Vertex* y, int s, const std::vector<Vertex>& camera, int t, const MergeMis& vm) const {
+float Vcm<T>::merge_weight(const MergeVertex<T>& photon, float pdf_to_light, float pdf_to_camera, const std::vector<Vertex>& camera,
+                           int t, const MergeMis& vm, float camera_prev_g) const {
     // The path is weighed as the connection (s - 1, t) whose camera endpoint is z = z_{t-1}
     // (standing for the photon's vertex y_{s-1}): z's light-side density is the photon's, and
     // the densities through z of its neighbours are z's BSDF's, between the photon's direction
-    // and the camera's. The rest of both subpaths keep their stored densities: the light
-    // subpath did arrive at y_{s-1}, the camera subpath at z.
+    // and the camera's. The rest of both subpaths keep their densities: their running quantities.
+    const MisRules rules(bdpt_.power_heuristic(), &vm);
+    const Vertex& z = camera[size_t(t - 1)];
+    const double light_prev_rev = double(pdf_to_light) * double(photon.prev_g);
+    if (camera_prev_g < 0) camera_prev_g = to_area_density(1.0f, z, camera[size_t(t - 2)]);
+    const double camera_prev_rev = double(pdf_to_camera) * double(camera_prev_g);
+    // The light side ends at y_{s-2}, whose density from z is light_prev_rev.
+    const double light = rules.h(MisRules::remap0(light_prev_rev) / MisRules::remap0(photon.prev_pdf_fwd)) * double(photon.mis_running);
+    // The camera side includes this merge itself: its density, psi (1 after a Dirac light vertex), times eta.
+    const double psi = photon.prev_delta ? 1.0 : double(photon.pdf_fwd);
+    const double camera_sum = camera_side_sum(camera.data(), t - 1, z.pdf_fwd, photon.pdf_fwd, psi, true, camera_prev_rev, rules);
+    // The connection (s - 1, t) is the reference, 1, where it exists.
+    const double reference = vm.connections && !photon.prev_delta ? 1.0 : 0.0;
+    const double own = rules.h((faults_.merge_weight_without_light_pdf ? 1.0 : psi) * vm.eta);
+    const double total = reference + light + camera_sum;
+    return total > 0 ? float(own / total) : 0.0f;
+}
+
+template <class T>
+float Vcm<T>::merge_weight(const Vertex* y, int s, const std::vector<Vertex>& camera, int t, const MergeMis& vm) const {
+    const Vertex& z = camera[size_t(t - 1)];
+    const MergeVertex<T> photon = merge_vertex(y, s - 1);
+    const Vec3f wp = z.sp.frame.to_local(photon.wi);
+    return merge_weight(photon, z.sp.material->pdf(z.sp, z.sp.wi, wp), z.sp.material->pdf(z.sp, wp, z.sp.wi), camera, t, vm);
+}
+
+template <class T>
+float Vcm<T>::merge_weight_oracle(const Vertex* y, int s, const std::vector<Vertex>& camera, int t, const MergeMis& vm) const {
+    // As merge_weight, by Veach's ratio walk over both subpaths.
     const Vertex& z = camera[size_t(t - 1)];
     const Vertex& photon = y[s - 1];
     const Vec3f wp = z.sp.frame.to_local(photon.sp.frame.to_world(photon.sp.wi));
@@ -115,16 +173,18 @@ ColourOf<T> Vcm<T>::merge(const std::vector<Vertex>& camera, int t, float r, con
     const Vertex& z = camera[size_t(t - 1)];
     const int max_bounces = bdpt_.max_bounces();
     MergeSum<T> sum;
+    const float camera_prev_g = to_area_density(1.0f, z, camera[size_t(t - 2)]);
     grid_.for_each_within(z.p, r, [&](uint32_t k) {
-        const Photon<T>& ph = photons_[k];
+        const MergeVertex<T>& ph = photons_[k];
         const int s = int(ph.vertex) + 1;
         const int depth = s + t - 3;
         if (depth > max_bounces || (options_.only_length >= 0 && depth != options_.only_length)) return;
         const Vec3f wo = z.sp.frame.to_local(ph.wi);
-        const Rgb f = z.sp.material->eval(z.sp, z.sp.wi, wo);
+        float pdf_to_light = 0;
+        const Rgb f = z.sp.material->eval_and_pdf(z.sp, z.sp.wi, wo, pdf_to_light);
         if (is_black(f)) return;
-        const Vertex* y = photon_vertex_[k] - ph.vertex;
-        sum.add(bsdf_colour(z.sp, wo, f, wl) * ph.power * merge_weight(y, s, camera, t, vm), ph.dispersed);
+        const float pdf_to_camera = z.sp.material->pdf(z.sp, wo, z.sp.wi);
+        sum.add(bsdf_colour(z.sp, wo, f, wl) * ph.power * merge_weight(ph, pdf_to_light, pdf_to_camera, camera, t, vm, camera_prev_g), ph.dispersed);
     });
     // The factor 4 once per path: a dispersed photon counts 4 times against a camera path of 4
     // lanes; against a dispersed camera path once, and that path's own hero_only() gives the 4.
@@ -149,8 +209,8 @@ PassCounters Vcm<T>::render_passes(const RenderContext& ctx, Film& film, uint64_
         vm.connections = options_.vcm_connections;
         norm_ = double(pixels) * (faults_.no_pi_in_kernel ? 1.0 : kPi) * double(r) * double(r);
         vm.eta = norm_;
-        rays += trace_light_paths(ctx, pass, wl);
-        if (vm.merging) grid_.build(photons_, r);
+        rays += trace_light_paths(ctx, pass, wl, vm);
+        if (vm.merging) grid_.build_sorted(photons_, r);
         if (progress) progress((double(k) + 0.25) / count);
         pass_.begin(pixels, chunks);
         const bool filtered = ctx.filter && !ctx.filter->is_box();
@@ -168,7 +228,7 @@ PassCounters Vcm<T>::render_passes(const RenderContext& ctx, Film& film, uint64_
                 SplatList& splats = pass_.chunk(c);
                 for (size_t pixel = size_t(c) * per_chunk; pixel < std::min(pixels, size_t(c + 1) * per_chunk); ++pixel) {
                     Sampler camera_sampler(ctx.seed, pixel, pass, ctx.sampler);
-                    bdpt_.camera_subpath(ctx, pixel, camera_sampler, wl, camera, filtered ? &shift : nullptr);
+                    bdpt_.camera_subpath(ctx, pixel, camera_sampler, wl, camera, filtered ? &shift : nullptr, &vm);
                     // This pixel's light subpath, copied: connections modify it for a moment,
                     // while other threads read the stored one to merge.
                     const Vertex* stored = chunk_vertices_[pixel / per_chunk].data() + path_begin_[pixel];
@@ -206,6 +266,8 @@ PassCounters Vcm<T>::render_passes(const RenderContext& ctx, Film& film, uint64_
 
 template class Vcm<RgbTransport>;
 template class Vcm<SpectralTransport>;
+// The VCM report's target for a light vertex kept for merging: a cache line.
+static_assert(sizeof(MergeVertex<RgbTransport>) <= 64 && sizeof(MergeVertex<SpectralTransport>) <= 64);
 
 namespace {
 

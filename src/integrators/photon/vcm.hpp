@@ -11,9 +11,12 @@
 //     within the iteration's radius r_i: a photon y_{s-1} there makes the path y_0 .. y_{s-1},
 //     z_{t-2} .. z_0, with the estimate f(z, wo, wi_y) beta_y beta_z / (N pi r_i^2).
 // All these strategies are combined by multiple importance sampling (balance heuristic, or
-// power with --mis power) with bdpt's ratio walk extended by the merging strategies: merging at
-// a vertex x has the density of the connection ending at x, times the light side's area density
-// of x, times eta = N pi r_i^2 (path_vertex.hpp, MergeMis).
+// power with --mis power) with bdpt's weights extended by the merging strategies: merging at a
+// vertex x has the density of the connection ending at x, times the light side's area density
+// of x, times eta = N pi r_i^2 (path_vertex.hpp, MergeMis). Every weight, a merged photon's too,
+// costs O(1): the subpaths carry running quantities, and a photon is a compact MergeVertex that
+// holds its subpath's (no merge reads the subpath it came from). The photons are sorted into the
+// grid's cell order in place (PhotonGrid::build_sorted).
 //
 // The radius shrinks as in sppm (Knaus and Zwicker: r_i^2 = r_1^2 prod (k + alpha) / (k + 1),
 // progressive_radius.hpp; --radius, --alpha), so iterations are independent given their index
@@ -45,6 +48,18 @@
 
 namespace pathlab {
 
+// A light vertex as merging needs it (the VCM report's light vertex, without the BSDF: a merge
+// evaluates the camera vertex's): the photon, and the MIS quantities of its light subpath that a
+// merge completes in O(1) (path_vertex.hpp), so that no merge reads the subpath it came from.
+template <class T>
+struct MergeVertex : Photon<T> {
+    float pdf_fwd = 0;       // its light subpath's area density of it (0 after a Dirac vertex)
+    float prev_pdf_fwd = 0;  // ... of the vertex before it
+    float prev_g = 0;        // |cos| / distance^2 at the vertex before it (1 at infinity): a solid-angle density from here, as area there
+    float mis_running = 0;   // its light-side running quantity
+    bool prev_delta = false; // the vertex before it scattered by a Dirac lobe
+};
+
 // Deliberate faults, for the tests that must be able to fail.
 struct VcmFaults {
     bool no_pi_in_kernel = false;  // the merge divides by N r^2 instead of N pi r^2 (also in the MIS)
@@ -63,14 +78,24 @@ public:
     PassCounters render_passes(const RenderContext& ctx, Film& film, uint64_t first, int count,
                                const PassProgress& progress) override;
 
-    // The light subpaths and photons of iteration `pass` at its wavelengths (kept until the next);
-    // returns the rays traced.
-    uint64_t trace_light_paths(const RenderContext& ctx, uint64_t pass, const Wavelengths& wl);
+    // The light subpaths and photons of iteration `pass` at its wavelengths (kept until the next),
+    // with the running MIS quantities of the strategies in `vm`; returns the rays traced.
+    uint64_t trace_light_paths(const RenderContext& ctx, uint64_t pass, const Wavelengths& wl, const MergeMis& vm);
     // The merging estimate at camera vertex z_{t-1} (t >= 2) with the current photons, radius r,
     // MIS-weighted against every strategy in `vm` (times the camera throughput).
     Colour merge(const std::vector<Vertex>& camera, int t, float r, const MergeMis& vm, const Wavelengths& wl) const;
-    // The MIS weight of merging photon y_{s-1} (light subpath y[0..s)) at camera vertex z_{t-1}.
+    // The merge vertex of light vertex y_j of the subpath y (with its running MIS quantities).
+    static MergeVertex<T> merge_vertex(const Vertex* y, int j);
+    // The MIS weight of merging `photon` at camera vertex z_{t-1}, whose BSDF samples the photon's
+    // direction with solid-angle density pdf_to_light and the camera's from it with pdf_to_camera:
+    // O(1), from the running quantities of both subpaths (made with the same `vm`).
+    // camera_prev_g: to_area_density(1, z_{t-1}, z_{t-2}) if known (negative: computed here).
+    float merge_weight(const MergeVertex<T>& photon, float pdf_to_light, float pdf_to_camera, const std::vector<Vertex>& camera,
+                       int t, const MergeMis& vm, float camera_prev_g = -1) const;
+    // The MIS weight of merging photon y_{s-1} (light subpath y[0..s)) at camera vertex z_{t-1},
+    // by the running quantities as the render does, and by Veach's ratio walk (the tests' oracle).
     float merge_weight(const Vertex* y, int s, const std::vector<Vertex>& camera, int t, const MergeMis& vm) const;
+    float merge_weight_oracle(const Vertex* y, int s, const std::vector<Vertex>& camera, int t, const MergeMis& vm) const;
 
     const Bdpt<T>& bdpt() const { return bdpt_; }
     size_t photon_count() const { return photons_.size(); }
@@ -82,14 +107,13 @@ private:
     IntegratorOptions options_;
     VcmFaults faults_;
     Bdpt<T> bdpt_;  // the subpaths, the connections and their weights
-    // One iteration's light subpaths, per chunk of light paths, and where each path starts.
+    // One iteration's light subpaths (for the connections of their own pixels), per chunk of
+    // light paths, and where each path starts; its merge vertices, in one array in path order.
     std::vector<std::vector<Vertex>> chunk_vertices_;
-    std::vector<std::vector<Photon<T>>> chunk_photons_;
-    std::vector<std::vector<uint32_t>> chunk_photon_vertex_;  // the light vertex of each photon, in its chunk
-    std::vector<uint32_t> path_begin_;                         // light path j: its chunk's vertices from here
-    std::vector<uint16_t> path_length_;                        // ... this many
-    std::vector<Photon<T>> photons_;
-    std::vector<const Vertex*> photon_vertex_;  // photons_[k] is the light vertex *photon_vertex_[k]
+    std::vector<size_t> chunk_photons_;   // merge vertices of chunk c: photons_[chunk_photons_[c] ...)
+    std::vector<uint32_t> path_begin_;    // light path j: its chunk's vertices from here
+    std::vector<uint16_t> path_length_;   // ... this many
+    std::vector<MergeVertex<T>> photons_;
     PhotonGrid grid_;
     PassImage pass_;
     tbb::enumerable_thread_specific<std::pair<std::vector<Vertex>, std::vector<Vertex>>> subpaths_;  // camera, light

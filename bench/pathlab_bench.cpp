@@ -6,6 +6,7 @@
 //   pathlab_bench pt       the same for the path tracers 4a, 4b, 4c
 //   pathlab_bench lt       light tracing: paths/s next to pt-mis, and splat accumulation
 //   pathlab_bench bdpt     bdpt against pt-mis: equal-time RMSE, and samples per second
+//   pathlab_bench bidir    pt-mis, bdpt, bpm, vcm on SmallVCM's kind of scene: time per iteration, MSE per sample, efficiency
 //   pathlab_bench pm       photons per second; hashed grid against k-d tree (build, query)
 //   pathlab_bench ic       irradiance caching and pbgi against pt-mis and bdpt at short budgets
 //   pathlab_bench pbgi-gather  pbgi's gather against a ray-traced truth per cutoff and micro-buffer
@@ -17,6 +18,7 @@
 //   pathlab_bench spectral the spectral layer's building blocks: wavelength sampling, RGB upsampling, the XYZ film estimator
 #include <CLI/CLI.hpp>
 
+#include "bidir_efficiency.hpp"
 #include "bidirectional.hpp"
 #include "differentiable.hpp"
 #include "distributed.hpp"
@@ -76,6 +78,14 @@ int main(int argc, char** argv) {
     bd->add_option("--repeats", b.repeats, "Timed pairs per scene (median reported)")->capture_default_str();
     bd->add_option("--ref-spp", b.ref_spp, "Samples per pixel of each reference (bdpt)")->capture_default_str();
     bd->add_option("--scenes", b.scenes, "Course scene indices and scene files of scenes/")->delimiter(',')->capture_default_str();
+    BidirEfficiencyOptions be;
+    CLI::App* bec = app.add_subcommand("bidir", "pt-mis, bdpt, bpm and vcm on SmallVCM's kind of scene: time per iteration, MSE per sample, efficiency");
+    bec->add_option("--size", be.size, "Image width and height")->capture_default_str();
+    bec->add_option("--iterations", be.iterations, "Iterations (samples per pixel) per timed render")->capture_default_str();
+    bec->add_option("--repeats", be.repeats, "Timed renders per method (median reported)")->capture_default_str();
+    bec->add_option("--ref-spp", be.ref_spp, "Samples per pixel of each reference (bdpt)")->capture_default_str();
+    bec->add_option("--scenes", be.scenes, "Scene files of scenes/")->delimiter(',')->capture_default_str();
+    bec->add_option("--algorithms", be.algorithms, "Methods (pt-mis first: the efficiencies are relative to it)")->delimiter(',')->capture_default_str();
     PhotonMappingOptions pm;
     CLI::App* pmc = app.add_subcommand("pm", "Photons per second; hashed grid against k-d tree");
     pmc->add_option("--light-paths", pm.light_paths, "Light paths traced per scene")->capture_default_str();
@@ -166,6 +176,7 @@ int main(int argc, char** argv) {
     if (*icc) irradiance_caching_suite(icopt);
     if (*pmc) photon_mapping_suite(pm);
     if (*bd) bidirectional_suite(b);
+    if (*bec) bidir_efficiency_suite(be);
     if (*lt) light_tracing_suite(l);
     if (*perf) performance_suite(p);
     if (*tables[0]) efficiency_table(e, {"direct-light", "direct-uniform", "direct-cosine", "direct-brdf", "direct-mis"}, "direct-mis");

@@ -93,8 +93,11 @@ template <typename F> void PhotonGrid::for_each_within(const Vec3f& q, float r, 
     const int cx = int(std::floor(c.x)), cy = int(std::floor(c.y)), cz = int(std::floor(c.z));
     const int px = c.x - float(cx) < 0.5f ? cx - 1 : cx, py = c.y - float(cy) < 0.5f ? cy - 1 : cy,
               pz = c.z - float(cz) < 0.5f ? cz - 1 : cz;
-    // Two grid cells may hash to one table cell: visit each table cell once.
+    // Two grid cells may hash to one table cell: visit each table cell once. The cells' runs are
+    // looked up first, and then scanned: the lookups (random reads of the table, the query's
+    // main cost once the photons outgrow the caches) are then independent and overlap.
     size_t visited[8];
+    uint32_t begins[8], ends[8];
     int n_visited = 0;
     for (int dz = 0; dz < 2; ++dz)
         for (int dy = 0; dy < 2; ++dy)
@@ -102,15 +105,20 @@ template <typename F> void PhotonGrid::for_each_within(const Vec3f& q, float r, 
                 const size_t cell = cell_index(px + dx, py + dy, pz + dz);
                 bool seen = false;
                 for (int k = 0; k < n_visited; ++k) seen |= visited[k] == cell;
-                if (seen) continue;
-                visited[n_visited++] = cell;
-                const uint32_t begin = cell == 0 ? 0 : cell_ends_[cell - 1], end = cell_ends_[cell];
-                for (uint32_t k = begin; k < end; ++k) {
-                    const uint32_t i = sorted_ ? k : order_[k];
-                    const Vec3f d = positions_[i] - q;
-                    if (dot(d, d) <= r2) f(i);
-                }
+                if (!seen) visited[n_visited++] = cell;
             }
+    for (int k = 0; k < n_visited; ++k) {
+        begins[k] = visited[k] == 0 ? 0 : cell_ends_[visited[k] - 1];
+        ends[k] = cell_ends_[visited[k]];
+    }
+    for (int k = 0; k < n_visited; ++k)
+        if (begins[k] < ends[k]) __builtin_prefetch(&positions_[sorted_ ? begins[k] : order_[begins[k]]]);
+    for (int c = 0; c < n_visited; ++c)
+        for (uint32_t k = begins[c]; k < ends[c]; ++k) {
+            const uint32_t i = sorted_ ? k : order_[k];
+            const Vec3f d = positions_[i] - q;
+            if (dot(d, d) <= r2) f(i);
+        }
 }
 
 class PhotonKdTree {

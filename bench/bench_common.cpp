@@ -10,6 +10,10 @@ RenderResult run(const Scene& scene, const std::string& algorithm, int size, int
                  std::function<void(const Film&, const RenderStats&)> after_pass, SamplerKind sampler) {
     JobRequest r;
     r.algorithm = algorithm;
+    if (const size_t colon = algorithm.find(":radius="); colon != std::string::npos) {
+        r.algorithm = algorithm.substr(0, colon);
+        r.photon_radius = std::stof(algorithm.substr(colon + 8));
+    }
     r.width = r.height = size;
     if (spp > 0) r.spp = uint64_t(spp);
     r.time_limit = seconds;

@@ -36,6 +36,7 @@ inline double rmse(const Image& img, const Reference& ref) {
 }
 
 // One render of `size` x `size` pixels: `spp` samples per pixel, or (spp = 0) `seconds`.
+// `algorithm` may carry a photon radius: "vcm:radius=0.005".
 RenderResult run(const Scene& scene, const std::string& algorithm, int size, int spp, double seconds, uint64_t seed,
                  std::function<void(const Film&, const RenderStats&)> after_pass = {},
                  SamplerKind sampler = SamplerKind::Independent);

@@ -11,7 +11,8 @@ struct BidirEfficiencyOptions {
     int repeats = 3;       // timed renders per method and scene, interleaved (medians reported)
     int ref_spp = 256;     // bdpt samples per pixel of each scene's reference
     std::vector<std::string> scenes{"smallvcm-box.xml", "smallvcm-lightbox.xml"};  // under scenes/
-    std::vector<std::string> algorithms{"pt-mis", "bdpt", "bpm", "vcm"};
+    std::vector<std::string> algorithms{"pt-mis", "bdpt", "bpm", "vcm"};  // "vcm:radius=R": another first radius
+    std::vector<std::string> samplers{"independent", "sobol"};
 };
 
 // `pathlab_bench bidir`: the bidirectional methods against pt-mis on SmallVCM's kind of scene

@@ -85,7 +85,9 @@ int main(int argc, char** argv) {
     bec->add_option("--repeats", be.repeats, "Timed renders per method (median reported)")->capture_default_str();
     bec->add_option("--ref-spp", be.ref_spp, "Samples per pixel of each reference (bdpt)")->capture_default_str();
     bec->add_option("--scenes", be.scenes, "Scene files of scenes/")->delimiter(',')->capture_default_str();
-    bec->add_option("--algorithms", be.algorithms, "Methods (pt-mis first: the efficiencies are relative to it)")->delimiter(',')->capture_default_str();
+    bec->add_option("--algorithms", be.algorithms, "Methods (the efficiencies are relative to the first); vcm:radius=R sets a first radius")
+        ->delimiter(',')->capture_default_str();
+    bec->add_option("--samplers", be.samplers, "Pixel samplers: independent (the course's), sobol")->delimiter(',')->capture_default_str();
     PhotonMappingOptions pm;
     CLI::App* pmc = app.add_subcommand("pm", "Photons per second; hashed grid against k-d tree");
     pmc->add_option("--light-paths", pm.light_paths, "Light paths traced per scene")->capture_default_str();

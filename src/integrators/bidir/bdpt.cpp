@@ -185,7 +185,7 @@ ConnectionDensities Bdpt<T>::connection_densities(const RenderContext& ctx, cons
 }
 
 template <class T>
-float Bdpt<T>::mis_weight(const RenderContext& ctx, Subpath& light, int s, Subpath& camera, int t, const Vertex& sampled,
+float Bdpt<T>::mis_weight(const RenderContext& ctx, SubpathView light, int s, SubpathView camera, int t, const Vertex& sampled,
                           const EdgeDensities& known, const MergeMis* vm) const {
     if (s + t == 2) return 1.0f;
     if (faults_.any()) return mis_weight_oracle(ctx, light, s, camera, t, sampled, known, vm);
@@ -202,10 +202,11 @@ float Bdpt<T>::mis_weight(const RenderContext& ctx, Subpath& light, int s, Subpa
 }
 
 template <class T>
-float Bdpt<T>::mis_weight_oracle(const RenderContext& ctx, Subpath& light, int s, Subpath& camera, int t, const Vertex& sampled,
-                                 const EdgeDensities& known, const MergeMis* vm) const {
+float Bdpt<T>::mis_weight_oracle(const RenderContext& ctx, SubpathView light_view, int s, SubpathView camera_view, int t,
+                                 const Vertex& sampled, const EdgeDensities& known, const MergeMis* vm) const {
     if (s + t == 2) return 1.0f;
-    // The connection's densities written onto the vertices for the walk, and restored after.
+    // The connection's densities written onto copies of the vertices for the walk.
+    Subpath light(light_view.begin(), light_view.end()), camera(camera_view.begin(), camera_view.end());
     Vertex end = sampled;
     Vertex* const ys = s == 1 ? &end : light.data();
     Vertex* const zs = t == 1 ? &end : camera.data();
@@ -214,14 +215,6 @@ float Bdpt<T>::mis_weight_oracle(const RenderContext& ctx, Subpath& light, int s
     Vertex* pt = &zs[t - 1];
     Vertex* qs_minus = s > 1 ? &ys[s - 2] : nullptr;
     Vertex* pt_minus = t > 1 ? &zs[t - 2] : nullptr;
-    struct Saved {
-        Vertex* v;
-        float pdf_rev;
-        bool delta;
-    };
-    Saved saved[4] = {{qs, 0, false}, {pt, 0, false}, {qs_minus, 0, false}, {pt_minus, 0, false}};
-    for (Saved& x : saved)
-        if (x.v) x.pdf_rev = x.v->pdf_rev, x.delta = x.v->delta;
     // The connected vertices are not Dirac here (the connection evaluated their BSDFs).
     pt->delta = false;
     if (qs) qs->delta = false;
@@ -249,14 +242,11 @@ float Bdpt<T>::mis_weight_oracle(const RenderContext& ctx, Subpath& light, int s
     } else {
         w = mis_weight_ratio_walk(ys, s, zs, t, options_.mis_power, vm);
     }
-
-    for (Saved& x : saved)
-        if (x.v) x.v->pdf_rev = x.pdf_rev, x.v->delta = x.delta;
     return w;
 }
 
 template <class T>
-StrategyResult<T> Bdpt<T>::connect(const RenderContext& ctx, Subpath& light, int s, Subpath& camera, int t, Sampler& sampler,
+StrategyResult<T> Bdpt<T>::connect(const RenderContext& ctx, SubpathView light, int s, SubpathView camera, int t, Sampler& sampler,
                                    const Wavelengths& wl, const MergeMis* vm) const {
     const Scene& scene = ctx.scene;
     StrategyResult<T> r;

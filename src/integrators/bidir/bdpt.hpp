@@ -44,6 +44,7 @@
 #include <tbb/enumerable_thread_specific.h>
 
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "integrators/bidir/path_vertex.hpp"
@@ -92,6 +93,7 @@ public:
     using Wavelengths = WavelengthsOf<T>;
     using Vertex = PathVertex<T>;
     using Subpath = std::vector<Vertex>;
+    using SubpathView = std::span<const Vertex>;  // a subpath that strategies read (vcm's stored light paths too)
 
     explicit Bdpt(const IntegratorOptions& options, BdptFaults faults = {});
     ~Bdpt() override;
@@ -107,17 +109,17 @@ public:
                         const Vec2f* shift = nullptr, const MergeMis* vm = nullptr) const;
     void light_subpath(const RenderContext& ctx, Sampler& sampler, const Wavelengths& wl, Subpath& path,
                        const MergeMis* vm = nullptr) const;
-    // Strategy (s, t) on the subpaths (which it may modify temporarily); `vm`: the merging
-    // strategies that also take part in its MIS weight (vcm).
-    StrategyResult<T> connect(const RenderContext& ctx, Subpath& light, int s, Subpath& camera, int t, Sampler& sampler,
+    // Strategy (s, t) on the subpaths; `vm`: the merging strategies that also take part in its
+    // MIS weight (vcm).
+    StrategyResult<T> connect(const RenderContext& ctx, SubpathView light, int s, SubpathView camera, int t, Sampler& sampler,
                               const Wavelengths& wl, const MergeMis* vm = nullptr) const;
     // The MIS weight of strategy (s, t); `sampled` replaces y_0 (s = 1) or z_0 (t = 1). From the
     // subpaths' running quantities (made with the same `vm`) in O(1).
-    float mis_weight(const RenderContext& ctx, Subpath& light, int s, Subpath& camera, int t, const Vertex& sampled,
+    float mis_weight(const RenderContext& ctx, SubpathView light, int s, SubpathView camera, int t, const Vertex& sampled,
                      const EdgeDensities& known = {}, const MergeMis* vm = nullptr) const;
     // The same weight by Veach's ratio walk over both subpaths: the oracle of the tests (and the
     // weight of the deliberate faults).
-    float mis_weight_oracle(const RenderContext& ctx, Subpath& light, int s, Subpath& camera, int t, const Vertex& sampled,
+    float mis_weight_oracle(const RenderContext& ctx, SubpathView light, int s, SubpathView camera, int t, const Vertex& sampled,
                             const EdgeDensities& known = {}, const MergeMis* vm = nullptr) const;
     // The densities strategy (s, t) gives the vertices at its new edge.
     ConnectionDensities connection_densities(const RenderContext& ctx, const Vertex* ys, int s, const Vertex* zs, int t,
@@ -128,7 +130,7 @@ public:
     // those ending at camera vertex t are done. `vm`: merging strategies in the weights (vcm);
     // with vm->connections off only s = 0 is evaluated.
     template <typename Strategy, typename AfterVertex>
-    void for_each_connection(const RenderContext& ctx, size_t pixel, uint64_t pass, Subpath& light, Subpath& camera, const Wavelengths& wl,
+    void for_each_connection(const RenderContext& ctx, size_t pixel, uint64_t pass, SubpathView light, SubpathView camera, const Wavelengths& wl,
                              const MergeMis* vm, Strategy&& strategy, AfterVertex&& after_vertex) const {
         for (int t = 1; t <= int(camera.size()); ++t) {
             Sampler sampler(ctx.seed, sample_stream(pixel, 1 + uint64_t(t)), pass, ctx.sampler);

@@ -221,7 +221,6 @@ PassCounters Vcm<T>::render_passes(const RenderContext& ctx, Film& film, uint64_
             // allows for bindings but clang before 16 (Debian 12's is 14: the fuzz build) does not.
             auto& subpaths = subpaths_.local();
             std::vector<Vertex>& camera = subpaths.first;
-            std::vector<Vertex>& light = subpaths.second;
             for (int c = range.begin(); c != range.end(); ++c) {
                 const uint64_t rays_before = Scene::rays_traced_by_this_thread();
                 uint64_t chunk_invalid = 0;
@@ -229,10 +228,9 @@ PassCounters Vcm<T>::render_passes(const RenderContext& ctx, Film& film, uint64_
                 for (size_t pixel = size_t(c) * per_chunk; pixel < std::min(pixels, size_t(c + 1) * per_chunk); ++pixel) {
                     Sampler camera_sampler(ctx.seed, pixel, pass, ctx.sampler);
                     bdpt_.camera_subpath(ctx, pixel, camera_sampler, wl, camera, filtered ? &shift : nullptr, &vm);
-                    // This pixel's light subpath, copied: connections modify it for a moment,
-                    // while other threads read the stored one to merge.
-                    const Vertex* stored = chunk_vertices_[pixel / per_chunk].data() + path_begin_[pixel];
-                    light.assign(stored, stored + path_length_[pixel]);
+                    // This pixel's light subpath, as stored (connections only read it).
+                    const typename Bdpt<T>::SubpathView light(chunk_vertices_[pixel / per_chunk].data() + path_begin_[pixel],
+                                                              path_length_[pixel]);
                     // The pixel's own contributions, summed and converted once; splats (t = 1) on their own.
                     typename T::SampleSum own(0.0f);
                     const auto add = [&](const Colour& value, bool splat, const Vec2f& raster) {

@@ -60,7 +60,10 @@ class StrategyImages;
 struct BdptFaults {
     bool drop_nee_strategy = false;      // MIS weights leave the s = 1 strategies out of their sums
     bool specular_pdf_rev_missing = false;  // a Dirac vertex's reverse density left unset (0)
-    bool any() const { return drop_nee_strategy || specular_pdf_rev_missing; }
+    // Not a fault: every weight by the ratio walk (the oracle), for the test that compares whole
+    // renders with the running quantities' weights.
+    bool ratio_walk = false;
+    bool any() const { return drop_nee_strategy || specular_pdf_rev_missing || ratio_walk; }
 };
 
 // What one strategy gives for one sample: the unweighted contribution (a path through

@@ -108,12 +108,12 @@ private:
     VcmFaults faults_;
     Bdpt<T> bdpt_;  // the subpaths, the connections and their weights
     // One iteration's light subpaths (for the connections of their own pixels), per chunk of
-    // light paths, and where each path starts; its merge vertices, in one array in path order.
+    // light paths, and where each path starts; its merge vertices, in one array.
     std::vector<std::vector<Vertex>> chunk_vertices_;
-    std::vector<size_t> chunk_photons_;   // merge vertices of chunk c: photons_[chunk_photons_[c] ...)
+    std::vector<size_t> chunk_photons_;   // where chunk c writes its merge vertices (before the grid sorts them)
     std::vector<uint32_t> path_begin_;    // light path j: its chunk's vertices from here
     std::vector<uint16_t> path_length_;   // ... this many
-    std::vector<MergeVertex<T>> photons_;
+    std::vector<MergeVertex<T>> photons_;  // made in path order, then sorted into the grid's cells
     PhotonGrid grid_;
     PassImage pass_;
     tbb::enumerable_thread_specific<std::pair<std::vector<Vertex>, std::vector<Vertex>>> subpaths_;  // camera, light

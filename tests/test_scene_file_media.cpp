@@ -1,7 +1,8 @@
 // Media in scene files: <medium> at the top level and nested, interior/exterior references, the
 // null BSDF and BSDF-less boundaries, the sensor's medium, grid volumes from .vol and .vdb files
 // with to_world, and bad input (named with file:line, grid problems naming the grid file, exit
-// code 2 from the command line).
+// code 2 from the command line), and every integrator but those that render media refusing a
+// scene with one.
 #include <gtest/gtest.h>
 
 #include <unistd.h>
@@ -11,6 +12,9 @@
 #include <fstream>
 
 #include "cli_runner.hpp"
+#include "integrators/integrator.hpp"
+#include "job/render_job.hpp"
+#include "job/usage_error.hpp"
 #include "media/grid_files.hpp"
 #include "scene/scene.hpp"
 #include "scenefile/scene_file.hpp"
@@ -193,6 +197,58 @@ TEST_F(SceneFileMedia, BadGridFilesNameTheSceneLineAndTheGridFile) {
     EXPECT_TRUE(contains(r.err, path("scene.xml") + ":3:")) << r.err;
     EXPECT_TRUE(contains(r.err, path("short.vol"))) << r.err;
     EXPECT_TRUE(contains(r.err, "truncated")) << r.err;
+}
+
+// No silent wrong answer: every integrator that does not render media refuses a scene whose
+// shapes or camera refer to one (naming the medium, where it is, and the integrators that do),
+// rather than render it as if the medium were not there; a medium declared and never used, or
+// one of no extinction (a vacuum), changes nothing and is accepted.
+TEST_F(SceneFileMedia, IntegratorsWithoutMediaRefuseScenesWithMedia) {
+    const std::string rest = R"(<shape type="rectangle"><bsdf type="diffuse"/></shape>
+        <shape type="sphere"><point name="center" value="0, 0, 2"/><emitter type="area"><rgb name="radiance" value="1"/></emitter></shape>)";
+    const SceneDescription inside = load(R"(<medium type="homogeneous" id="fog"><rgb name="sigma_t" value="1"/></medium>
+        <shape type="cube"><bsdf type="null"/><ref name="interior" id="fog"/></shape>)" + rest);
+    const SceneDescription camera = load(R"(<sensor type="perspective"><medium type="homogeneous"/></sensor>)" + rest);
+    const SceneDescription unused = load(R"(<medium type="homogeneous" id="fog"/>)" + rest);
+    const SceneDescription vacuum = load(R"(<medium type="homogeneous" id="fog"><rgb name="sigma_t" value="0"/></medium>
+        <shape type="cube"><bsdf type="null"/><ref name="interior" id="fog"/></shape>)" + rest);
+    int refusing = 0;
+    for (const IntegratorInfo& info : integrators()) {
+        JobRequest request;
+        request.algorithm = info.name;
+        EXPECT_NO_THROW(RenderJob(scene_choice_of(unused), request)) << info.name;
+        EXPECT_NO_THROW(RenderJob(scene_choice_of(vacuum), request)) << info.name;
+        for (const auto& [d, where] : {std::pair{&inside, std::string("homogeneous medium 'fog' (inside mesh")},
+                                       std::pair{&camera, "homogeneous medium of " + path("test.xml") + ":2 (the camera is in it)"}}) {
+            std::string message;
+            try {
+                RenderJob job(scene_choice_of(*d), request);
+            } catch (const UsageError& e) {
+                message = e.what();
+            }
+            if (info.media) {
+                EXPECT_EQ(message, "") << info.name;
+                continue;
+            }
+            EXPECT_TRUE(contains(message, info.name + " does not render participating media")) << message;
+            EXPECT_TRUE(contains(message, where)) << message;
+            EXPECT_TRUE(contains(message, "The integrators that render media: volpath")) << message;
+            ++refusing;
+        }
+    }
+    EXPECT_EQ(refusing, 2 * (int(integrators().size()) - 1));  // all but volpath
+    // From the command line: exit code 2, and `pathlab algorithms` says which render media.
+    std::ofstream(path("fog.xml")) << "<scene version=\"3.0.0\">\n<medium type=\"homogeneous\" id=\"fog\"/>\n"
+                                      "<shape type=\"cube\"><ref name=\"interior\" id=\"fog\"/></shape>\n" + rest + "</scene>\n";
+    for (const char* a : {"bdpt", "pt-mis"}) {
+        const CliResult r = run({"--scene", path("fog.xml"), "-a", a, "--spp", "1", "--resolution", "8x8", "-o", path("out.exr")});
+        EXPECT_EQ(r.code, 2) << r.err;
+        EXPECT_TRUE(contains(r.err, "medium 'fog'")) << r.err;
+        EXPECT_FALSE(fs::exists(path("out.exr")));
+    }
+    EXPECT_EQ(run({"--scene", path("fog.xml"), "-a", "volpath", "--spp", "1", "--resolution", "8x8", "-q", "-o", path("out.exr")}).code, 0);
+    const CliResult list = run({"algorithms"});
+    EXPECT_TRUE(contains(list.out, "Participating media (scenes with a <medium>): volpath;")) << list.out;
 }
 
 }  // namespace

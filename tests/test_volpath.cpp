@@ -72,11 +72,13 @@ TEST(Volpath, WithoutMediaItIsPtMisBitForBit) {
 // ---- media that change nothing --------------------------------------------------------------
 
 // Index-matched boundaries are Embree geometry with their own mask: every other estimator's rays
-// pass through them (meshes and spheres), so pt-mis renders the scene as if they were not there.
+// pass through them (meshes and spheres), so pt-mis renders a scene whose media are a vacuum as
+// if the boundaries were not there (a scene with a medium that attenuates it refuses:
+// test_scene_file_media.cpp).
 TEST(Volpath, OtherEstimatorsDoNotSeeIndexMatchedBoundaries) {
     const SceneDescription plain = make_builtin_scene(2);
     SceneDescription with = plain;
-    with.media.push_back(HomogeneousMedium{Rgb(2.0f), Rgb(1.0f), IsotropicPhase{}});
+    with.media.push_back(HomogeneousMedium{Rgb(0.0f), Rgb(0.0f), IsotropicPhase{}});
     MeshDesc box = cube_mesh();
     transform_mesh(box, Transform::scale({0.5, 0.5, 0.5}));
     box.media.interior = 0;
@@ -92,7 +94,8 @@ TEST(Volpath, OtherEstimatorsDoNotSeeIndexMatchedBoundaries) {
         const RenderResult x = render_scene(plain, a, 16, 16, 4, 7), y = render_scene(with, a, 16, 16, 4, 7);
         EXPECT_TRUE(bit_identical(x.film.mean(), y.film.mean())) << a;
     }
-    // volpath does see them (the medium is dense).
+    // volpath does see them when the medium is dense.
+    with.media[0] = HomogeneousMedium{Rgb(2.0f), Rgb(1.0f), IsotropicPhase{}};
     const RenderResult x = render_scene(plain, "volpath", 16, 16, 4, 7), y = render_scene(with, "volpath", 16, 16, 4, 7);
     EXPECT_FALSE(bit_identical(x.film.mean(), y.film.mean()));
 }

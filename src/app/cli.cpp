@@ -37,6 +37,8 @@ void print_algorithms() {
         const std::string alias = e.aliases.empty() ? "" : fmt::format("({})", fmt::join(e.aliases, "/"));
         fmt::print("{:<14} {:<5} {}\n", e.name, alias, e.summary);
     }
+    fmt::print("\nParticipating media (scenes with a <medium>): {}; the others refuse such scenes.\n", media_integrator_names());
+    fmt::print("Spectral mode (--spectral): {}.\n", spectral_integrator_names());
 }
 
 }  // namespace

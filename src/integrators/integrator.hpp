@@ -178,6 +178,9 @@ struct IntegratorInfo {
     bool any_filter = true;
     // Renders in spectral mode (--spectral); the others refuse it.
     bool spectral = true;
+    // Renders participating media (a scene whose shapes or camera refer to a <medium>); the
+    // others refuse such a scene (RenderJob), rather than render it as if the media were not there.
+    bool media = false;
 
     PluginInfo plugin() const;
 };
@@ -196,5 +199,6 @@ const IntegratorInfo* find_integrator(const std::string& name_or_alias);
 std::string integrator_names();
 // "pt-mis, pt-naive, ...": the integrators that render in spectral mode.
 std::string spectral_integrator_names();
+std::string media_integrator_names();
 
 }  // namespace pathlab

@@ -44,4 +44,11 @@ std::string spectral_integrator_names() {
     return out;
 }
 
+std::string media_integrator_names() {
+    std::string out;
+    for (const IntegratorInfo& e : integrators())
+        if (e.media) out += (out.empty() ? "" : ", ") + e.name;
+    return out;
+}
+
 }  // namespace pathlab

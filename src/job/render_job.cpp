@@ -38,6 +38,38 @@ std::optional<double> environment_cap(const char* name) {
     return v;
 }
 
+// True when the medium attenuates light somewhere (a vacuum, sigma_t = 0 everywhere, changes nothing).
+bool has_extinction(const Medium& medium) {
+    if (const auto* h = std::get_if<HomogeneousMedium>(&medium)) return max_component(h->sigma_t) > 0;
+    const auto& g = std::get<HeterogeneousMedium>(medium);
+    return g.scale > 0 && g.sigma_t.max_value() > 0;
+}
+
+// The first medium the scene renders (the camera's, or one on a side of a shape), and where,
+// for the message of an integrator that cannot render media; "" when the scene has none (media
+// declared and never referred to, and media of no extinction, change nothing).
+std::string medium_in_use(const SceneDescription& d) {
+    const auto attenuates = [&](int32_t m) { return m >= 0 && size_t(m) < d.media.size() && has_extinction(d.media[size_t(m)]); };
+    const auto label = [&](int32_t m) {
+        return size_t(m) < d.medium_labels.size() && !d.medium_labels[size_t(m)].empty() ? d.medium_labels[size_t(m)]
+                                                                                        : fmt::format("medium {}", m);
+    };
+    const auto on_shape = [&](const MediumInterface& mi, const std::string& shape) -> std::string {
+        if (attenuates(mi.interior)) return fmt::format("{} (inside {})", label(mi.interior), shape);
+        if (attenuates(mi.exterior)) return fmt::format("{} (outside {})", label(mi.exterior), shape);
+        return "";
+    };
+    if (attenuates(d.camera_medium)) return fmt::format("{} (the camera is in it)", label(d.camera_medium));
+    std::string found;
+    for (size_t i = 0; i < d.meshes.size() && found.empty(); ++i)
+        found = on_shape(d.meshes[i].media, d.meshes[i].name.empty() ? fmt::format("mesh {}", i) : "mesh '" + d.meshes[i].name + "'");
+    for (size_t i = 0; i < d.spheres.size() && found.empty(); ++i) found = on_shape(d.spheres[i].media, fmt::format("sphere {}", i));
+    for (const ShapeGroupDesc& g : d.groups)
+        for (const MeshDesc& m : g.meshes)
+            if (found.empty()) found = on_shape(m.media, fmt::format("mesh '{}' of shapegroup '{}'", m.name, g.name));
+    return found;
+}
+
 // PATHLAB_SPP_CAP, PATHLAB_TIME_CAP and PATHLAB_RESOLUTION_CAP (see the header).
 void apply_environment_caps(RenderSettings& s, const SceneDescription& d) {
     if (const auto cap = environment_cap("PATHLAB_RESOLUTION_CAP")) {
@@ -89,6 +121,11 @@ RenderJob::RenderJob(SceneChoice scene, const JobRequest& r) : choice_(std::move
         throw UsageError(fmt::format("{} does not render in spectral mode yet (--spectral, or the scene file's <default name=\"mode\" "
                                      "value=\"spectral\"/>); the integrators that do: {}",
                                      info_->name, spectral_integrator_names()));
+    if (!info_->media)
+        if (const std::string medium = medium_in_use(d); !medium.empty())
+            throw UsageError(fmt::format("{0} does not render participating media, and this scene has the {1}: {0} would render "
+                                         "the scene as if the medium were not there. The integrators that render media: {2}",
+                                         info_->name, medium, media_integrator_names()));
     // What the integrator cannot do with this scene's sensor and film.
     if (!info_->any_camera && d.camera.kind != CameraKind::Perspective)
         throw UsageError(fmt::format("{} cannot render through a {} sensor: it connects light paths to a pinhole camera (or sizes "

@@ -31,6 +31,9 @@ struct SceneDescription {
     // camera sits in (-1: none).
     std::vector<Medium> media;
     int32_t camera_medium = -1;
+    // How messages name each medium (by index in `media`; the vector may be shorter): its type
+    // and a scene file's id ("homogeneous medium 'fog'"), or where the file declares it.
+    std::vector<std::string> medium_labels;
     // Ids of the materials (by index in `materials`) and free lights (by index in `lights`), ""
     // for unnamed ones (either vector may be shorter): the names of differentiable parameters
     // (diff/parameters.hpp), as scene files' id attributes give them. Shapes carry their own id.

@@ -319,8 +319,12 @@ std::unique_ptr<Integrator> make_volpath(const IntegratorOptions& options, Volpa
 }
 
 const IntegratorInfo& volpath_integrator() {
-    static const IntegratorInfo info{"volpath", {"volpathmis"}, "volumetric path tracing: participating media, delta tracking, MIS",
-                                     false, true, path_params(), [](const IntegratorOptions& o) { return make_volpath(o); }};
+    static const IntegratorInfo info = [] {
+        IntegratorInfo i{"volpath", {"volpathmis"}, "volumetric path tracing: participating media, delta tracking, MIS",
+                         false, true, path_params(), [](const IntegratorOptions& o) { return make_volpath(o); }};
+        i.media = true;
+        return i;
+    }();
     return info;
 }
 

@@ -2,6 +2,10 @@
 
 #include <sys/resource.h>
 
+#include <stdexcept>
+
+#include <fmt/format.h>
+
 #include "job/render_job.hpp"
 
 namespace pathlab::bench {
@@ -9,10 +13,18 @@ namespace pathlab::bench {
 RenderResult run(const Scene& scene, const std::string& algorithm, int size, int spp, double seconds, uint64_t seed,
                  std::function<void(const Film&, const RenderStats&)> after_pass, SamplerKind sampler) {
     JobRequest r;
-    r.algorithm = algorithm;
-    if (const size_t colon = algorithm.find(":radius="); colon != std::string::npos) {
-        r.algorithm = algorithm.substr(0, colon);
-        r.photon_radius = std::stof(algorithm.substr(colon + 8));
+    // "name:key=value:...": radius (the photon methods' first radius), max_depth, rr_depth.
+    r.algorithm = algorithm.substr(0, algorithm.find(':'));
+    for (size_t at = algorithm.find(':'); at != std::string::npos;) {
+        const size_t next = algorithm.find(':', at + 1);
+        const std::string setting = algorithm.substr(at + 1, next == std::string::npos ? std::string::npos : next - at - 1);
+        const size_t eq = setting.find('=');
+        const std::string key = setting.substr(0, eq), value = eq == std::string::npos ? "" : setting.substr(eq + 1);
+        if (key == "radius") r.photon_radius = std::stof(value);
+        else if (key == "max_depth") r.max_depth = std::stoi(value);
+        else if (key == "rr_depth") r.rr_depth = std::stoi(value);
+        else throw std::runtime_error(fmt::format("{}: unknown setting '{}' (radius, max_depth, rr_depth)", algorithm, key));
+        at = next;
     }
     r.width = r.height = size;
     if (spp > 0) r.spp = uint64_t(spp);

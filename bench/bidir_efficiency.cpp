@@ -12,35 +12,66 @@
 #include <fmt/format.h>
 
 #include "bench_common.hpp"
+#include "image/image_io.hpp"
 #include "integrators/photon/vcm.hpp"
 #include "scenefile/scene_file.hpp"
 
 namespace pathlab::bench {
+namespace {
+
+// Images rendered elsewhere ("LABEL:ITERATIONS:SECONDS=FILE"), judged as the methods below are.
+void judge_images(const std::vector<std::string>& specs, const Reference& ref) {
+    fmt::print("\nImages from elsewhere:\n\n| image | iterations | s per iteration | MSE per sample | 1 / (MSE x s) |\n|---|---|---|---|---|\n");
+    for (const std::string& spec : specs) {
+        const size_t eq = spec.find('='), c1 = spec.find(':'), c2 = spec.find(':', c1 + 1);
+        if (eq == std::string::npos || c2 == std::string::npos || c2 > eq)
+            throw std::runtime_error(fmt::format("--judge {}: expected LABEL:ITERATIONS:SECONDS=FILE", spec));
+        const std::string label = spec.substr(0, c1), file = spec.substr(eq + 1);
+        const int iterations = std::stoi(spec.substr(c1 + 1, c2 - c1 - 1));
+        const double seconds = std::stod(spec.substr(c2 + 1, eq - c2 - 1));
+        const Image img = read_image(file);
+        if (img.width() != ref.mean.width() || img.height() != ref.mean.height())
+            throw std::runtime_error(fmt::format("--judge {}: {}x{}, the reference is {}x{}", file, img.width(), img.height(),
+                                                 ref.mean.width(), ref.mean.height()));
+        const double e = rmse(img, ref);
+        fmt::print("| {} | {} | {:.3f} | {:.3g} | {:.3g} |\n", label, iterations, seconds / iterations, e * e * iterations,
+                   1 / (e * e * seconds));
+    }
+}
+
+}  // namespace
 
 void bidir_efficiency_suite(const BidirEfficiencyOptions& o) {
     const int threads = tbb::info::default_concurrency();
-    fmt::print("# Bidirectional methods against pt-mis at {0}x{0}, {1} iterations per render, {2} threads, medians of {3}\n\n", o.size,
-               o.iterations, threads, o.repeats);
+    fmt::print("# Bidirectional methods against pt-mis at {0}x{0}, {1} iterations per render, {2} threads, medians of {3}{4}\n\n", o.size,
+               o.iterations, threads, o.repeats, o.max_depth > 0 ? fmt::format(", at most {} bounces", o.max_depth) : "");
     fmt::print("MSE per sample = MSE x iterations, against bdpt at {} spp (its noise subtracted); efficiency = 1 / (MSE x seconds), "
                "relative to pt-mis's.\n",
                o.ref_spp);
     for (const std::string& key : o.scenes) {
         const auto scene = Scene::build(load_scene_file(std::string(PATHLAB_SOURCE_DIR) + "/scenes/" + key));
         const auto t0 = std::chrono::steady_clock::now();
-        const Reference ref = make_reference(*scene, "bdpt", o.size, o.ref_spp);
+        const std::string depth = o.max_depth > 0 ? fmt::format(":max_depth={}", o.max_depth) : "";
+        const Reference ref = make_reference(*scene, "bdpt" + depth, o.size, o.ref_spp);
         const double ref_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         fmt::print("\n## scenes/{} (reference: {:.0f} s)\n", key, ref_seconds);
+        if (key == o.scenes.front() && !o.judge.empty()) judge_images(o.judge, ref);
         for (const std::string& sampler_name : o.samplers) {
             const SamplerKind sampler = sampler_name == "sobol" ? SamplerKind::Sobol : SamplerKind::Independent;
             std::map<std::string, std::vector<double>> seconds, mse, efficiency;
             for (int r = 0; r < o.repeats; ++r)
                 for (const std::string& a : o.algorithms) {
-                    const RenderResult res = run(*scene, a, o.size, o.iterations, 0, 1000 + uint64_t(r), {}, sampler);
+                    const RenderResult res = run(*scene, a + depth, o.size, o.iterations, 0, 1000 + uint64_t(r), {}, sampler);
                     const double e = rmse(res.film.mean(), ref);
                     seconds[a].push_back(res.stats.seconds / o.iterations);
                     mse[a].push_back(e * e * o.iterations);
                     efficiency[a].push_back(1 / (e * e * res.stats.seconds));
                 }
+            if (!o.judge.empty() && key == o.scenes.front()) {
+                fmt::print("\n{} sampler, absolute:\n\n| method | MSE per sample | 1 / (MSE x s) |\n|---|---|---|\n", sampler_name);
+                for (const std::string& a : o.algorithms)
+                    fmt::print("| {} | {:.3g} | {:.3g} |\n", a, median(mse[a]), median(efficiency[a]));
+            }
             fmt::print("\n{} sampler:\n\n| method | s per iteration | MSE per sample | efficiency / {}'s |\n|---|---|---|---|\n", sampler_name,
                        o.algorithms.front());
             const double base = median(efficiency[o.algorithms.front()]);

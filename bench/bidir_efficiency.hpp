@@ -13,6 +13,10 @@ struct BidirEfficiencyOptions {
     std::vector<std::string> scenes{"smallvcm-box.xml", "smallvcm-lightbox.xml"};  // under scenes/
     std::vector<std::string> algorithms{"pt-mis", "bdpt", "bpm", "vcm"};  // "vcm:radius=R": another first radius
     std::vector<std::string> samplers{"independent", "sobol"};
+    int max_depth = -1;    // for every method and the reference (SmallVCM's default, 10 segments, is 9)
+    // Images of the first scene rendered elsewhere (another renderer: SmallVCM's .hdr output, say),
+    // judged against the same reference: "LABEL:ITERATIONS:SECONDS=FILE".
+    std::vector<std::string> judge;
 };
 
 // `pathlab_bench bidir`: the bidirectional methods against pt-mis on SmallVCM's kind of scene

@@ -53,6 +53,10 @@ int main(int argc, char** argv) {
         ->delimiter(',')
         ->capture_default_str();
     perf->add_option("--json", p.json, "JSON output file ('' for none)")->capture_default_str();
+    perf->add_option("--sections", p.sections, "The tables to measure")
+        ->delimiter(',')
+        ->check(CLI::IsMember({"throughput", "bound", "growth", "efficiency"}))
+        ->capture_default_str();
 
     EfficiencyOptions e;
     std::vector<CLI::App*> tables = {app.add_subcommand("direct", "Direct-illumination estimators 1, 2a, 2b, 2c, 3"),
@@ -88,6 +92,10 @@ int main(int argc, char** argv) {
     bec->add_option("--algorithms", be.algorithms, "Methods (the efficiencies are relative to the first); vcm:radius=R sets a first radius")
         ->delimiter(',')->capture_default_str();
     bec->add_option("--samplers", be.samplers, "Pixel samplers: independent (the course's), sobol")->delimiter(',')->capture_default_str();
+    bec->add_option("--max-depth", be.max_depth, "Bounces at most, for every method and the reference (-1: unlimited)")->capture_default_str();
+    bec->add_option("--judge", be.judge,
+                    "Images of the first scene from elsewhere (e.g. SmallVCM's .hdr), judged against its reference: LABEL:ITERATIONS:SECONDS=FILE")
+        ->delimiter(',');
     PhotonMappingOptions pm;
     CLI::App* pmc = app.add_subcommand("pm", "Photons per second; hashed grid against k-d tree");
     pmc->add_option("--light-paths", pm.light_paths, "Light paths traced per scene")->capture_default_str();

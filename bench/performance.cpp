@@ -169,6 +169,10 @@ MeshDesc tessellated_sphere(size_t triangles, uint32_t material) {
 
 }  // namespace
 
+bool PerfOptions::has(const std::string& section) const {
+    return std::find(sections.begin(), sections.end(), section) != sections.end();
+}
+
 void performance_suite(const PerfOptions& o) {
     nlohmann::json report = {{"options",
                               {{"size", o.size},
@@ -179,15 +183,18 @@ void performance_suite(const PerfOptions& o) {
     const int max_threads = std::min(2, tbb::this_task_arena::max_concurrency());
 
     // 1 + 2: throughput, scaling and the Embree bound, per scene.
-    fmt::print("## Throughput at {0}x{0} (medians of {1} runs of {2} s)\n\n", o.size, o.repeats, o.seconds);
-    fmt::print("| scene | estimator | Msamples/s 1 thr | Msamples/s {0} thr | scaling | Mrays/s {0} thr | rays/sample |\n",
-               max_threads);
-    fmt::print("|---|---|---|---|---|---|---|\n");
+    if (o.has("throughput")) {
+        fmt::print("## Throughput at {0}x{0} (medians of {1} runs of {2} s)\n\n", o.size, o.repeats, o.seconds);
+        fmt::print("| scene | estimator | Msamples/s 1 thr | Msamples/s {0} thr | scaling | Mrays/s {0} thr | rays/sample |\n",
+                   max_threads);
+        fmt::print("|---|---|---|---|---|---|---|\n");
+    }
     std::vector<std::pair<int, nlohmann::json>> bounds;
     for (int index : o.scenes) {
         const auto scene = Scene::build(make_builtin_scene(index));
         const std::string name = fmt::format("{} {}", index, builtin_scenes()[size_t(index)].name);
         for (const IntegratorInfo& e : integrators()) {
+            if (!o.has("throughput")) break;
             const Scaling sc = measure_scaling(*scene, e.name, o, max_threads);
             const Throughput &one = sc.one, &many = sc.many;
             const double scaling = sc.ratio;
@@ -205,6 +212,7 @@ void performance_suite(const PerfOptions& o) {
         }
         // Embree alone, pathlab's intersect() and a pt-mis render, back to back, 5 times; the
         // fraction is the median of the per-round ratios pt-mis / Embree.
+        if (!o.has("bound")) continue;
         const std::vector<Ray> rays = incoherent_rays(*scene, o.raw_rays);
         nlohmann::json b = {{"scene", name}, {"rays", o.raw_rays}, {"threads", max_threads}};
         std::vector<double> e1, en, pn, pt, fraction;
@@ -224,11 +232,13 @@ void performance_suite(const PerfOptions& o) {
         report["embree_bound"].push_back(b);
         save(report, o.json);
     }
-    fmt::print("\n## Embree's raw throughput: incoherent closest-hit rays ({} rays), against pathlab (medians of 5 rounds)\n\n",
+    if (o.has("bound")) fmt::print("\n## Embree's raw throughput: incoherent closest-hit rays ({} rays), against pathlab (medians of 5 rounds)\n\n",
                o.raw_rays);
-    fmt::print("| scene | Embree Mrays/s 1 thr | Embree Mrays/s {0} thr | pathlab intersect() Mrays/s {0} thr | pt-mis Mrays/s {0} thr | pt-mis / Embree |\n",
-               max_threads);
-    fmt::print("|---|---|---|---|---|---|\n");
+    if (o.has("bound")) {
+        fmt::print("| scene | Embree Mrays/s 1 thr | Embree Mrays/s {0} thr | pathlab intersect() Mrays/s {0} thr | pt-mis Mrays/s {0} thr | pt-mis / Embree |\n",
+                   max_threads);
+        fmt::print("|---|---|---|---|---|---|\n");
+    }
     for (const auto& [index, b] : bounds)
         fmt::print("| {} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {:.0f}% |\n", b["scene"].get<std::string>(),
                    b["embree_mrays_1_thread"].get<double>(), b["embree_mrays"].get<double>(),
@@ -236,56 +246,60 @@ void performance_suite(const PerfOptions& o) {
                    b["pt_mis_mrays"].get<double>(), 100 * b["pt_mis_fraction_of_embree"].get<double>());
 
     // 3: scene growth.
-    fmt::print("\n## Scene growth: scene 3 plus a tessellated sphere, pt-mis at {0}x{0}, {1} threads\n\n", o.growth_size,
-               max_threads);
-    fmt::print("| triangles added | BVH build (ms) | us per sample | relative to plain box | rays/sample | peak RSS (MiB) |\n");
-    fmt::print("|---|---|---|---|---|---|\n");
-    // Each size is timed in rounds against the plain box (back to back); the relative cost is
-    // the median of the per-round ratios.
-    const auto plain_box = Scene::build(make_builtin_scene(3));
-    const auto us_per_sample = [&](const Scene& scene, uint64_t seed, double* rays_per_sample) {
-        const RenderResult r =
-            with_threads(max_threads, [&] { return run(scene, "pt-mis", o.growth_size, 0, o.seconds, seed); });
-        if (rays_per_sample) *rays_per_sample = double(r.stats.rays) / double(r.stats.samples);
-        return r.stats.seconds / double(r.stats.samples) * 1e6;
-    };
-    for (size_t n : o.mesh_sizes) {
-        SceneDescription d = make_builtin_scene(3);
-        if (n > 0) {
-            d.materials.push_back(make_phong(Rgb(0.6f)));
-            d.meshes.push_back(tessellated_sphere(n, uint32_t(d.materials.size() - 1)));
+    if (o.has("growth")) {
+        fmt::print("\n## Scene growth: scene 3 plus a tessellated sphere, pt-mis at {0}x{0}, {1} threads\n\n", o.growth_size,
+                   max_threads);
+        fmt::print("| triangles added | BVH build (ms) | us per sample | relative to plain box | rays/sample | peak RSS (MiB) |\n");
+        fmt::print("|---|---|---|---|---|---|\n");
+        // Each size is timed in rounds against the plain box (back to back); the relative cost is
+        // the median of the per-round ratios.
+        const auto plain_box = Scene::build(make_builtin_scene(3));
+        const auto us_per_sample = [&](const Scene& scene, uint64_t seed, double* rays_per_sample) {
+            const RenderResult r =
+                with_threads(max_threads, [&] { return run(scene, "pt-mis", o.growth_size, 0, o.seconds, seed); });
+            if (rays_per_sample) *rays_per_sample = double(r.stats.rays) / double(r.stats.samples);
+            return r.stats.seconds / double(r.stats.samples) * 1e6;
+        };
+        for (size_t n : o.mesh_sizes) {
+            SceneDescription d = make_builtin_scene(3);
+            if (n > 0) {
+                d.materials.push_back(make_phong(Rgb(0.6f)));
+                d.meshes.push_back(tessellated_sphere(n, uint32_t(d.materials.size() - 1)));
+            }
+            const size_t triangles = n > 0 ? d.meshes.back().triangles.size() : 0;
+            std::vector<double> builds;
+            std::unique_ptr<Scene> scene;
+            for (int k = 0; k < 3; ++k) {
+                scene.reset();
+                const auto t0 = Clock::now();
+                scene = with_threads(max_threads, [&] { return Scene::build(d); });
+                builds.push_back(seconds_since(t0) * 1e3);
+            }
+            std::vector<double> cost, relative, rps;
+            for (int k = 0; k < o.repeats; ++k) {
+                double r = 0;
+                const double base = us_per_sample(*plain_box, 20 + uint64_t(k), nullptr);
+                cost.push_back(us_per_sample(*scene, 20 + uint64_t(k), &r));
+                relative.push_back(cost.back() / base);
+                rps.push_back(r);
+            }
+            const double us = median(cost);
+            fmt::print("| {} | {:.1f} | {:.3f} | {:.2f}x | {:.2f} | {:.0f} |\n", triangles, median(builds), us,
+                       median(relative), median(rps), peak_rss_mib());
+            std::fflush(stdout);
+            report["growth"].push_back({{"triangles_added", triangles},
+                                        {"bvh_build_ms", median(builds)},
+                                        {"us_per_sample", us},
+                                        {"relative_cost", median(relative)},
+                                        {"rays_per_sample", median(rps)},
+                                        {"peak_rss_mib", peak_rss_mib()}});
+            save(report, o.json);
         }
-        const size_t triangles = n > 0 ? d.meshes.back().triangles.size() : 0;
-        std::vector<double> builds;
-        std::unique_ptr<Scene> scene;
-        for (int k = 0; k < 3; ++k) {
-            scene.reset();
-            const auto t0 = Clock::now();
-            scene = with_threads(max_threads, [&] { return Scene::build(d); });
-            builds.push_back(seconds_since(t0) * 1e3);
-        }
-        std::vector<double> cost, relative, rps;
-        for (int k = 0; k < o.repeats; ++k) {
-            double r = 0;
-            const double base = us_per_sample(*plain_box, 20 + uint64_t(k), nullptr);
-            cost.push_back(us_per_sample(*scene, 20 + uint64_t(k), &r));
-            relative.push_back(cost.back() / base);
-            rps.push_back(r);
-        }
-        const double us = median(cost);
-        fmt::print("| {} | {:.1f} | {:.3f} | {:.2f}x | {:.2f} | {:.0f} |\n", triangles, median(builds), us,
-                   median(relative), median(rps), peak_rss_mib());
-        std::fflush(stdout);
-        report["growth"].push_back({{"triangles_added", triangles},
-                                    {"bvh_build_ms", median(builds)},
-                                    {"us_per_sample", us},
-                                    {"relative_cost", median(relative)},
-                                    {"rays_per_sample", median(rps)},
-                                    {"peak_rss_mib", peak_rss_mib()}});
-        save(report, o.json);
+
     }
 
     // 4: efficiency of pt-mis over time.
+    if (!o.has("efficiency")) return;
     fmt::print("\n## pt-mis efficiency at {0}x{0}: reference {1} spp; checkpoints of one progressive render\n\n",
                o.efficiency_size, o.efficiency_ref_spp);
     fmt::print("| scene | sampler | seconds | spp | RMSE | 1/(MSE x s) |\n|---|---|---|---|---|---|\n");

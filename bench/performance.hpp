@@ -17,6 +17,9 @@ struct PerfOptions {
     int efficiency_ref_spp = 1024;
     std::vector<double> checkpoints{5, 10, 20};
     std::string json = "out/bench/performance.json";
+    // Which tables to measure: throughput, bound (Embree's raw rate against pt-mis's), growth, efficiency.
+    std::vector<std::string> sections{"throughput", "bound", "growth", "efficiency"};
+    bool has(const std::string& section) const;
 };
 
 void performance_suite(const PerfOptions& o);

@@ -135,9 +135,11 @@ public:
     }
     // The BSDF density at x_j of going on to x_next, having come from x_prev.
     float bsdf_density(const FullPath& f, int prev, int j, int next) const {
-        // A Dirac lobe: its selection probability (1 for the mirror), common to every strategy
-        // that can make the path, so it cancels from the heuristic.
-        if (specular(f, j)) return 1;
+        // A Dirac lobe: its coefficient (the selection probability, 1 for the mirror) as a
+        // solid-angle density, converted to area at x_next: the delta itself is common to every
+        // strategy that can make the path, so it cancels from the heuristic, and the cosines and
+        // distances stay (the VCM report's specular vertices).
+        if (specular(f, j)) return area(f, 1.0f, j, next);
         const ShadingPoint sp = make_shading_point(*scene_, f.hit[size_t(j)], -dir(f, j, prev));
         return area(f, sp.material->pdf(sp.frame.to_local(dir(f, j, prev)), sp.frame.to_local(dir(f, j, next))), j, next);
     }

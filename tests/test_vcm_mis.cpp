@@ -24,8 +24,8 @@ public:
 
     bool valid_connection(const FullPath& f, int s) const { return h_.valid(f, s) && (vm_.connections || s == 0); }
     bool valid_merge(const FullPath& f, int j) const { return j >= 1 && j <= h_.k(f) - 1 && !h_.specular(f, j); }
-    // The light side's area density of x_j (from x_{j+1}); 1 after a Dirac vertex (its delta,
-    // common to every strategy that samples x_j from the light side).
+    // The light side's area density of x_j (from x_{j+1}; after a Dirac vertex, its coefficient
+    // times the edge's cos / d^2, as bsdf_density gives it).
     double light_density(const FullPath& f, int j) const {
         return j + 1 == h_.k(f) ? h_.light_emission(f) : h_.bsdf_density(f, j + 2, j + 1, j);
     }
@@ -57,8 +57,6 @@ public:
         std::vector<PathVertex<RgbTransport>> light, camera, unused;
         h_.subpaths(f, s, light, unused, power_, &vm_);
         h_.subpaths(f, s - 1, unused, camera, power_, &vm_);
-        // As the light walk stores it: 0 after a Dirac vertex.
-        if (h_.specular(f, j + 1)) light.back().pdf_fwd = 0;
         const float w = vcm_.merge_weight(light.data(), s, camera, j + 1, vm_);
         const float oracle = vcm_.merge_weight_oracle(light.data(), s, camera, j + 1, vm_);
         EXPECT_NEAR(w, oracle, 1e-5 * oracle + 1e-12) << "merge at x_" << j << ": running vs walk";

@@ -96,12 +96,15 @@ void Bdpt<T>::random_walk(const RenderContext& ctx, Ray ray, Sampler& sampler, C
             beta = hero_lane(beta);
             scatter = hero_lane(scatter);
         }
+        // A Dirac lobe keeps its coefficient (the probability of choosing it, the same both
+        // ways) as its density: the delta itself is common to every strategy that can sample
+        // the path, and the neighbours' area densities keep their cosines and distances (as the
+        // VCM report's specular vertices do; reading the density as 0, and 0 as 1 in the
+        // ratios, as pbrt-v3 does, leaves out a factor d^2 / cos per Dirac vertex and gave
+        // the camera strategies of a caustic seen through glass too much weight).
         pdfW = s->pdfW;
-        float pdf_rev = s->pdf_rev;
-        if (s->delta) {
-            cur.delta = true;
-            pdfW = pdf_rev = 0;
-        }
+        const float pdf_rev = s->pdf_rev;
+        if (s->delta) cur.delta = true;
         // The reverse density of the previous vertex: cur's sampling of it.
         if (!(faults_.specular_pdf_rev_missing && path[prev].delta)) path[prev].pdf_rev = to_area_density(pdf_rev, cur, path[prev]);
         // Russian roulette after rr_depth bounces, as in the path tracers.

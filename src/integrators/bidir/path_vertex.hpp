@@ -6,7 +6,13 @@
 // vertex (Veach's thesis, ch. 10), except for vertices at infinity (a camera ray that escaped to
 // the environment, or the light vertex of an environment or directional light), whose density
 // is per unit solid angle of their direction. A Dirac scattering (mirror, glass, the coating of
-// plastic) makes both 0 and sets `delta`: no strategy may connect there.
+// plastic) sets `delta`: no strategy may connect there. Its lobe counts with its coefficient,
+// the probability of choosing it (the same in both directions), as its solid-angle density: the
+// delta itself is common to every strategy that can sample the path, so it cancels in their
+// ratios, and the neighbours' area densities keep their cosines and distances (the VCM report's
+// treatment of specular vertices; pbrt-v3's reading of the density as 0, and of 0 as 1 in the
+// ratios, drops a factor d^2 / cos per Dirac vertex). A density of 0 is a strategy that cannot
+// sample the vertex at all (read as 1 in the ratios, where the delta flags leave it out anyway).
 //
 // These are the pieces of Veach's ratio form of the MIS weight (pbrt's formulation): for a
 // path of n + 1 vertices sampled by strategy (s, t), the weight is 1 / sum_i (p_i / p_s)^beta,
@@ -94,7 +100,7 @@ inline MisVertex mis_vertex(const PathVertexBase& v) { return {v.pdf_fwd, v.pdf_
 // camera endpoint is x, times the light side's area density of x, times eta = the number of
 // light paths merged with (n_VM, against n_VC = 1 for connections) times the acceptance area
 // pi r^2 (the VCM report's formulation). After a Dirac vertex on the light side the density of
-// x is that vertex's delta, which every strategy sampling x from the light side shares: 1.
+// x is that lobe's coefficient times the edge's cos / d^2, as in every ratio (the delta cancels).
 struct MergeMis {
     double eta = 0;
     bool merging = false;     // merging strategies take part
@@ -107,8 +113,7 @@ struct MergeMis {
 // strategy (s, t). With `vm`, merging strategies too.
 template <typename LightAt, typename CameraAt>
 double mis_ratio_sum(const LightAt& light, int s, const CameraAt& camera, int t, bool power, const MergeMis* vm) {
-    // A density of 0 marks a Dirac lobe: those strategies are left out, and the ratio passes
-    // through the vertex unchanged.
+    // Strategies ending at a Dirac vertex are left out (the delta flags); a density of 0 counts as 1.
     const auto remap0 = [](float f) { return f != 0 ? double(f) : 1.0; };
     const auto h = [power](double r) { return power ? r * r : r; };
     const bool connections = !vm || vm->connections, merging = vm && vm->merging;
@@ -116,13 +121,8 @@ double mis_ratio_sum(const LightAt& light, int s, const CameraAt& camera, int t,
     // Strategies with fewer light vertices: the camera subpath's vertices, taken from the light side.
     for (int i = t - 1; i > 0; --i) {
         const MisVertex c = camera(i);
-        // Merging at camera vertex i: ri is here the ratio of the connection ending there. A
-        // light-side density of 0 after a Dirac vertex is that vertex's delta, common to every
-        // strategy that samples i from the light side: 1, as in the ratios.
-        if (merging && c.surface && !c.delta && s + (t - 1 - i) >= 1) {
-            const bool after_dirac = i == t - 1 ? light(s - 1).delta : camera(i + 1).delta;
-            sum += h(ri * (after_dirac ? 1.0 : double(c.pdf_rev)) * vm->eta);
-        }
+        // Merging at camera vertex i: ri is here the ratio of the connection ending there.
+        if (merging && c.surface && !c.delta && s + (t - 1 - i) >= 1) sum += h(ri * double(c.pdf_rev) * vm->eta);
         ri *= remap0(c.pdf_rev) / remap0(c.pdf_fwd);
         if (connections && !c.delta && !camera(i - 1).delta) sum += h(ri);
     }
@@ -134,7 +134,7 @@ double mis_ratio_sum(const LightAt& light, int s, const CameraAt& camera, int t,
         const bool delta_before = i > 0 ? light(i - 1).delta : l.delta_light;
         if ((connections || i == 0) && !l.delta && !delta_before) sum += h(ri);
         // Merging at light vertex i, now the camera endpoint of the connection (i, s + t - i).
-        if (merging && i >= 1 && l.surface && !l.delta) sum += h(ri * (light(i - 1).delta ? 1.0 : double(l.pdf_fwd)) * vm->eta);
+        if (merging && i >= 1 && l.surface && !l.delta) sum += h(ri * double(l.pdf_fwd) * vm->eta);
     }
     return sum;
 }
@@ -161,8 +161,8 @@ float mis_weight_ratio_walk(const Vertex* light, int s, const Vertex* camera, in
 // then completes the sum from its endpoint's neighbourhood in O(1):
 //   light side, endpoint y_e:  h(Q'_e) (c_e + mc_e h(phi_e eta) + h(Q'_{e-1}) X_e)
 //   camera side, endpoint z_e: mc_e h(psi_e eta) + h(R'_e) (c_e + mc_{e-1} h(rev'_{e-1} eta) + h(R'_{e-1}) Y_e)
-// with Q, R = pdf_rev / pdf_fwd (0 read as 1, a Dirac lobe), c / mc whether a connection / a
-// merge exists there, phi_i the light side's own density of y_i (1 after a Dirac vertex), psi_i
+// with Q, R = pdf_rev / pdf_fwd (0 read as 1), c / mc whether a connection / a
+// merge exists there, phi_i the light side's own density of y_i, psi_i
 // the light side's density of z_i, X / Y the running quantities. The walk stays as the oracle
 // (tests/test_bdpt_mis.cpp compares both).
 
@@ -193,7 +193,7 @@ void set_running_mis(Vertex* v, int n, bool light_side, const MisRules& m) {
             double x = prefix;
             if ((m.connections || i == 0) && !v[i].delta && !delta_before) x += 1;
             if (m.merging && i >= 1 && v[i].kind == VertexKind::Surface && !v[i].delta)
-                x += m.h((v[i - 1].delta ? 1.0 : double(v[i].pdf_fwd)) * m.eta);
+                x += m.h(double(v[i].pdf_fwd) * m.eta);
             v[k].mis_running = x;
             prefix = m.h(MisRules::remap0(v[i].pdf_rev) / MisRules::remap0(v[i].pdf_fwd)) * x;
         } else {
@@ -204,7 +204,7 @@ void set_running_mis(Vertex* v, int n, bool light_side, const MisRules& m) {
             v[k].mis_running = y;
             prefix = m.h(MisRules::remap0(v[i].pdf_rev) / MisRules::remap0(v[i].pdf_fwd)) * y;
             if (m.merging && v[i].kind == VertexKind::Surface && !v[i].delta)
-                prefix += m.h((v[k].delta ? 1.0 : double(v[i].pdf_rev)) * m.eta);
+                prefix += m.h(double(v[i].pdf_rev) * m.eta);
         }
     }
 }
@@ -217,13 +217,13 @@ double light_side_sum(const Vertex* y, int e, double rev_e, double rev_prev, con
     if (e == 0) return y[0].delta_light ? 0.0 : q;
     double inner = m.h(MisRules::remap0(rev_prev) / MisRules::remap0(y[e - 1].pdf_fwd)) * y[e].mis_running;
     if (m.connections && !y[e - 1].delta) inner += 1;
-    if (m.merging && y[e].kind == VertexKind::Surface) inner += m.h((y[e - 1].delta ? 1.0 : double(y[e].pdf_fwd)) * m.eta);
+    if (m.merging && y[e].kind == VertexKind::Surface) inner += m.h(double(y[e].pdf_fwd) * m.eta);
     return q * inner;
 }
 
 // The camera side's part of the MIS sum of a strategy ending at z_e (e = t - 1 >= 1, not Dirac
 // there): z_e's light-side density rev_e (merging at z_e counts with psi_e, its density from the
-// light side or 1 after a Dirac light vertex; merge_here: the strategy has a light vertex), and
+// light side; merge_here: the strategy has a light vertex), and
 // z_{e-1}'s, rev_prev. `fwd_e` is z_e's own density (a merge's camera endpoint has its own).
 template <class Vertex>
 double camera_side_sum(const Vertex* z, int e, double fwd_e, double rev_e, double psi_e, bool merge_here, double rev_prev,

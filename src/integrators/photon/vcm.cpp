@@ -117,8 +117,8 @@ float Vcm<T>::merge_weight(const MergeVertex<T>& photon, float pdf_to_light, flo
     const double camera_prev_rev = double(pdf_to_camera) * double(camera_prev_g);
     // The light side ends at y_{s-2}, whose density from z is light_prev_rev.
     const double light = rules.h(MisRules::remap0(light_prev_rev) / MisRules::remap0(photon.prev_pdf_fwd)) * double(photon.mis_running);
-    // The camera side includes this merge itself: its density, psi (1 after a Dirac light vertex), times eta.
-    const double psi = photon.prev_delta ? 1.0 : double(photon.pdf_fwd);
+    // The camera side includes this merge itself: its density, psi, times eta.
+    const double psi = double(photon.pdf_fwd);
     const double camera_sum = camera_side_sum(camera.data(), t - 1, z.pdf_fwd, photon.pdf_fwd, psi, true, camera_prev_rev, rules);
     // The connection (s - 1, t) is the reference, 1, where it exists.
     const double reference = vm.connections && !photon.prev_delta ? 1.0 : 0.0;
@@ -162,7 +162,7 @@ float Vcm<T>::merge_weight_oracle(const Vertex* y, int s, const std::vector<Vert
     // (s - 1, t) is the reference, 1, where it exists.
     const double others = mis_ratio_sum(light_at, s - 1, camera_at, t, power, &vm);
     const double reference = vm.connections && !y[s - 2].delta ? 1.0 : 0.0;
-    double own = (y[s - 2].delta || faults_.merge_weight_without_light_pdf ? 1.0 : double(photon.pdf_fwd)) * vm.eta;
+    double own = (faults_.merge_weight_without_light_pdf ? 1.0 : double(photon.pdf_fwd)) * vm.eta;
     if (power) own *= own;
     const double total = reference + others;
     return total > 0 ? float(own / total) : 0.0f;

@@ -53,7 +53,7 @@ namespace pathlab {
 // merge completes in O(1) (path_vertex.hpp), so that no merge reads the subpath it came from.
 template <class T>
 struct MergeVertex : Photon<T> {
-    float pdf_fwd = 0;       // its light subpath's area density of it (0 after a Dirac vertex)
+    float pdf_fwd = 0;       // its light subpath's area density of it
     float prev_pdf_fwd = 0;  // ... of the vertex before it
     float prev_g = 0;        // |cos| / distance^2 at the vertex before it (1 at infinity): a solid-angle density from here, as area there
     float mis_running = 0;   // its light-side running quantity

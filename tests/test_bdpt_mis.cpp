@@ -97,5 +97,35 @@ TEST(BdptMis, RunningWeightsEqualTheWalkOnTracedPaths) {
     expect_same_render<SpectralTransport>("prism.xml", false);
 }
 
+// On traced subpaths through SmallVCM's mirror and glass balls: a Dirac vertex gives its
+// neighbours the densities of its lobe's coefficient (the probability of choosing it, in (0, 1],
+// the same both ways) across the edge, cosine and distance included, not 0: the weights of
+// caustics seen through glass depend on it (docs/estimators.md, "Against SmallVCM itself").
+TEST(BdptMis, DiracVerticesPassTheirCoefficientToTheirNeighbours) {
+    const auto scene = Scene::build(load_scene_file(std::string(PATHLAB_SOURCE_DIR) + "/scenes/smallvcm-balls.xml"));
+    const PerspectiveCamera camera(scene->camera(), 64, 64);
+    const RenderContext ctx{*scene, camera, 64, 64, 7, SamplerKind::Independent, 32};
+    const Bdpt<RgbTransport> bdpt{IntegratorOptions{}};
+    std::vector<PathVertex<RgbTransport>> path;
+    int checked = 0;
+    for (uint64_t j = 0; j < 20000; ++j)
+        for (const bool light_side : {false, true}) {
+            Sampler sampler(7, j, 0);
+            if (light_side) bdpt.light_subpath(ctx, sampler, RgbWavelengths{}, path);
+            else bdpt.camera_subpath(ctx, size_t(j % 4096), sampler, RgbWavelengths{}, path);
+            for (size_t i = 1; i + 1 < path.size(); ++i) {
+                if (!path[i].delta || path[i + 1].infinite) continue;
+                // The coefficient as the next vertex's density, and as the previous one's reverse density.
+                const double forward = path[i + 1].pdf_fwd / to_area_density(1.0f, path[i], path[i + 1]);
+                const double backward = path[i - 1].pdf_rev / to_area_density(1.0f, path[i], path[i - 1]);
+                ASSERT_GT(forward, 0.0) << (light_side ? "light" : "camera") << " subpath " << j << ", vertex " << i;
+                ASSERT_LE(forward, 1.0 + 1e-5);
+                ASSERT_NEAR(backward, forward, 1e-4 * forward) << (light_side ? "light" : "camera") << " subpath " << j << ", vertex " << i;
+                ++checked;
+            }
+        }
+    EXPECT_GT(checked, 1000);
+}
+
 }  // namespace
 }  // namespace pathlab::test

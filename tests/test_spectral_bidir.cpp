@@ -220,8 +220,9 @@ TEST(SpectralBidir, BdptStrategiesAddUpToItsImage) {
 // ---- RGB mode unchanged ----------------------------------------------------------------------
 
 // The golden-image test does not cover lt and bdpt: tests/data/golden/bidir/ holds their RGB
-// images rendered by the build before spectral mode reached them (commit 7d99cd4), rendered
-// again here through the command line and compared bit for bit.
+// images rendered by the build before spectral mode reached them (commit 7d99cd4; smooth-bdpt
+// re-made when bdpt's weights at Dirac vertices changed, see make.sh there), rendered again here
+// through the command line and compared bit for bit.
 TEST(SpectralBidir, RgbImagesAreThoseRenderedBeforeSpectralMode) {
     namespace fs = std::filesystem;
     const fs::path dir = fs::path(PATHLAB_SOURCE_DIR) / "tests/data/golden/bidir";

@@ -190,11 +190,11 @@ void performance_suite(const PerfOptions& o) {
         fmt::print("|---|---|---|---|---|---|---|\n");
     }
     std::vector<std::pair<int, nlohmann::json>> bounds;
+    const std::vector<IntegratorInfo> none;  // the estimators measured when throughput is not asked for
     for (int index : o.scenes) {
         const auto scene = Scene::build(make_builtin_scene(index));
         const std::string name = fmt::format("{} {}", index, builtin_scenes()[size_t(index)].name);
-        for (const IntegratorInfo& e : integrators()) {
-            if (!o.has("throughput")) break;
+        for (const IntegratorInfo& e : o.has("throughput") ? integrators() : none) {
             const Scaling sc = measure_scaling(*scene, e.name, o, max_threads);
             const Throughput &one = sc.one, &many = sc.many;
             const double scaling = sc.ratio;
@@ -232,9 +232,9 @@ void performance_suite(const PerfOptions& o) {
         report["embree_bound"].push_back(b);
         save(report, o.json);
     }
-    if (o.has("bound")) fmt::print("\n## Embree's raw throughput: incoherent closest-hit rays ({} rays), against pathlab (medians of 5 rounds)\n\n",
-               o.raw_rays);
     if (o.has("bound")) {
+        fmt::print("\n## Embree's raw throughput: incoherent closest-hit rays ({} rays), against pathlab (medians of 5 rounds)\n\n",
+                   o.raw_rays);
         fmt::print("| scene | Embree Mrays/s 1 thr | Embree Mrays/s {0} thr | pathlab intersect() Mrays/s {0} thr | pt-mis Mrays/s {0} thr | pt-mis / Embree |\n",
                    max_threads);
         fmt::print("|---|---|---|---|---|---|\n");
@@ -295,7 +295,6 @@ void performance_suite(const PerfOptions& o) {
                                         {"peak_rss_mib", peak_rss_mib()}});
             save(report, o.json);
         }
-
     }
 
     // 4: efficiency of pt-mis over time.

@@ -199,6 +199,7 @@ const IntegratorInfo* find_integrator(const std::string& name_or_alias);
 std::string integrator_names();
 // "pt-mis, pt-naive, ...": the integrators that render in spectral mode.
 std::string spectral_integrator_names();
+// ... and those that render participating media.
 std::string media_integrator_names();
 
 }  // namespace pathlab

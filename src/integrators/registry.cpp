@@ -37,18 +37,20 @@ std::string integrator_names() {
     return out;
 }
 
-std::string spectral_integrator_names() {
+namespace {
+
+// "a, b, ...": the integrators whose `capability` is true.
+std::string names_of_integrators_with(bool IntegratorInfo::*capability) {
     std::string out;
     for (const IntegratorInfo& e : integrators())
-        if (e.spectral) out += (out.empty() ? "" : ", ") + e.name;
+        if (e.*capability) out += (out.empty() ? "" : ", ") + e.name;
     return out;
 }
 
-std::string media_integrator_names() {
-    std::string out;
-    for (const IntegratorInfo& e : integrators())
-        if (e.media) out += (out.empty() ? "" : ", ") + e.name;
-    return out;
-}
+}  // namespace
+
+std::string spectral_integrator_names() { return names_of_integrators_with(&IntegratorInfo::spectral); }
+
+std::string media_integrator_names() { return names_of_integrators_with(&IntegratorInfo::media); }
 
 }  // namespace pathlab

@@ -38,13 +38,6 @@ std::optional<double> environment_cap(const char* name) {
     return v;
 }
 
-// True when the medium attenuates light somewhere (a vacuum, sigma_t = 0 everywhere, changes nothing).
-bool has_extinction(const Medium& medium) {
-    if (const auto* h = std::get_if<HomogeneousMedium>(&medium)) return max_component(h->sigma_t) > 0;
-    const auto& g = std::get<HeterogeneousMedium>(medium);
-    return g.scale > 0 && g.sigma_t.max_value() > 0;
-}
-
 // The first medium the scene renders (the camera's, or one on a side of a shape), and where,
 // for the message of an integrator that cannot render media; "" when the scene has none (media
 // declared and never referred to, and media of no extinction, change nothing).

@@ -46,4 +46,30 @@ float free_flight_pdf(const HomogeneousMedium& m, float t, int hero) {
     return s * std::exp(-s * t);
 }
 
+bool has_extinction(const Medium& medium) {
+    if (const auto* h = std::get_if<HomogeneousMedium>(&medium)) return max_component(h->sigma_t) > 0;
+    const auto& g = std::get<HeterogeneousMedium>(medium);
+    return g.scale > 0 && g.sigma_t.max_value() > 0;
+}
+
+float mis_extinction(const Medium& m, const Vec3f& p) { return mean(MediumRgb{m}.extinction(p)); }
+
+float mis_transmittance(const Medium& m, const Vec3f& o, const Vec3f& d, float tmax) {
+    const MediumRgb view{m};
+    Rgb sigma_t;
+    if (view.constant_extinction(sigma_t)) {
+        const float s = mean(sigma_t);
+        return s > 0 ? std::exp(-s * tmax) : 1.0f;
+    }
+    float scale, depth = 0;
+    MajorantIterator pieces = view.majorants(o, d, tmax, 1, scale);
+    MajorantSegment seg;
+    while (pieces.next(seg)) {
+        if (!(seg.sigma_maj > 0)) continue;  // nothing there
+        if (!std::isfinite(seg.t1)) return 0.0f;
+        depth += mean(view.extinction(o + d * (0.5f * (seg.t0 + seg.t1)))) * (seg.t1 - seg.t0);
+    }
+    return std::exp(-depth);
+}
+
 }  // namespace pathlab

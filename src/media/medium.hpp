@@ -61,8 +61,23 @@ inline Rgb estimate_transmittance(const Medium& m, const Vec3f& o, const Vec3f& 
     return estimate_transmittance(MediumRgb{m}, o, d, tmax, rng, majorant_factor);
 }
 
+// True when the medium attenuates light somewhere (a vacuum, sigma_t = 0 everywhere, changes nothing).
+bool has_extinction(const Medium& medium);
+
 // The density of the free-flight distance t in a homogeneous medium for hero channel h (its
 // sampling pdf): sigma_t,h exp(-sigma_t,h t); the probability of passing tmax is exp(-sigma_t,h tmax).
 float free_flight_pdf(const HomogeneousMedium& m, float t, int hero);
+
+// The distance-sampling part of the densities in the bidirectional methods' MIS weights (bdpt,
+// docs/volumes.md): a deterministic function of the path, so that every strategy that can make
+// a path gives its edges the same densities, and exact for grey media of constant extinction.
+// A vertex in a medium reached along an edge has the density sigma(x) T(edge) per unit volume
+// (times the direction's density over d^2); a surface behind the edge, T(edge) per unit area.
+//   mis_extinction      the channels' mean extinction at p
+//   mis_transmittance   exp(-optical depth of mis_extinction along o + t d, t in [0, tmax]):
+//                       exact where the extinction is constant (0 for an infinite ray through
+//                       a medium), else the midpoint rule over the majorant grid's cells
+float mis_extinction(const Medium& m, const Vec3f& p);
+float mis_transmittance(const Medium& m, const Vec3f& o, const Vec3f& d, float tmax);
 
 }  // namespace pathlab

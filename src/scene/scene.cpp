@@ -169,7 +169,31 @@ std::unique_ptr<Scene> Scene::build(const SceneDescription& desc) {
     }
 
     s->light_distribution_ = LightDistribution(s->lights_, s->scene_sphere());
+    if (s->has_media_) {
+        // A point of each light on its emitting side (the middle of its emission sampling's domain).
+        const float offset = 1e-4f * s->radius_;
+        for (const Light& l : s->lights_) {
+            const auto es = sample_emission(l, {0.5f, 0.5f}, {0.5f, 0.5f}, s->scene_sphere());
+            int32_t m = -1;
+            if (es) m = s->medium_at((light_flags(l) & kLightSurface) ? es->origin + es->normal * offset : es->origin);
+            s->light_media_.push_back(m);
+        }
+    }
     return s;
+}
+
+int32_t Scene::medium_at(const Vec3f& p) const {
+    int32_t medium = desc_.camera_medium;
+    Ray ray{camera_.position, p - camera_.position, 1.0f};
+    for (int crossings = 0; crossings < 1024; ++crossings) {
+        Intersection hit;
+        const MediumInterface* media = nullptr;
+        if (!intersect(ray, hit, kMaskAll, media)) break;
+        if (media && media->changes_medium()) medium = media->medium_towards(ray.d, hit.ng);
+        const Vec3f from = offset_ray_origin(hit.p, dot(ray.d, hit.ng) >= 0 ? hit.ng : -hit.ng);
+        ray = Ray{from, p - from, 1.0f};
+    }
+    return medium;
 }
 
 bool Scene::has_delta_lights() const {

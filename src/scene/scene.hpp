@@ -56,6 +56,13 @@ public:
     int32_t camera_medium() const { return desc_.camera_medium; }
     // True when some shape changes the medium or the camera sits in one.
     bool has_media() const { return has_media_; }
+    // The medium at point p (-1: none), found by following the segment from the camera to p
+    // through every boundary it crosses, as the camera's paths track media.
+    int32_t medium_at(const Vec3f& p) const;
+    // The medium light i's light paths start in: at its position (point lights), on the
+    // emitting side of its surface, or at infinity (outside the scene's bounds); found once by
+    // medium_at at a point of the light (an emitter lies in one medium on its emitting side).
+    int32_t light_medium(int i) const { return light_media_.empty() ? -1 : light_media_[size_t(i)]; }
 
     // The surface's coordinates at a hit, for materials that use them (textures, normal and bump
     // maps, anisotropic roughness), computed on demand so that other hits pay nothing: uv (a
@@ -128,6 +135,7 @@ private:
     LightDistribution light_distribution_;
     int environment_ = -1;
     bool has_media_ = false;
+    std::vector<int32_t> light_media_;  // by light, when the scene has media
     Vec3f center_{0.0f};
     float radius_ = 1;
 };

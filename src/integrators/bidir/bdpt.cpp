@@ -7,16 +7,23 @@
 
 #include "integrators/bidir/strategy_images.hpp"
 #include "integrators/common/light_path_start.hpp"
+#include "integrators/common/media_walk.hpp"
 #include "integrators/integrators.hpp"
 
 namespace pathlab {
 namespace {
 
 // The BSDF of surface vertex v for light leaving towards the world direction w (the mode of v's
-// subpath: radiance on the camera side, importance on the light side), at the wavelengths wl.
-// Also the solid-angle density with which v's BSDF samples w (which the MIS weight needs).
+// subpath: radiance on the camera side, importance on the light side), at the wavelengths wl, or
+// the phase function of a medium vertex. Also the solid-angle density with which v samples w
+// (which the MIS weight needs).
 template <class Wl>
-ColourAt<Wl> bsdf_towards(const PathVertexBase& v, const Vec3f& w, float& pdfW, const Wl& wl) {
+ColourAt<Wl> bsdf_towards(const Scene& scene, const PathVertexBase& v, const Vec3f& w, float& pdfW, const Wl& wl) {
+    if (v.kind == VertexKind::Medium) {
+        const PhaseFunction& phase = medium_phase(scene.medium(v.medium));
+        pdfW = phase_pdf(phase, v.dir, w);
+        return ColourAt<Wl>(phase_eval(phase, v.dir, w));
+    }
     const Vec3f wo = v.sp.frame.to_local(w);
     return bsdf_colour(v.sp, wo, v.sp.material->eval_and_pdf(v.sp, v.sp.wi, wo, pdfW), wl);
 }
@@ -48,96 +55,163 @@ Bdpt<T>::~Bdpt() = default;
 
 template <class T>
 void Bdpt<T>::random_walk(const RenderContext& ctx, Ray ray, Sampler& sampler, Colour beta, float pdfW, int max_vertices,
-                          TransportMode mode, Wavelengths wl, Subpath& path) const {
+                          TransportMode mode, Wavelengths wl, Subpath& path, int32_t medium, int hero) const {
     const Scene& scene = ctx.scene;
+    const bool media = scene.has_media();
+    // Media's random numbers and the subpath's spectral MIS state (media_walk.hpp).
+    MediumState<T> st{sampler, wl};
+    st.hero = hero;
     Colour scatter(1.0f);  // the throughput of the scattering alone, for Russian roulette
     for (int bounces = 0;; ++bounces) {
         if (int(path.size()) >= max_vertices) return;
         const size_t prev = path.size() - 1;
+        Vertex v;
+        v.beta = beta;
+        v.dispersed = wl.secondary_terminated();
         Intersection hit;
-        if (!scene.intersect(ray, hit)) {
+        bool found;
+        Vec3f dir = ray.d;
+        if (!media) {
+            found = scene.intersect(ray, hit);
+        } else {
+            // Through media and index-matched boundaries to a scattering point or a surface.
+            Colour seg(1.0f);
+            const MediumWalk w = walk_media(scene, ray, medium, st, seg, &v.T_in);
+            if (w.kind == MediumWalk::kLost) return;
+            if (faults_.drop_distance_pdf) v.T_in = 1;
+            beta *= seg;
+            scatter *= seg;
+            v.beta = beta;
+            v.r = st.r;
+            v.medium = w.medium;
+            dir = w.dir;
+            found = w.kind != MediumWalk::kEscaped;
+            if (w.kind == MediumWalk::kMedium) {
+                v.kind = VertexKind::Medium;
+                v.p = w.p;
+                v.dir = -normalize(w.dir);
+                v.sigma_mis = faults_.drop_distance_pdf ? 1.0f : mis_extinction(scene.medium(w.medium), w.p);
+                v.pdf_fwd = to_area_density(pdfW, path[prev], v) * v.distance_factor(v.T_in);
+                path.push_back(v);
+            } else if (found) {
+                hit = w.isect;
+                v.media = w.media;
+            }
+        }
+        if (!found) {
             // A camera ray that escapes reaches the environment: a light vertex at infinity.
             if (mode == TransportMode::Radiance && scene.environment_light() >= 0) {
-                Vertex v;
                 v.kind = VertexKind::Light;
                 v.infinite = true;
-                v.dir = normalize(ray.d);
+                v.dir = normalize(dir);
                 v.light = scene.environment_light();
-                v.beta = beta;
-                v.dispersed = wl.secondary_terminated();
-                v.pdf_fwd = pdfW;  // per unit solid angle
+                v.pdf_fwd = pdfW * v.T_in;  // per unit solid angle
                 path.push_back(v);
             }
             return;
         }
-        Vertex v;
-        v.kind = VertexKind::Surface;
-        v.sp = make_shading_point(scene, hit, normalize(ray.d), mode);
-        v.p = hit.p;
-        v.n = v.sp.ng;
-        v.emitter_n = hit.ng;
-        v.light = hit.light;
-        v.beta = beta;
-        v.dispersed = wl.secondary_terminated();
-        v.pdf_fwd = to_area_density(pdfW, path[prev], v);
-        path.push_back(v);
-        Vertex& cur = path.back();
-        if (cur.sp.material->is_black() || int(path.size()) >= max_vertices) return;
-
-        cur.sp.reverse_pdf = true;
-        const auto s = bsdf_sample(cur.sp, sampler.next2d(), wl);
-        cur.sp.reverse_pdf = false;
-        if (!s) return;
-        const Colour weight = bsdf_sample_colour(cur.sp, *s, wl) * (std::abs(s->wo.z) / s->pdfW);
-        beta *= weight;
-        scatter *= weight;
-        if (wl.secondary_terminated()) {
-            // Dispersion here or before: the next vertex and all after it carry the hero alone.
-            beta = hero_lane(beta);
-            scatter = hero_lane(scatter);
+        if (v.kind != VertexKind::Medium) {
+            v.kind = VertexKind::Surface;
+            v.sp = make_shading_point(scene, hit, normalize(dir), mode);
+            v.p = hit.p;
+            v.n = v.sp.ng;
+            v.emitter_n = hit.ng;
+            v.light = hit.light;
+            v.pdf_fwd = to_area_density(pdfW, path[prev], v) * v.T_in;
+            path.push_back(v);
         }
-        // A Dirac lobe keeps its coefficient (the probability of choosing it, the same both
-        // ways) as its density: the delta itself is common to every strategy that can sample
-        // the path, and the neighbours' area densities keep their cosines and distances (as the
-        // VCM report's specular vertices do; reading the density as 0, and 0 as 1 in the
-        // ratios, as pbrt-v3 does, leaves out a factor d^2 / cos per Dirac vertex and gave
-        // the camera strategies of a caustic seen through glass too much weight).
-        pdfW = s->pdfW;
-        const float pdf_rev = s->pdf_rev;
-        if (s->delta) cur.delta = true;
-        // The reverse density of the previous vertex: cur's sampling of it.
-        if (!(faults_.specular_pdf_rev_missing && path[prev].delta)) path[prev].pdf_rev = to_area_density(pdf_rev, cur, path[prev]);
-        // Russian roulette after rr_depth bounces, as in the path tracers.
+        Vertex& cur = path.back();
+        if (int(path.size()) >= max_vertices) return;
+
+        Vec3f wo;  // the next direction: in world space in a medium, local to the surface's frame on one
+        float pdf_rev;
+        if (cur.kind == VertexKind::Medium) {
+            // The phase function samples the next direction; p / pdf = 1, and it is symmetric.
+            const PhaseFunction& phase = medium_phase(scene.medium(cur.medium));
+            const PhaseSample ps = phase_sample(phase, cur.dir, sampler.next2d());
+            if (!(ps.pdfW > 0)) return;
+            const Colour weight(ps.p / ps.pdfW);
+            beta *= weight;
+            scatter *= weight;
+            wo = ps.wo;
+            pdfW = ps.pdfW;
+            pdf_rev = phase_pdf(phase, ps.wo, cur.dir);
+        } else {
+            if (cur.sp.material->is_black()) return;
+            cur.sp.reverse_pdf = true;
+            const auto s = bsdf_sample(cur.sp, sampler.next2d(), wl);
+            cur.sp.reverse_pdf = false;
+            if (!s) return;
+            const Colour weight = bsdf_sample_colour(cur.sp, *s, wl) * (std::abs(s->wo.z) / s->pdfW);
+            beta *= weight;
+            scatter *= weight;
+            if (wl.secondary_terminated()) {
+                // Dispersion here or before: the next vertex and all after it carry the hero alone.
+                beta = hero_lane(beta);
+                scatter = hero_lane(scatter);
+            }
+            // A Dirac lobe keeps its coefficient (the probability of choosing it, the same both
+            // ways) as its density: the delta itself is common to every strategy that can sample
+            // the path, and the neighbours' area densities keep their cosines and distances (as the
+            // VCM report's specular vertices do; reading the density as 0, and 0 as 1 in the
+            // ratios, as pbrt-v3 does, leaves out a factor d^2 / cos per Dirac vertex and gave
+            // the camera strategies of a caustic seen through glass too much weight).
+            pdfW = s->pdfW;
+            pdf_rev = s->pdf_rev;
+            if (s->delta) cur.delta = true;
+            wo = s->wo;
+        }
+        // The reverse density of the previous vertex: cur's sampling of it, back along the same edge.
+        if (!(faults_.specular_pdf_rev_missing && path[prev].delta))
+            path[prev].pdf_rev = to_area_density(pdf_rev, cur, path[prev]) * path[prev].distance_factor(cur.T_in);
+        // Russian roulette after rr_depth bounces, as in the path tracers (in media on the
+        // throughput over the path's density, its actual weight).
         if (options_.rr_depth >= 0 && bounces + 1 >= options_.rr_depth) {
-            const float q = std::clamp(max_component(scatter), 0.05f, 1.0f);
+            const float q = std::clamp(media ? max_component(scatter / st.density()) : max_component(scatter), 0.05f, 1.0f);
             if (sampler.next1d() >= q) return;
             beta /= q;
             scatter /= q;
         }
-        ray = cur.sp.spawn(s->wo);
+        if (cur.kind == VertexKind::Medium) {
+            medium = cur.medium;
+            ray = Ray{cur.p, wo, kInf};
+        } else {
+            if (media) medium = cur.medium_towards(cur.sp.frame.to_world(wo));
+            ray = cur.sp.spawn(wo);
+        }
     }
 }
 
 template <class T>
+int Bdpt<T>::sample_hero(const RenderContext& ctx, size_t pixel, uint64_t pass, const Wavelengths& wl) {
+    if (!ctx.scene.has_media()) return -1;
+    Sampler hero_sampler(ctx.seed, sample_stream(pixel, kHeroStream), pass, ctx.sampler);
+    return hero_channel(wl, [&] { return hero_sampler.next1d(); });
+}
+
+template <class T>
 void Bdpt<T>::camera_subpath(const RenderContext& ctx, size_t pixel, Sampler& sampler, const Wavelengths& wl, Subpath& path,
-                             const Vec2f* shift, const MergeMis* vm) const {
+                             const Vec2f* shift, const MergeMis* vm, int hero) const {
     path.clear();
     Vertex c;
     c.kind = VertexKind::Camera;
     c.p = ctx.camera.position();
     c.beta = Colour(1.0f);
     c.pdf_fwd = 1;
+    c.medium = ctx.scene.camera_medium();
     path.push_back(c);
     const Vec2f jitter = shift ? (sampler.next2d(), *shift) : sampler.next2d();
     const float x = float(pixel % size_t(ctx.width)), y = float(pixel / size_t(ctx.width));
     const Ray ray = ctx.camera.generate(x + jitter.x, y + jitter.y);
     // We cos / (pdfA pdfW) = 1 for the pinhole: the camera path starts with throughput 1.
-    random_walk(ctx, ray, sampler, Colour(1.0f), ctx.camera.pdf_direction(ray.d), max_camera_vertices(), TransportMode::Radiance, wl, path);
+    random_walk(ctx, ray, sampler, Colour(1.0f), ctx.camera.pdf_direction(ray.d), max_camera_vertices(), TransportMode::Radiance, wl, path,
+                c.medium, hero);
     set_running_mis(path.data(), int(path.size()), /*light_side=*/false, MisRules(options_.mis_power, vm));
 }
 
 template <class T>
-void Bdpt<T>::light_subpath(const RenderContext& ctx, Sampler& sampler, const Wavelengths& wl, Subpath& path, const MergeMis* vm) const {
+void Bdpt<T>::light_subpath(const RenderContext& ctx, Sampler& sampler, const Wavelengths& wl, Subpath& path, const MergeMis* vm,
+                            int hero) const {
     path.clear();
     const Scene& scene = ctx.scene;
     const auto start = start_light_path(scene, sampler);
@@ -154,16 +228,21 @@ void Bdpt<T>::light_subpath(const RenderContext& ctx, Sampler& sampler, const Wa
     l.n = (flags & kLightSurface) ? es->normal : Vec3f(0.0f);
     l.emitter_n = es->normal;
     l.light = choice.index;
+    l.medium = scene.light_medium(choice.index);
     l.beta = light_colour(scene, choice.index, es->Le, wl);
     l.pdf_fwd = choice.pmf * es->pdfA;
     path.push_back(l);
+    // Light from infinity through a medium that reaches infinity is all absorbed on its way.
+    if (l.infinite && l.medium >= 0 && has_extinction(scene.medium(l.medium))) return;
     const Colour beta = l.beta * (es->cos / (choice.pmf * es->pdfA * es->pdfW));
     const Ray ray = (flags & kLightSurface) ? spawn_ray(es->origin, es->normal, es->direction) : Ray{es->origin, es->direction, kInf};
-    random_walk(ctx, ray, sampler, beta, es->pdfW, max_light_vertices(), TransportMode::Importance, wl, path);
+    random_walk(ctx, ray, sampler, beta, es->pdfW, max_light_vertices(), TransportMode::Importance, wl, path, l.medium, hero);
     if (l.infinite) {
         // From infinity the first hit's density is that of the entry disk, projected; the light
         // vertex's own density is that of its direction under light sampling.
-        if (path.size() > 1) path[1].pdf_fwd = es->pdfA * (path[1].has_normal() ? std::abs(dot(path[1].n, es->direction)) : 1.0f);
+        if (path.size() > 1)
+            path[1].pdf_fwd = es->pdfA * (path[1].has_normal() ? std::abs(dot(path[1].n, es->direction)) : 1.0f) *
+                              path[1].distance_factor(path[1].T_in);
         path[0].pdf_fwd = pdf_light_origin(scene, path[0], path[0]);
     }
     set_running_mis(path.data(), int(path.size()), /*light_side=*/true, MisRules(options_.mis_power, vm));
@@ -178,12 +257,19 @@ ConnectionDensities Bdpt<T>::connection_densities(const RenderContext& ctx, cons
     const Vertex* qs_minus = s > 1 ? &ys[s - 2] : nullptr;
     const Vertex* pt_minus = t > 1 ? &zs[t - 2] : nullptr;
     ConnectionDensities d;
+    // Each density times the distance-sampling factor of the edge it arrives along (1 without
+    // media): the new edge's MIS transmittance known.T, or that of the subpath's own edge.
+    const auto factor = [this](const Vertex& v, float edge_T) { return faults_.drop_distance_pdf ? 1.0f : v.distance_factor(edge_T); };
     if (s == 0) d.camera_end = pdf_light_origin(scene, *pt, *pt_minus);
-    else if (known.qs_to_pt >= 0) d.camera_end = to_area_density(known.qs_to_pt, *qs, *pt);
-    else d.camera_end = pdf_next(scene, ctx.camera, qs_minus, *qs, *pt);
-    if (pt_minus) d.camera_prev = s > 0 ? pdf_next(scene, ctx.camera, qs, *pt, *pt_minus) : pdf_light_emission(scene, *pt, *pt_minus);
-    if (qs) d.light_end = known.pt_to_qs >= 0 ? to_area_density(known.pt_to_qs, *pt, *qs) : pdf_next(scene, ctx.camera, pt_minus, *pt, *qs);
-    if (qs_minus) d.light_prev = pdf_next(scene, ctx.camera, pt, *qs, *qs_minus);
+    else if (known.qs_to_pt >= 0) d.camera_end = to_area_density(known.qs_to_pt, *qs, *pt) * factor(*pt, known.T);
+    else d.camera_end = pdf_next(scene, ctx.camera, qs_minus, *qs, *pt) * factor(*pt, known.T);
+    if (pt_minus)
+        d.camera_prev = (s > 0 ? pdf_next(scene, ctx.camera, qs, *pt, *pt_minus) : pdf_light_emission(scene, *pt, *pt_minus)) *
+                        factor(*pt_minus, pt->T_in);
+    if (qs)
+        d.light_end = (known.pt_to_qs >= 0 ? to_area_density(known.pt_to_qs, *pt, *qs) : pdf_next(scene, ctx.camera, pt_minus, *pt, *qs)) *
+                      factor(*qs, known.T);
+    if (qs_minus) d.light_prev = pdf_next(scene, ctx.camera, pt, *qs, *qs_minus) * factor(*qs_minus, qs->T_in);
     return d;
 }
 
@@ -252,9 +338,20 @@ template <class T>
 StrategyResult<T> Bdpt<T>::connect(const RenderContext& ctx, SubpathView light, int s, SubpathView camera, int t, Sampler& sampler,
                                    const Wavelengths& wl, const MergeMis* vm) const {
     const Scene& scene = ctx.scene;
+    const bool media = scene.has_media();
     StrategyResult<T> r;
     Vertex sampled;
     EdgeDensities known;  // the BSDF densities across the new edge, from the evaluations below
+    // The connecting edge's transmittance: 0 where a surface blocks it; through media an
+    // estimate (ratio tracking, from a stream of strategy (s, t)'s own), and its MIS transmittance.
+    MediumState<T> st{sampler, wl};
+    st.stream_id = kMediumStream + uint64_t(s);
+    const auto transmittance = [&](const PathVertexBase& from, const PathVertexBase& to, const Vec3f& w) {
+        if (!media) return scene.occluded(from.segment_to(to)) ? Colour(0.0f) : Colour(1.0f);
+        const Colour Tr = shadow_transmittance(scene, from.segment_to(to), from.medium_towards(w), st, &known.T);
+        if (faults_.drop_distance_pdf) known.T = 1;
+        return faults_.drop_connection_transmittance && !is_black(Tr) ? Colour(1.0f) : Tr;
+    };
     const Vertex& pt = camera[size_t(t - 1)];
     // A camera subpath that escaped ends at infinity: only s = 0 can use that vertex.
     if (t > 1 && s != 0 && pt.kind == VertexKind::Light) return r;
@@ -267,14 +364,18 @@ StrategyResult<T> Bdpt<T>::connect(const RenderContext& ctx, SubpathView light, 
         }
     } else if (t == 1) {
         const Vertex& qs = light[size_t(s - 1)];
-        if (!qs.connectible() || qs.kind != VertexKind::Surface) return r;
+        if (!qs.connectible() || qs.kind == VertexKind::Light) return r;
         const auto k = ctx.camera.connect(qs.p);
         if (!k) return r;
         sampled.kind = VertexKind::Camera;
         sampled.p = ctx.camera.position();
+        sampled.medium = scene.camera_medium();
         sampled.beta = Colour(k->We / k->pdfW);
-        r.L = qs.beta * bsdf_towards(qs, k->wi, known.qs_to_pt, wl) * sampled.beta * cos_at(qs, k->wi);
-        if (is_black(r.L) || scene.occluded(qs.segment_to(sampled))) return StrategyResult<T>{};
+        r.L = qs.beta * bsdf_towards(scene, qs, k->wi, known.qs_to_pt, wl) * sampled.beta * cos_at(qs, k->wi);
+        if (is_black(r.L)) return StrategyResult<T>{};
+        const Colour Tr = transmittance(qs, sampled, k->wi);
+        if (is_black(Tr)) return StrategyResult<T>{};
+        if (media) r.L *= Tr;
         r.splat = true;
         r.raster = k->raster;
     } else if (s == 1) {
@@ -296,22 +397,31 @@ StrategyResult<T> Bdpt<T>::connect(const RenderContext& ctx, SubpathView light, 
         sampled.light = choice.index;
         sampled.beta = light_colour(scene, choice.index, ls->Le, wl) / (choice.pmf * ls->pdfW);
         sampled.pdf_fwd = pdf_light_origin(scene, sampled, pt);
-        r.L = pt.beta * bsdf_towards(pt, ls->wi, known.pt_to_qs, wl) * sampled.beta * cos_at(pt, ls->wi);
-        if (is_black(r.L) || scene.occluded(pt.segment_to(sampled))) return StrategyResult<T>{};
+        r.L = pt.beta * bsdf_towards(scene, pt, ls->wi, known.pt_to_qs, wl) * sampled.beta * cos_at(pt, ls->wi);
+        if (is_black(r.L)) return StrategyResult<T>{};
+        const Colour Tr = transmittance(pt, sampled, ls->wi);
+        if (is_black(Tr)) return StrategyResult<T>{};
+        if (media) r.L *= Tr;
     } else {
         const Vertex& qs = light[size_t(s - 1)];
-        if (!qs.connectible() || !pt.connectible() || qs.kind != VertexKind::Surface) return r;
+        if (!qs.connectible() || !pt.connectible() || qs.kind == VertexKind::Light) return r;
         const Vec3f d = qs.p - pt.p;
         const float dist2 = dot(d, d);
         if (!(dist2 > 0)) return r;
         const Vec3f w = d / std::sqrt(dist2);  // from pt towards qs
         const float G = cos_at(pt, w) * cos_at(qs, w) / dist2;
-        r.L = qs.beta * bsdf_towards(qs, -w, known.qs_to_pt, wl) * bsdf_towards(pt, w, known.pt_to_qs, wl) * pt.beta * G;
-        if (is_black(r.L) || scene.occluded(pt.segment_to(qs))) return StrategyResult<T>{};
+        r.L = qs.beta * bsdf_towards(scene, qs, -w, known.qs_to_pt, wl) * bsdf_towards(scene, pt, w, known.pt_to_qs, wl) * pt.beta * G;
+        if (is_black(r.L)) return StrategyResult<T>{};
+        const Colour Tr = transmittance(pt, qs, w);
+        if (is_black(Tr)) return StrategyResult<T>{};
+        if (media) r.L *= Tr;
     }
     if (is_black(r.L)) return r;
     // A path through a dispersive vertex on either side is the hero's estimate, once.
-    if ((s >= 2 && light[size_t(s - 1)].dispersed) || (t >= 2 && camera[size_t(t - 1)].dispersed)) r.L = hero_only(r.L);
+    const bool dispersed = (s >= 2 && light[size_t(s - 1)].dispersed) || (t >= 2 && camera[size_t(t - 1)].dispersed);
+    if (dispersed) r.L = hero_only(r.L);
+    // In media: the spectral MIS over the hero channel that both subpaths shared (media/medium.hpp).
+    if (media) r.L /= path_density_of((s >= 2 ? light[size_t(s - 1)].r : Colour(1.0f)) * (t >= 2 ? pt.r : Colour(1.0f)), dispersed);
     r.weight = mis_weight(ctx, light, s, camera, t, sampled, known, vm);
     return r;
 }
@@ -341,8 +451,9 @@ PassCounters Bdpt<T>::render_passes(const RenderContext& ctx, Film& film, uint64
                     Sampler light_sampler(ctx.seed, sample_stream(pixel, 1), pass, ctx.sampler);
                     // The camera sample's wavelengths (as PixelIntegrator's), for both subpaths.
                     const Wavelengths wl = T::camera_wavelengths(camera_sampler);
-                    camera_subpath(ctx, pixel, camera_sampler, wl, camera, filtered ? &shift : nullptr);
-                    light_subpath(ctx, light_sampler, wl, light);
+                    const int hero = sample_hero(ctx, pixel, pass, wl);
+                    camera_subpath(ctx, pixel, camera_sampler, wl, camera, filtered ? &shift : nullptr, nullptr, hero);
+                    light_subpath(ctx, light_sampler, wl, light, nullptr, hero);
                     // The pixel's own contributions (t >= 2) are summed and converted once; each
                     // light-tracing splat (t = 1) on its own.
                     typename T::SampleSum own(0.0f);
@@ -382,9 +493,13 @@ template class Bdpt<RgbTransport>;
 template class Bdpt<SpectralTransport>;
 
 const IntegratorInfo& bdpt_integrator() {
-    static const IntegratorInfo info{"bdpt", {"bpt"}, "bidirectional path tracing: every connection strategy (s, t), combined by MIS",
-                                     false, true, path_params(), [](const IntegratorOptions& o) { return make_for_transport<Bdpt>(o); },
-                                     /*any_camera=*/false};
+    static const IntegratorInfo info = [] {
+        IntegratorInfo i{"bdpt", {"bpt"}, "bidirectional path tracing: every connection strategy (s, t), combined by MIS",
+                         false, true, path_params(), [](const IntegratorOptions& o) { return make_for_transport<Bdpt>(o); },
+                         /*any_camera=*/false};
+        i.media = true;
+        return i;
+    }();
     return info;
 }
 

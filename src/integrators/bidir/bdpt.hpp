@@ -60,10 +60,12 @@ class StrategyImages;
 struct BdptFaults {
     bool drop_nee_strategy = false;      // MIS weights leave the s = 1 strategies out of their sums
     bool specular_pdf_rev_missing = false;  // a Dirac vertex's reverse density left unset (0)
+    bool drop_connection_transmittance = false;  // media: a connection's transmittance left out
+    bool drop_distance_pdf = false;              // media: densities without distance sampling's factor
     // Not a fault: every weight by the ratio walk (the oracle), for the test that compares whole
     // renders with the running quantities' weights.
     bool ratio_walk = false;
-    bool any() const { return drop_nee_strategy || specular_pdf_rev_missing || ratio_walk; }
+    bool any() const { return drop_nee_strategy || specular_pdf_rev_missing || ratio_walk; }  // (the media faults act where they are)
 };
 
 // What one strategy gives for one sample: the unweighted contribution (a path through
@@ -81,6 +83,7 @@ struct StrategyResult {
 struct EdgeDensities {
     float pt_to_qs = -1;  // z_{t-1}'s BSDF sampling the direction to y_{s-1}
     float qs_to_pt = -1;  // y_{s-1}'s BSDF sampling the direction to z_{t-1}
+    float T = 1;          // the new edge's MIS transmittance (media)
 };
 
 // The area densities that a connection gives the vertices at its new edge, from the other side:
@@ -108,10 +111,15 @@ public:
     // The subpaths of one sample at its wavelengths wl (for the tests and the per-pixel loop),
     // with their running MIS quantities for the strategies `vm` adds (vcm; none: bdpt's).
     // `shift`: with a reconstruction filter, the pass's lattice shift replaces the pixel's jitter.
+    // `hero`: in media, the channel that drives distance sampling, shared by the subpaths of a
+    // sample (sample_hero; -1: drawn from the subpath's own stream).
     void camera_subpath(const RenderContext& ctx, size_t pixel, Sampler& sampler, const Wavelengths& wl, Subpath& path,
-                        const Vec2f* shift = nullptr, const MergeMis* vm = nullptr) const;
+                        const Vec2f* shift = nullptr, const MergeMis* vm = nullptr, int hero = -1) const;
     void light_subpath(const RenderContext& ctx, Sampler& sampler, const Wavelengths& wl, Subpath& path,
-                       const MergeMis* vm = nullptr) const;
+                       const MergeMis* vm = nullptr, int hero = -1) const;
+    // The hero channel of a pixel sample in a scene with media (from a stream of its own; RGB
+    // draws one of the three, spectral mode's hero is its first wavelength), else -1.
+    static int sample_hero(const RenderContext& ctx, size_t pixel, uint64_t pass, const Wavelengths& wl);
     // Strategy (s, t) on the subpaths; `vm`: the merging strategies that also take part in its
     // MIS weight (vcm).
     StrategyResult<T> connect(const RenderContext& ctx, SubpathView light, int s, SubpathView camera, int t, Sampler& sampler,
@@ -153,8 +161,9 @@ public:
     }
 
     // The random-number stream of a sample: 0 the camera subpath (the pixel's own), 1 the light
-    // subpath, 1 + t the connections at camera vertex t.
+    // subpath, 1 + t the connections at camera vertex t, kHeroStream the hero channel in media.
     static uint64_t sample_stream(size_t pixel, uint64_t stream) { return uint64_t(pixel) + (stream << 40); }
+    static constexpr uint64_t kHeroStream = 0xfffff;  // the hero channel's (beyond every 1 + t)
     // Pixels per chunk of a pass: a function of the image size only.
     static size_t chunk_size(size_t pixels) { return std::max<size_t>(16, pixels / 64); }
     bool power_heuristic() const { return options_.mis_power; }
@@ -167,8 +176,9 @@ public:
     int max_light_vertices() const { return max_bounces_ + 1; }
 
 private:
+    // Extends `path` from its last vertex along `ray` (starting in `medium`); `hero` as for the subpaths.
     void random_walk(const RenderContext& ctx, Ray ray, Sampler& sampler, Colour beta, float pdfW, int max_vertices, TransportMode mode,
-                     Wavelengths wl, Subpath& path) const;
+                     Wavelengths wl, Subpath& path, int32_t medium, int hero) const;
 
     IntegratorOptions options_;
     BdptFaults faults_;

@@ -6,6 +6,7 @@
 #include <atomic>
 
 #include "integrators/common/light_path_start.hpp"
+#include "integrators/common/media_walk.hpp"
 #include "integrators/integrators.hpp"
 
 namespace pathlab {
@@ -38,23 +39,43 @@ void LightTracer<T>::trace(const RenderContext& ctx, Sampler& sampler, SplatList
     const EmissionSample* es = &start->emission;
     const uint32_t flags = start->flags;
     const Colour Le = light_colour(scene, choice.index, es->Le, wl);
+    // Media (docs/volumes.md): the path walks through them (media_walk.hpp), scatters in them by
+    // the phase function, and every connection to the camera carries the transmittance of its
+    // segment; contributions are divided by the path's density over the hero channel.
+    const bool media = scene.has_media();
+    MediumState<T> st{sampler, wl};
+    int32_t medium = scene.light_medium(choice.index);
+    // Light from infinity through a medium that reaches infinity is all absorbed on its way.
+    if ((flags & kLightInfinite) && medium >= 0 && has_extinction(scene.medium(medium))) return;
+    // Whether the segment to the camera is free, and its transmittance through media.
+    const auto to_camera = [&](const Ray& segment, int32_t from_medium) {
+        return shadow_transmittance(scene, segment, from_medium, st);
+    };
 
     // Paths of no bounce: the emitter seen by the camera.
     if (hide_emitters_) {
     } else if (flags & kLightSurface) {
         if (const auto k = camera.connect(es->origin)) {
             const float cos_light = dot(es->normal, k->wi);
-            if (cos_light > 0 && !scene.occluded(spawn_segment(es->origin, es->normal, camera.position(), Vec3f(0.0f))))
-                splat(out, ctx, k->raster, Le * (cos_light * k->We / (choice.pmf * es->pdfA * k->pdfW)), wl, invalid);
+            if (cos_light > 0) {
+                const Colour Tr = to_camera(spawn_segment(es->origin, es->normal, camera.position(), Vec3f(0.0f)), medium);
+                if (!is_black(Tr)) {
+                    const Colour seen = Le * (cos_light * k->We / (choice.pmf * es->pdfA * k->pdfW));
+                    splat(out, ctx, k->raster, media ? seen * Tr : seen, wl, invalid);
+                }
+            }
         }
     } else if ((flags & kLightInfinite) && !(flags & kLightDeltaDirection)) {
         const Vec2f u = sampler.next2d();
         if (const auto ls = sample_light(*start->light, camera.position(), u)) {
             const auto raster = camera.raster_of(ls->wi);
-            if (raster && ls->pdfW > 0 && !scene.occluded(Ray{camera.position(), ls->wi, kInf})) {
-                const float cos_lens = dot(ls->wi, camera.forward());
-                const Colour seen = light_colour(scene, choice.index, ls->Le, wl);
-                splat(out, ctx, *raster, seen * (camera.We(ls->wi) * cos_lens / (choice.pmf * ls->pdfW)), wl, invalid);
+            if (raster && ls->pdfW > 0) {
+                const Colour Tr = to_camera(Ray{camera.position(), ls->wi, kInf}, scene.camera_medium());
+                if (!is_black(Tr)) {
+                    const float cos_lens = dot(ls->wi, camera.forward());
+                    const Colour seen = light_colour(scene, choice.index, ls->Le, wl) * (camera.We(ls->wi) * cos_lens / (choice.pmf * ls->pdfW));
+                    splat(out, ctx, *raster, media ? seen * Tr : seen, wl, invalid);
+                }
             }
         }
     }
@@ -66,8 +87,42 @@ void LightTracer<T>::trace(const RenderContext& ctx, Sampler& sampler, SplatList
     Ray ray = (flags & kLightSurface) ? spawn_ray(es->origin, es->normal, es->direction) : Ray{es->origin, es->direction, kInf};
     for (int bounces = 1;; ++bounces) {
         Intersection hit;
-        if (!scene.intersect(ray, hit)) return;
-        const ShadingPoint sp = make_shading_point(scene, hit, ray.d, TransportMode::Importance);
+        const MediumInterface* boundary = nullptr;  // the surface's media (null: it changes none)
+        Vec3f dir = ray.d;
+        if (!media) {
+            if (!scene.intersect(ray, hit)) return;
+        } else {
+            Colour seg(1.0f);
+            const MediumWalk w = walk_media(scene, ray, medium, st, seg);
+            if (w.kind == MediumWalk::kLost || w.kind == MediumWalk::kEscaped) return;
+            beta *= seg;
+            medium = w.medium;
+            if (w.kind == MediumWalk::kMedium) {
+                // Scattering in the medium: connect to the camera through the phase function.
+                const PhaseFunction& phase = medium_phase(scene.medium(medium));
+                const Vec3f wi = -normalize(w.dir);
+                if (const auto k = camera.connect(w.p)) {
+                    const float f = phase_eval(phase, wi, k->wi);
+                    const float camera_pdf = faults_.drop_camera_geometry ? 1.0f : k->pdfW;
+                    if (f > 0) {
+                        const Colour Tr = to_camera(spawn_segment(w.p, Vec3f(0.0f), camera.position(), Vec3f(0.0f)), medium);
+                        if (!is_black(Tr))
+                            splat(out, ctx, k->raster, power * beta * Tr * (f * k->We / camera_pdf / st.density()), wl, invalid);
+                    }
+                }
+                if (!rules_.may_bounce(bounces)) return;
+                const PhaseSample ps = phase_sample(phase, wi, sampler.next2d());
+                if (!(ps.pdfW > 0)) return;
+                beta *= Colour(ps.p / ps.pdfW);
+                if (!survive_roulette(bounces, beta, st.density(), sampler)) return;
+                ray = Ray{w.p, ps.wo, kInf};
+                continue;
+            }
+            hit = w.isect;
+            boundary = w.media;
+            dir = w.dir;
+        }
+        const ShadingPoint sp = make_shading_point(scene, hit, media ? normalize(dir) : ray.d, TransportMode::Importance);
         const Material& m = *sp.material;
         if (m.is_black()) return;
         // Connect this vertex to the camera: a path of `bounces` bounces. After a dispersive
@@ -77,8 +132,14 @@ void LightTracer<T>::trace(const RenderContext& ctx, Sampler& sampler, SplatList
                 const Vec3f wo = sp.frame.to_local(k->wi);
                 const Rgb f = m.eval(sp, sp.wi, wo);
                 const float camera_pdf = faults_.drop_camera_geometry ? 1.0f : k->pdfW;
-                if (!is_black(f) && !scene.occluded(spawn_segment(sp.p, sp.ng, camera.position(), Vec3f(0.0f))))
-                    splat(out, ctx, k->raster, power * beta * bsdf_colour(sp, wo, f, wl) * (std::abs(wo.z) * k->We / camera_pdf), wl, invalid);
+                if (!is_black(f)) {
+                    const Colour Tr = to_camera(spawn_segment(sp.p, sp.ng, camera.position(), Vec3f(0.0f)),
+                                                media ? medium_after(boundary, hit.ng, k->wi, medium) : medium);
+                    if (!is_black(Tr)) {
+                        const Colour value = power * beta * bsdf_colour(sp, wo, f, wl) * (std::abs(wo.z) * k->We / camera_pdf);
+                        splat(out, ctx, k->raster, media ? value * Tr / st.density() : value, wl, invalid);
+                    }
+                }
             }
         }
         if (!rules_.may_bounce(bounces)) return;
@@ -86,9 +147,21 @@ void LightTracer<T>::trace(const RenderContext& ctx, Sampler& sampler, SplatList
         if (!s) return;
         beta *= bsdf_sample_colour(sp, *s, wl) * (std::abs(s->wo.z) / s->pdfW);
         if (wl.secondary_terminated()) beta = hero_lane(beta);
-        if (!rules_.survive_roulette(bounces, beta, sampler)) return;
+        if (!survive_roulette(bounces, beta, media ? st.density() : 1.0f, sampler)) return;
+        if (media) medium = medium_after(boundary, hit.ng, sp.frame.to_world(s->wo), medium);
         ray = sp.spawn(s->wo);
     }
+}
+
+// Russian roulette on beta / density, the path's actual weight (the path tracers' rule on beta
+// exactly when the density is 1).
+template <class T>
+bool LightTracer<T>::survive_roulette(int bounces, ColourOf<T>& beta, float density, Sampler& sampler) const {
+    if (density == 1) return rules_.survive_roulette(bounces, beta, sampler);
+    ColourOf<T> weight = beta / density;
+    if (!rules_.survive_roulette(bounces, weight, sampler)) return false;
+    beta = weight * density;
+    return true;
 }
 
 template <class T>
@@ -125,9 +198,13 @@ template class LightTracer<RgbTransport>;
 template class LightTracer<SpectralTransport>;
 
 const IntegratorInfo& light_tracer_integrator() {
-    static const IntegratorInfo info{"lt", {"ptracer"}, "light tracing: paths from the lights, every vertex connected to the camera",
-                                     false, false, path_params(), [](const IntegratorOptions& o) { return make_for_transport<LightTracer>(o); },
-                                     /*any_camera=*/false};
+    static const IntegratorInfo info = [] {
+        IntegratorInfo i{"lt", {"ptracer"}, "light tracing: paths from the lights, every vertex connected to the camera",
+                         false, false, path_params(), [](const IntegratorOptions& o) { return make_for_transport<LightTracer>(o); },
+                         /*any_camera=*/false};
+        i.media = true;
+        return i;
+    }();
     return info;
 }
 

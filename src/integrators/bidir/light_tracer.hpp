@@ -15,6 +15,10 @@
 // the path tracers count. Russian roulette acts on the scattering throughput only (beta
 // without the emitted power), by the path tracers' rule.
 //
+// In participating media the path also scatters in them (by the phase function) and connects
+// those points to the camera; every connection carries its segment's transmittance, estimated
+// as volpath estimates a shadow ray's (docs/volumes.md).
+//
 // By design, pixels whose first vertex seen from the camera is specular (a mirror, glass, the
 // coating of plastic) miss that part: no light path can connect through a Dirac lobe to a
 // pinhole. `pathlab check` reports such pixels as black by design.
@@ -51,6 +55,8 @@ public:
     static size_t chunk_size(size_t paths) { return std::max<size_t>(16, paths / 64); }
 
 private:
+    bool survive_roulette(int bounces, ColourOf<T>& beta, float density, Sampler& sampler) const;
+
     PathRules rules_;
     LightTracerFaults faults_;
     bool hide_emitters_ = false;

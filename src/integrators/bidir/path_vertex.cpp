@@ -34,6 +34,9 @@ float pdf_next(const Scene& scene, const PerspectiveCamera& camera, const PathVe
     float pdfW = 0;
     if (cur.kind == VertexKind::Camera) {
         pdfW = camera.pdf_direction(wn);
+    } else if (cur.kind == VertexKind::Medium) {
+        if (!prev) return 0.0f;
+        pdfW = phase_pdf(medium_phase(scene.medium(cur.medium)), direction(cur, *prev), wn);
     } else {
         if (!prev) return 0.0f;
         const Vec3f wp = direction(cur, *prev);

@@ -14,6 +14,14 @@
 // ratios, drops a factor d^2 / cos per Dirac vertex). A density of 0 is a strategy that cannot
 // sample the vertex at all (read as 1 in the ratios, where the delta flags leave it out anyway).
 //
+// In participating media (bdpt, lt; docs/volumes.md) a subpath also scatters at points in a
+// medium (VertexKind::Medium, the phase function its BSDF, no normal), and the densities include
+// distance sampling's: a vertex reached along an edge has density
+//   pdfW / d^2 x (|cos| at a surface) x T(edge) x (sigma(x) at a medium vertex),
+// per unit area at a surface and per unit volume in a medium, with T and sigma the deterministic
+// MIS transmittance and extinction of media/medium.hpp; every vertex keeps T of the edge it was
+// reached by (T_in) and its sigma (sigma_mis), which both directions of that edge share.
+//
 // These are the pieces of Veach's ratio form of the MIS weight (pbrt's formulation): for a
 // path of n + 1 vertices sampled by strategy (s, t), the weight is 1 / sum_i (p_i / p_s)^beta,
 // and the ratios p_{i+1} / p_i of neighbouring strategies are pdf_rev / pdf_fwd of one vertex.
@@ -26,7 +34,7 @@
 
 namespace pathlab {
 
-enum class VertexKind : unsigned char { Camera, Light, Surface };
+enum class VertexKind : unsigned char { Camera, Light, Surface, Medium };
 
 // A vertex apart from the colour its subpath carries there (what the densities and the MIS
 // weights read).
@@ -35,7 +43,8 @@ struct PathVertexBase {
     Vec3f p;                 // position (on the entry disk for a light at infinity)
     Vec3f n{0.0f};           // geometric normal for the G term (zero: a point, e.g. the pinhole)
     Vec3f emitter_n{0.0f};   // the emitter's own normal (its emitting side), where it is one
-    Vec3f dir{0.0f};         // at infinity: the unit direction from the scene towards the light
+    Vec3f dir{0.0f};         // at infinity: the unit direction from the scene towards the light;
+                             // in a medium: the unit direction back towards where the subpath came from
     ShadingPoint sp;         // surface vertices: material, frame, arrival direction, mode
     float pdf_fwd = 0, pdf_rev = 0;
     bool delta = false;      // scattered by a Dirac lobe here
@@ -45,6 +54,12 @@ struct PathVertexBase {
     // wavelength alone from here on (the throughput's other lanes are 0).
     bool dispersed = false;
     int light = -1;          // the light of a light vertex, or of the emitter a surface lies on
+    // Media: the medium the vertex lies in (a surface: the one the subpath arrived in; -1: none),
+    // a surface's media on its two sides (null: it changes none), and the MIS densities' factors.
+    int32_t medium = -1;
+    const MediumInterface* media = nullptr;
+    float sigma_mis = 1;     // a medium vertex's extinction (1 elsewhere)
+    float T_in = 1;          // the MIS transmittance of the edge from the previous vertex
     // The running MIS quantity (set_running_mis): the part of a strategy's MIS sum that comes
     // from this subpath's vertices two or more before this one, as a connection or merge ending
     // here needs it (the VCM report's dVCM / dVC / dVM, folded into one number).
@@ -57,17 +72,27 @@ struct PathVertexBase {
             case VertexKind::Camera: return true;
             case VertexKind::Light: return !(delta_light && infinite);  // not a directional light
             case VertexKind::Surface: return !sp.material->is_delta();
+            case VertexKind::Medium: return true;
         }
         return false;
     }
     // Where a connecting ray leaves this vertex for `to` (offset off its surface).
     Ray segment_to(const PathVertexBase& to) const;
+    // The medium a ray leaving this vertex in direction w starts in (a surface may separate two).
+    int32_t medium_towards(const Vec3f& w) const {
+        return kind == VertexKind::Surface && media && media->changes_medium() ? media->medium_towards(w, emitter_n) : medium;
+    }
+    // The distance-sampling factor of a density arriving here along an edge of MIS transmittance T.
+    float distance_factor(float T) const { return T * sigma_mis; }
 };
 
 // A vertex of a subpath of transport T.
 template <class T>
 struct PathVertex : PathVertexBase {
     ColourOf<T> beta{0.0f};  // throughput of the subpath up to and including this vertex
+    // The channels' densities of the subpath's distance sampling over a common normaliser
+    // (media/medium.hpp's spectral MIS): a path's contribution is divided by their mean.
+    ColourOf<T> r{1.0f};
 };
 
 // The solid-angle density pdfW at `from` of the direction to `to`, as an area density at `to`
@@ -75,7 +100,8 @@ struct PathVertex : PathVertexBase {
 float to_area_density(float pdfW, const PathVertexBase& from, const PathVertexBase& to);
 
 // The density with which `cur` samples `next`, having been reached from `prev` (null for the
-// first vertex of a subpath); per unit area at `next`.
+// first vertex of a subpath); per unit area at `next` (per unit volume in a medium), without the
+// edge's distance_factor, which the caller multiplies.
 float pdf_next(const Scene& scene, const PerspectiveCamera& camera, const PathVertexBase* prev, const PathVertexBase& cur,
                const PathVertexBase& next);
 // The density with which the light at vertex `v` (a light vertex, or a surface on an emitter)

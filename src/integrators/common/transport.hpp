@@ -177,6 +177,10 @@ template <class Draw> int hero_channel(const SampledWavelengths&, Draw&&) { retu
 // mean, or the hero's alone once the path carries the hero alone.
 inline float path_density(const Rgb& r, const RgbWavelengths&) { return mean(r); }
 inline float path_density(const Spectrum4& r, const SampledWavelengths& wl) { return spectral_path_density(r, wl); }
+// The same for a path joined from two subpaths at the same wavelengths (bdpt): hero_only when a
+// vertex of either went through dispersion (it carries the hero alone).
+inline float path_density_of(const Rgb& r, bool) { return mean(r); }
+inline float path_density_of(const Spectrum4& r, bool hero_only) { return hero_only ? r[0] : r.average(); }
 
 // ---- dispersion --------------------------------------------------------------------------------
 // A throughput after a dispersive interface: the hero lane alone (the other lanes' light went

@@ -1,6 +1,6 @@
 // volpath: volumetric path tracing. pt-mis's loop (its MIS pair of a light sample and a
 // BSDF sample at every surface, the BSDF sample continuing the path) with participating media:
-//  - every ray walks through media and index-matched boundaries (walk()): in a medium it may
+//  - every ray walks through media and index-matched boundaries (walk_media(), common/media_walk.hpp): in a medium it may
 //    scatter, sampled by delta tracking (free-flight sampling, media/medium.hpp), and a
 //    boundary only changes the medium; it ends at a scattering point, a surface or the sky;
 //  - at a scattering point the phase function plays the BSDF's part: a light sample and a
@@ -20,6 +20,7 @@
 #include <optional>
 
 #include "integrators/common/direct_lighting.hpp"
+#include "integrators/common/media_walk.hpp"
 #include "integrators/common/path_rules.hpp"
 #include "integrators/integrators.hpp"
 #include "integrators/path/pt_mis.hpp"
@@ -27,124 +28,10 @@
 namespace pathlab {
 namespace {
 
-constexpr uint64_t kMediumStream = 0x766f6c70617468ull;  // "volpath"
-// A ray crossing more index-matched boundaries than this without an event is stuck (numerically).
-constexpr int kMaxCrossings = 256;
-
-// The random numbers of media along one path, and its spectral MIS state.
-template <class T>
-struct MediumState {
-    const Sampler& parent;
-    const WavelengthsOf<T>& wl;
-    float majorant_factor = 1;
-    std::optional<Sampler> stream{};  // forked on first use
-    int hero = -1;
-    ColourOf<T> r{1.0f};  // the channels' path densities over a common normaliser
-
-    Sampler& rng() {
-        if (!stream) stream.emplace(parent.fork(kMediumStream));
-        return *stream;
-    }
-    int hero_channel() {
-        if (hero < 0) hero = pathlab::hero_channel(wl, [this] { return rng().next1d(); });
-        return hero;
-    }
-    float density() const { return path_density(r, wl); }
-};
-
-// Where a walk along a ray ended.
-struct Walk {
-    enum Kind { kSurface, kMedium, kEscaped, kLost } kind = kEscaped;
-    Intersection isect{};  // kSurface
-    const MediumInterface* media = nullptr;  // kSurface: its shape's media (null: it changes none)
-    Vec3f p{};             // kMedium: the scattering point
-    Vec3f dir{};           // the direction of the last ray, as it was given (not normalised)
-    int32_t medium = -1;  // the medium the walk ended in
-};
-
-// The medium on the far side of a surface (geometric normal ng, its shape's media) for a ray
-// leaving it in direction w.
-int32_t medium_after(const MediumInterface* media, const Vec3f& ng, const Vec3f& w, int32_t current) {
-    return media && media->changes_medium() ? media->medium_towards(w, ng) : current;
-}
-
-// Scene::intersect with every shape of a scene with media (index-matched boundaries included),
-// or as pt-mis does in a scene without.
-bool intersect(const Scene& scene, const Ray& ray, Intersection& hit, const MediumInterface*& media) {
-    media = nullptr;
-    return scene.has_media() ? scene.intersect(ray, hit, kMaskAll, media) : scene.intersect(ray, hit);
-}
-
-// Follows `ray` from medium `medium` through media and index-matched boundaries. `seg` is
-// multiplied by the free-flight weights (and st.r by the channels' densities).
-template <class T>
-Walk walk(const Scene& scene, Ray ray, int32_t medium, MediumState<T>& st, ColourOf<T>& seg) {
-    for (int crossings = 0; crossings < kMaxCrossings; ++crossings) {
-        Walk w;
-        w.dir = ray.d;
-        w.medium = medium;
-        const bool hit = intersect(scene, ray, w.isect, w.media);
-        if (medium >= 0) {
-            const float len = length(ray.d);
-            const Vec3f d = ray.d / len;
-            const FreeFlight ff = sample_free_flight(medium_view(scene.medium(medium), st.wl), ray.o, d, hit ? w.isect.t * len : kInf,
-                                                     st.hero_channel(), st.rng(), seg, st.r, st.majorant_factor);
-            if (ff.scattered) {
-                w.kind = Walk::kMedium;
-                w.p = ray.o + d * ff.t;
-                return w;
-            }
-            if (is_black(seg)) return {Walk::kLost};
-        }
-        if (!hit) return w;  // kEscaped
-        if (!(w.media && w.media->index_matched)) {
-            w.kind = Walk::kSurface;
-            return w;
-        }
-        medium = medium_after(w.media, w.isect.ng, ray.d, medium);
-        ray = spawn_ray(w.isect.p, w.isect.ng, ray.d);
-    }
-    return {Walk::kLost};
-}
-
-// The transmittance along a shadow ray (a segment ending a little before its target, or a ray
-// to infinity) starting in `medium`: 0 if a surface blocks it, else the product of the media's
-// transmittance estimates between the index-matched boundaries it crosses.
-template <class T>
-ColourOf<T> transmittance(const Scene& scene, Ray shadow, int32_t medium, MediumState<T>& st) {
-    using Colour = ColourOf<T>;
-    if (!scene.has_media()) return scene.occluded(shadow) ? Colour(0.0f) : Colour(1.0f);
-    const bool segment = std::isfinite(shadow.tmax);
-    const Vec3f target = shadow.o + shadow.d;  // (segments: d = target - origin)
-    Colour Tr(1.0f);
-    for (int crossings = 0; crossings < kMaxCrossings; ++crossings) {
-        Intersection isect;
-        const MediumInterface* media = nullptr;
-        const bool hit = scene.intersect(shadow, isect, kMaskAll, media);
-        if (hit && !(media && media->index_matched)) return Colour(0.0f);
-        if (medium >= 0) {
-            const float len = length(shadow.d);
-            const float t = hit ? isect.t : shadow.tmax;
-            Tr *= estimate_transmittance(medium_view(scene.medium(medium), st.wl), shadow.o, shadow.d / len, segment || hit ? t * len : kInf,
-                                        st.rng(), st.majorant_factor);
-            if (is_black(Tr)) return Tr;
-        }
-        if (!hit) return Tr;
-        medium = medium_after(media, isect.ng, shadow.d, medium);
-        if (segment) {
-            const Vec3f from = offset_ray_origin(isect.p, dot(shadow.d, isect.ng) >= 0 ? isect.ng : -isect.ng);
-            shadow = Ray{from, target - from, shadow.tmax};
-        } else {
-            shadow = spawn_ray(isect.p, isect.ng, shadow.d);
-        }
-    }
-    return Colour(0.0f);
-}
-
 // A point where the path scatters: a surface (sp) or a point in a medium (phase).
 struct Vertex {
     const ShadingPoint* sp = nullptr;
-    const Walk* hit = nullptr;  // the walk that ended on the surface (its geometric normal, its shape's media)
+    const MediumWalk* hit = nullptr;  // the walk that ended on the surface (its geometric normal, its shape's media)
     Vec3f p;
     Vec3f wi;  // medium vertices: unit world direction back along the path
     const PhaseFunction* phase = nullptr;
@@ -188,7 +75,7 @@ ColourOf<T> estimate_light(const Scene& scene, const Vertex& v, Sampler& sampler
             shadow = Ray{v.p, to - v.p, 1.0f - 1e-4f};
         }
     }
-    const Colour Tr = transmittance(scene, shadow, medium, st);
+    const Colour Tr = shadow_transmittance(scene, shadow, medium, st);
     if (is_black(Tr)) return Colour(0.0f);
     const float pdf_light = choice.pmf * ls->pdfW;
     const float weight = !ls->delta ? (mis ? balance_heuristic(pdf_light, pdf_scatter) : 1.0f) : 1.0f;
@@ -199,17 +86,17 @@ ColourOf<T> estimate_light(const Scene& scene, const Vertex& v, Sampler& sampler
 // The radiance a walk that ended on a surface or in the sky finds (Le towards the path, in RGB),
 // the density with which light sampling at `from` would have chosen it (trace_to_emitter's), and
 // the light it belongs to.
-EmitterHit emission_found(const Scene& scene, const Walk& w, const Vec3f& from, int& light) {
+EmitterHit emission_found(const Scene& scene, const MediumWalk& w, const Vec3f& from, int& light) {
     EmitterHit e;
     light = -1;
-    if (w.kind == Walk::kEscaped) {
+    if (w.kind == MediumWalk::kEscaped) {
         const int env = scene.environment_light();
         if (env >= 0) {
             light = env;
             e.Le = scene.escaped_radiance(w.dir);
             e.pdf_light = scene.light_pmf(env) * environment_pdf_li(scene.lights()[size_t(env)], w.dir);
         }
-    } else if (w.kind == Walk::kSurface) {
+    } else if (w.kind == MediumWalk::kSurface) {
         e.Le = emitted_radiance(scene, w.isect, -w.dir / length(w.dir));
         if (!is_black(e.Le)) {
             light = w.isect.light;
@@ -237,18 +124,18 @@ public:
         const bool mis = settings_.mis;
         MediumState<T> st{sampler, wl, settings_.majorant_factor};
         Colour seg(1.0f);
-        Walk w = walk(scene, camera_ray, scene.camera_medium(), st, seg);
+        MediumWalk w = walk_media(scene, camera_ray, scene.camera_medium(), st, seg);
         Colour beta = seg;
         // What the camera sees directly (pt-mis: L starts as the emission at the first hit).
         Colour L(0.0f);
         // (hide_emitters: not the emitters and the sky seen directly, also through media.)
-        if (w.kind == Walk::kEscaped) return hide_ ? Colour(0.0f) : beta * escaped_radiance(scene, w.dir, wl) / st.density();
-        if (w.kind == Walk::kSurface && !hide_) L = beta * emitted_radiance(scene, w.isect, -w.dir, wl) / st.density();
-        for (int bounces = 0; w.kind != Walk::kLost && rules_.may_bounce(bounces); ++bounces) {
+        if (w.kind == MediumWalk::kEscaped) return hide_ ? Colour(0.0f) : beta * escaped_radiance(scene, w.dir, wl) / st.density();
+        if (w.kind == MediumWalk::kSurface && !hide_) L = beta * emitted_radiance(scene, w.isect, -w.dir, wl) / st.density();
+        for (int bounces = 0; w.kind != MediumWalk::kLost && rules_.may_bounce(bounces); ++bounces) {
             Vertex v;
             v.medium = w.medium;
             ShadingPoint sp;
-            if (w.kind == Walk::kSurface) {
+            if (w.kind == MediumWalk::kSurface) {
                 sp = make_shading_point(scene, w.isect, w.dir);
                 if (sp.material->is_black()) break;
                 v.sp = &sp;
@@ -264,13 +151,13 @@ public:
             L += beta * direct / st.density();
 
             Colour weight_next;  // f cos / pdf of the continuation
-            Walk next;
+            MediumWalk next;
             Colour next_seg(1.0f);  // its walk's free-flight weights
             int light;
             if (v.sp) {
                 const auto s = bsdf_sample(sp, sampler.next2d(), wl);
                 if (!s) break;  // pt-mis: no BSDF sample, nothing found, and the path ends
-                next = walk(scene, sp.spawn(s->wo), medium_after(w.media, w.isect.ng, sp.frame.to_world(s->wo), w.medium), st, next_seg);
+                next = walk_media(scene, sp.spawn(s->wo), medium_after(w.media, w.isect.ng, sp.frame.to_world(s->wo), w.medium), st, next_seg);
                 const Colour f = bsdf_sample_colour(sp, *s, wl);
                 weight_next = f * (std::abs(s->wo.z) / s->pdfW);
                 const EmitterHit e = emission_found(scene, next, sp.p, light);
@@ -281,7 +168,7 @@ public:
             } else {
                 const PhaseSample ps = phase_sample(*v.phase, v.wi, sampler.next2d());
                 if (!(ps.pdfW > 0)) break;
-                next = walk(scene, Ray{v.p, ps.wo, kInf}, w.medium, st, next_seg);
+                next = walk_media(scene, Ray{v.p, ps.wo, kInf}, w.medium, st, next_seg);
                 const EmitterHit e = emission_found(scene, next, v.p, light);
                 const float weight = mis ? balance_heuristic(ps.pdfW, e.pdf_light) : 0.0f;
                 const Colour found = is_black(e.Le) ? Colour(0.0f) : Colour(ps.p) * light_colour(scene, light, e.Le, wl) * (weight / ps.pdfW);
@@ -289,7 +176,7 @@ public:
                 weight_next = Colour(ps.p / ps.pdfW);
             }
             if (!rules_.may_bounce(bounces + 1)) break;
-            if (next.kind == Walk::kEscaped || next.kind == Walk::kLost) break;
+            if (next.kind == MediumWalk::kEscaped || next.kind == MediumWalk::kLost) break;
             beta = beta * next_seg * weight_next;
             if (!survive_roulette(bounces + 1, beta, st.density(), sampler)) break;
             w = next;

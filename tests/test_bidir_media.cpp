@@ -1,0 +1,455 @@
+// Light tracing and bdpt in participating media (issue 37): every method agrees with volpath per
+// pixel (z-tests at a stated false-alarm rate, judge/image_statistics.hpp) on homogeneous and
+// heterogeneous fog with surfaces, with the camera and an emitter inside the medium, through a
+// glass ball filled with another medium, and with the sky outside; the densities bdpt's random
+// walks store are those of their definitions (phase, distance sampling, transmittance) and its
+// MIS weights with medium vertices are those of the strategies' densities written out here; a
+// connection without its transmittance, and weights without distance sampling's densities, fail
+// those tests; 1 and 2 threads give the same bytes.
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <cmath>
+
+#include "geometry/shape_meshes.hpp"
+#include "integrators/bidir/bdpt.hpp"
+#include "integrators/bidir/light_tracer.hpp"
+#include "judge/image_statistics.hpp"
+#include "render_helpers.hpp"
+#include "scenefile/scene_file.hpp"
+
+namespace pathlab::test {
+namespace {
+
+std::string source_path(const std::string& relative) { return std::string(PATHLAB_SOURCE_DIR) + "/" + relative; }
+
+// Per pixel and channel at 1e-3, the whole image's family at 1e-4 (the suite's usual rates).
+const AgreementOptions kAgreement{1e-3, 1e-4};
+
+// A box filling the course box's inside (a little smaller), an index-matched boundary.
+MeshDesc fog_box(int32_t medium) {
+    MeshDesc m = cube_mesh();
+    transform_mesh(m, Transform::translate({0.01, 0.02, 0}) * Transform::scale({1.27, 1.27, 1.27}));
+    m.name = "fog";
+    m.media.interior = medium;
+    m.media.index_matched = true;
+    return m;
+}
+
+// A 3-channel grid of densities between 0.1 and 1.35 filling [-0.9, 0.9]^3.
+HeterogeneousMedium grid_medium() {
+    VoxelGrid g;
+    g.res = {6, 5, 4};
+    g.channels = 3;
+    for (int z = 0; z < 4; ++z)
+        for (int y = 0; y < 5; ++y)
+            for (int x = 0; x < 6; ++x)
+                for (int c = 0; c < 3; ++c) g.data.push_back(0.1f + 0.25f * float((x * 5 + y * 3 + z * 7 + c * 4) % 6));
+    HeterogeneousMedium m;
+    m.sigma_t = Volume::of_grid(g, Transform::translate({-0.9, -0.9, -0.9}) * Transform::scale({1.8, 1.8, 1.8}));
+    m.albedo = Volume::constant_value(Rgb(0.9f, 0.8f, 0.7f));
+    m.scale = 1;
+    m.phase = HgPhase{-0.3f};
+    m.prepare();
+    return m;
+}
+
+struct MediaScene {
+    std::string name;
+    SceneDescription d;
+    bool light_tracer = true;  // lt renders it (no pixel sees a Dirac surface first)
+};
+
+std::vector<MediaScene> media_scenes() {
+    std::vector<MediaScene> scenes;
+    {  // The light box in chromatic fog, the camera outside it.
+        SceneDescription d = make_builtin_scene(4);
+        d.media.push_back(HomogeneousMedium{Rgb(0.5f, 0.6f, 0.7f), Rgb(0.4f, 0.45f, 0.6f), HgPhase{0.4f}});
+        d.meshes.push_back(fog_box(0));
+        scenes.push_back({"light box in fog", d});
+    }
+    {  // Glossy walls, the whole world a medium: the camera and the emitter (a small ball in place
+       // of the course's point light: a point light in a scattering medium gives every estimator
+       // infinite variance, the 1 / d^2 of the points around it, and no z-test can hold there).
+        SceneDescription d = make_builtin_scene(1);
+        d.lights.clear();
+        d.light_ids.clear();
+        SphereDesc lamp{{0.0f, -0.3f, 0.9f}, 0.25f, 0, false};
+        lamp.emission = Rgb(50.0f / (4 * kPi) / (kPi * 0.0625f));  // the point light's intensity
+        d.spheres.push_back(lamp);
+        d.media.push_back(HomogeneousMedium{Rgb(0.3f, 0.35f, 0.4f), Rgb(0.25f, 0.3f, 0.3f), HgPhase{-0.2f}});
+        d.camera_medium = 0;
+        scenes.push_back({"camera and emitter in fog", d});
+    }
+    {  // A grid of smoke under the ceiling light, the blue ball turned to glass filled with ink.
+        SceneDescription d = make_builtin_scene(2);
+        d.media.push_back(grid_medium());
+        d.media.push_back(HomogeneousMedium{Rgb(2.0f, 1.0f, 0.5f), Rgb(1.5f, 0.5f, 0.4f), IsotropicPhase{}});
+        d.meshes.push_back(fog_box(0));
+        d.materials.push_back(make_dielectric(1.5f));
+        SphereDesc& glass = d.spheres.back();
+        glass.material = uint32_t(d.materials.size() - 1);
+        glass.media.interior = 1;
+        glass.media.exterior = 0;
+        scenes.push_back({"smoke grid and a glass ball of ink", d, false});
+    }
+    {  // The sky through the open front, fog inside the box.
+        SceneDescription d = make_builtin_scene(6);
+        d.media.push_back(HomogeneousMedium{Rgb(0.4f), Rgb(0.35f), HgPhase{0.6f}});
+        d.meshes.push_back(fog_box(0));
+        scenes.push_back({"sky and fog", d});
+    }
+    return scenes;
+}
+
+constexpr int kSize = 10, kMaxDepth = 5;
+
+IntegratorOptions depth_options() {
+    IntegratorOptions o;
+    o.max_depth = kMaxDepth;
+    return o;
+}
+
+struct Reference {
+    std::string name;
+    RenderResult volpath;
+};
+// volpath's renders of the scenes, made once for every test here.
+const std::vector<Reference>& references() {
+    static const std::vector<Reference> refs = [] {
+        std::vector<Reference> r;
+        for (const MediaScene& s : media_scenes()) r.push_back({s.name, render_scene(s.d, "volpath", kSize, kSize, 4096, 11, depth_options())});
+        return r;
+    }();
+    return refs;
+}
+
+AgreementResult agreement(const RenderResult& a, const RenderResult& ref) {
+    return test_agreement(a.film.mean(), a.film.standard_error(), ref.film.mean(), ref.film.standard_error(), kAgreement);
+}
+
+TEST(BidirMedia, BdptAndLightTracingAgreeWithVolpath) {
+    const std::vector<MediaScene> scenes = media_scenes();
+    for (size_t i = 0; i < scenes.size(); ++i) {
+        const RenderResult& ref = references()[i].volpath;
+        const RenderResult b = render_scene(scenes[i].d, "bdpt", kSize, kSize, 1024, 21, depth_options());
+        const AgreementResult rb = agreement(b, ref);
+        EXPECT_TRUE(rb.agree) << scenes[i].name << ", bdpt: " << rb.describe();
+        if (!scenes[i].light_tracer) continue;
+        const RenderResult l = render_scene(scenes[i].d, "lt", kSize, kSize, 2048, 22, depth_options());
+        const AgreementResult rl = agreement(l, ref);
+        EXPECT_TRUE(rl.agree) << scenes[i].name << ", lt: " << rl.describe();
+    }
+}
+
+TEST(BidirMedia, BdptInSpectralModeAgreesWithVolpath) {
+    const MediaScene s = media_scenes()[0];
+    IntegratorOptions o = depth_options();
+    o.spectral = true;
+    const auto volpath = find_integrator("volpath")->make(o), bdpt = find_integrator("bdpt")->make(o);
+    const RenderResult v = render_integrator(s.d, *volpath, kSize, kSize, 4096, 31), b = render_integrator(s.d, *bdpt, kSize, kSize, 1024, 32);
+    const AgreementResult r = agreement(b, v);
+    EXPECT_TRUE(r.agree) << r.describe();
+}
+
+// The test of the test: a connection that leaves out its transmittance is too bright.
+TEST(BidirMedia, AConnectionWithoutItsTransmittanceIsDetected) {
+    BdptFaults faults;
+    faults.drop_connection_transmittance = true;
+    Bdpt<RgbTransport> faulty(depth_options(), faults);
+    const RenderResult b = render_integrator(media_scenes()[0].d, faulty, kSize, kSize, 1024, 21);
+    EXPECT_FALSE(agreement(b, references()[0].volpath).agree);
+}
+
+TEST(BidirMedia, OneAndTwoThreadsGiveTheSameBytes) {
+    for (const char* f : {"scenes/fog-box.xml", "scenes/smoke.xml"}) {
+        const SceneDescription d = load_scene_file(source_path(f));
+        for (const char* a : {"bdpt", "lt"}) {
+            const auto with_threads = [&](int threads) {
+                tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+                return render_scene(d, a, 16, 12, 4, 5);
+            };
+            const RenderResult one = with_threads(1), two = with_threads(2);
+            EXPECT_TRUE(bit_identical(one.film.mean(), two.film.mean())) << f << ", " << a;
+            EXPECT_TRUE(bit_identical(one.film.standard_error(), two.film.standard_error())) << f << ", " << a;
+        }
+    }
+}
+
+// ---- densities and weights ---------------------------------------------------------------------
+
+// A grey medium everywhere (sigma_t = 0.4, Henyey-Greenstein g = 0.3) around a diffuse floor and
+// a downward area light, the camera in it: the densities below are written out for it.
+constexpr float kSigma = 0.4f, kG = 0.3f;
+
+SceneDescription medium_world() {
+    SceneDescription d;
+    d.name = "medium world";
+    d.camera = Camera::look_at({0, -4, 1.5f}, {0, 0, 0.5f}, {0, 0, 1}, 60, FovAxis::X);
+    d.width = d.height = 64;
+    d.materials = {make_phong(Rgb(0.6f)), make_phong(Rgb(0.0f))};
+    const auto quad = [](const Vec3f& c, const Vec3f& u, const Vec3f& v, uint32_t material, Rgb emission) {
+        MeshDesc m;
+        m.positions = {c - u - v, c + u - v, c + u + v, c - u + v};
+        m.triangles = {{0, 1, 2}, {0, 2, 3}};  // normal along u x v
+        m.material = material;
+        m.emission = emission;
+        return m;
+    };
+    d.meshes.push_back(quad({0, 0, 0}, {3, 0, 0}, {0, 3, 0}, 0, Rgb(0.0f)));                 // floor, normal +z
+    d.meshes.push_back(quad({0, 0.5f, 2.5f}, {0.5f, 0, 0}, {0, -0.5f, 0}, 1, Rgb(6.0f)));   // light, normal -z
+    d.media.push_back(HomogeneousMedium{Rgb(kSigma), Rgb(0.8f * kSigma), HgPhase{kG}});
+    d.camera_medium = 0;
+    return d;
+}
+
+double hg(double cos_theta) { return (1 - kG * kG) / (4 * M_PI * std::pow(1 + kG * kG - 2 * kG * cos_theta, 1.5)); }
+
+// A full path x_0 (the pinhole), ..., x_k (on the light), each inner point on the floor or in the medium.
+struct MediumPath {
+    std::string name;
+    std::vector<Vec3f> p;
+    std::vector<bool> in_medium;
+};
+
+class MediumMis {
+public:
+    explicit MediumMis(BdptFaults faults = {})
+        : desc_(medium_world()), scene_(Scene::build(desc_)), camera_(scene_->camera(), 64, 64),
+          ctx_{*scene_, camera_, 64, 64, 1, SamplerKind::Independent, 32}, bdpt_(IntegratorOptions{}, faults) {}
+
+    int k(const MediumPath& f) const { return int(f.p.size()) - 1; }
+    Vec3f dir(const MediumPath& f, int from, int to) const { return normalize(f.p[size_t(to)] - f.p[size_t(from)]); }
+    Vec3f normal(const MediumPath& f, int j) const { return j == k(f) ? Vec3f(0, 0, -1) : Vec3f(0, 0, 1); }
+    // The density at x_to of a direction chosen at x_from with solid-angle density pdfW: per unit
+    // area (|cos| / d^2) at a surface, per unit volume (1 / d^2) in the medium, times distance
+    // sampling's: exp(-sigma d), and sigma at a medium point.
+    double density(const MediumPath& f, double pdfW, int from, int to) const {
+        const Vec3f d = f.p[size_t(to)] - f.p[size_t(from)];
+        const double dist = length(d);
+        double p = pdfW / (dist * dist) * std::exp(-kSigma * dist);
+        if (f.in_medium[size_t(to)]) p *= kSigma;
+        else p *= std::abs(dot(normal(f, to), d / float(dist)));
+        return p;
+    }
+    // The density at x_j (floor: cosine-weighted diffuse; medium: Henyey-Greenstein) of going on to x_next.
+    double scatter_density(const MediumPath& f, int prev, int j, int next) const {
+        const Vec3f wi = dir(f, j, prev), wo = dir(f, j, next);
+        const double pdfW = f.in_medium[size_t(j)] ? hg(-dot(wi, wo)) : std::max(0.0f, dot(normal(f, j), wo)) / M_PI;
+        return density(f, pdfW, j, next);
+    }
+    double light_origin() const { return 1.0 / 1.0; }  // one light of area 1
+    double light_emission(const MediumPath& f) const {
+        const int n = k(f);
+        return density(f, std::max(0.0f, dot(normal(f, n), dir(f, n, n - 1))) / M_PI, n, n - 1);
+    }
+    double camera_density(const MediumPath& f) const { return density(f, camera_.pdf_direction(dir(f, 0, 1)), 0, 1); }
+    double strategy_density(const MediumPath& f, int s) const {
+        const int n = k(f), t = n + 1 - s;
+        double p = 1;
+        for (int j = 1; j < t; ++j) p *= j == 1 ? camera_density(f) : scatter_density(f, j - 2, j - 1, j);
+        for (int i = 0; i < s; ++i) {
+            const int j = n - i;
+            p *= i == 0 ? light_origin() : i == 1 ? light_emission(f) : scatter_density(f, j + 2, j + 1, j);
+        }
+        return p;
+    }
+    double expected_weight(const MediumPath& f, int s) const {
+        double sum = 0;
+        for (int i = 0; i <= k(f); ++i) sum += strategy_density(f, i);  // (every strategy can make these paths)
+        return strategy_density(f, s) / sum;
+    }
+
+    // The vertex bdpt's walk would have made of x_j on the camera side (reached from x_{j-1}) or the light side.
+    PathVertex<RgbTransport> vertex(const MediumPath& f, int j, bool camera_side) const {
+        PathVertex<RgbTransport> v;
+        v.medium = 0;
+        v.p = f.p[size_t(j)];
+        const int n = k(f);
+        if (j == 0 && camera_side) {
+            v.kind = VertexKind::Camera;
+            return v;
+        }
+        const int from = camera_side ? j - 1 : j + 1;
+        if (j > 0 && j < n) v.T_in = float(std::exp(-kSigma * length(f.p[size_t(j)] - f.p[size_t(from)])));
+        if (j == n && !camera_side) {
+            v.kind = VertexKind::Light;
+            v.light = 0;
+            v.n = v.emitter_n = normal(f, n);
+            return v;
+        }
+        if (j == n) v.T_in = float(std::exp(-kSigma * length(f.p[size_t(j)] - f.p[size_t(from)])));
+        if (f.in_medium[size_t(j)]) {
+            v.kind = VertexKind::Medium;
+            v.dir = dir(f, j, from);
+            v.sigma_mis = kSigma;
+            return v;
+        }
+        Intersection hit;
+        const Vec3f w = dir(f, from, j), o = f.p[size_t(from)] + w * 1e-3f;
+        EXPECT_TRUE(scene_->intersect(Ray{o, w, kInf}, hit));
+        v.kind = VertexKind::Surface;
+        v.sp = make_shading_point(*scene_, hit, dir(f, from, j), camera_side ? TransportMode::Radiance : TransportMode::Importance);
+        v.n = v.sp.ng;
+        v.emitter_n = hit.ng;
+        v.light = hit.light;
+        return v;
+    }
+    // The subpaths of strategy (s, t) with the densities of their definitions (NaN where the
+    // connection must set them) and their running MIS quantities.
+    void subpaths(const MediumPath& f, int s, std::vector<PathVertex<RgbTransport>>& light,
+                  std::vector<PathVertex<RgbTransport>>& camera) const {
+        const int n = k(f), t = n + 1 - s;
+        camera.clear(), light.clear();
+        for (int j = 0; j < t; ++j) {
+            PathVertex<RgbTransport> v = vertex(f, j, true);
+            v.pdf_fwd = float(j == 0 ? 1 : j == 1 ? camera_density(f) : scatter_density(f, j - 2, j - 1, j));
+            v.pdf_rev = j + 2 <= t - 1 ? float(scatter_density(f, j + 2, j + 1, j)) : NAN;
+            camera.push_back(v);
+        }
+        for (int i = 0; i < s; ++i) {
+            const int j = n - i;
+            PathVertex<RgbTransport> v = vertex(f, j, false);
+            v.pdf_fwd = float(i == 0 ? light_origin() : i == 1 ? light_emission(f) : scatter_density(f, j + 2, j + 1, j));
+            v.pdf_rev = i + 2 <= s - 1 ? float(scatter_density(f, j - 2, j - 1, j)) : NAN;
+            light.push_back(v);
+        }
+        set_running_mis(light.data(), int(light.size()), true, MisRules(false, nullptr));
+        set_running_mis(camera.data(), int(camera.size()), false, MisRules(false, nullptr));
+    }
+    float bdpt_weight(const MediumPath& f, int s) const {
+        std::vector<PathVertex<RgbTransport>> light, camera;
+        subpaths(f, s, light, camera);
+        const int n = k(f), t = n + 1 - s;
+        PathVertex<RgbTransport> sampled = s == 1 ? vertex(f, n, false) : vertex(f, 0, true);
+        if (s == 1) sampled.pdf_fwd = float(light_origin());
+        EdgeDensities known;
+        if (s >= 1) known.T = float(std::exp(-kSigma * length(f.p[size_t(t)] - f.p[size_t(t - 1)])));
+        return bdpt_.mis_weight(ctx_, light, s, camera, t, sampled, known);
+    }
+
+    std::vector<MediumPath> paths() const {
+        const Vec3f m1(0.3f, -1.0f, 1.2f), m2(-0.4f, 0.2f, 1.8f), floor(0.2f, 0.4f, 0.0f), on_light(0.1f, 0.45f, 2.5f);
+        const Vec3f c = camera_.position();
+        return {{"camera-medium-light", {c, m1, on_light}, {false, true, false}},
+                {"camera-medium-floor-light", {c, m1, floor, on_light}, {false, true, false, false}},
+                {"camera-floor-medium-light", {c, floor, m2, on_light}, {false, false, true, false}},
+                {"camera-medium-medium-light", {c, m1, m2, on_light}, {false, true, true, false}},
+                {"camera-medium-floor-medium-light", {c, m1, floor, m2, on_light}, {false, true, false, true, false}}};
+    }
+
+    const Bdpt<RgbTransport>& bdpt() const { return bdpt_; }
+    const RenderContext& ctx() const { return ctx_; }
+    const Scene& scene() const { return *scene_; }
+
+private:
+    SceneDescription desc_;
+    std::unique_ptr<Scene> scene_;
+    PerspectiveCamera camera_;
+    RenderContext ctx_;
+    Bdpt<RgbTransport> bdpt_;
+};
+
+// Hand-built paths with medium vertices: bdpt's weight of every strategy is the balance
+// heuristic over the strategies' densities written out above (and so they sum to 1).
+bool weights_match(const MediumMis& h, std::string& report) {
+    bool ok = true;
+    for (const MediumPath& f : h.paths()) {
+        double sum = 0;
+        for (int s = 0; s <= h.k(f); ++s) {
+            const double expected = h.expected_weight(f, s), got = h.bdpt_weight(f, s);
+            sum += got;
+            if (std::abs(got - expected) > 1e-4 * std::max(1e-3, expected)) {
+                ok = false;
+                report += f.name + " s=" + std::to_string(s) + ": " + std::to_string(got) + " instead of " + std::to_string(expected) + "\n";
+            }
+        }
+        if (std::abs(sum - 1) > 1e-4) {
+            ok = false;
+            report += f.name + ": the weights sum to " + std::to_string(sum) + "\n";
+        }
+    }
+    return ok;
+}
+
+TEST(BidirMedia, WeightsWithMediumVerticesAreTheBalanceHeuristicOfTheDensities) {
+    std::string report;
+    EXPECT_TRUE(weights_match(MediumMis{}, report)) << report;
+}
+
+TEST(BidirMedia, WeightsWithoutDistanceSamplingAreDetected) {
+    BdptFaults faults;
+    faults.drop_distance_pdf = true;
+    std::string report;
+    EXPECT_FALSE(weights_match(MediumMis(faults), report));
+}
+
+// The densities bdpt's random walks store on real subpaths in the medium world are those of
+// their definitions: pdf_fwd from the predecessor, pdf_rev from the successor.
+bool walk_densities_match(const MediumMis& h, std::string& report, int& medium_vertices) {
+    const auto pdfW_at = [&](const PathVertexBase& at, const PathVertexBase* from, const Vec3f& to) -> double {
+        const Vec3f wo = normalize(to - at.p);
+        if (at.kind == VertexKind::Camera) return h.ctx().camera.pdf_direction(wo);
+        if (at.kind == VertexKind::Light) return std::max(0.0f, dot(at.emitter_n, wo)) / M_PI;
+        const Vec3f wi = normalize(from->p - at.p);
+        if (at.kind == VertexKind::Medium) return hg(-dot(wi, wo));
+        // The floor's diffuse lobe, on the side it was reached from (the floor is seen from below too).
+        const float cos_i = dot(Vec3f(0, 0, 1), wi), cos_o = dot(Vec3f(0, 0, 1), wo);
+        return cos_i * cos_o > 0 ? std::abs(cos_o) / M_PI : 0.0;
+    };
+    const auto density = [&](const PathVertexBase& to, const PathVertexBase& from, double pdfW) {
+        const Vec3f d = to.p - from.p;
+        const double dist = length(d);
+        double p = pdfW / (dist * dist) * std::exp(-kSigma * dist);
+        return to.kind == VertexKind::Medium ? p * kSigma : p * std::abs(dot(to.n, d / float(dist)));
+    };
+    bool ok = true;
+    medium_vertices = 0;
+    std::vector<PathVertex<RgbTransport>> path;
+    for (uint64_t i = 0; i < 200; ++i) {
+        Sampler sampler(7, i, 0, SamplerKind::Independent);
+        const RgbWavelengths wl{};
+        const bool camera_side = i % 2 == 0;
+        if (camera_side) h.bdpt().camera_subpath(h.ctx(), size_t(i * 37 % 4096), sampler, wl, path);
+        else h.bdpt().light_subpath(h.ctx(), sampler, wl, path);
+        for (size_t j = 1; j < path.size(); ++j) {
+            const PathVertexBase& v = path[j];
+            if (v.kind == VertexKind::Light) continue;  // (a camera ray that escaped)
+            // Edges shorter than this from a surface are left out: the ray leaves the surface a
+            // little off it (geometry/ray.hpp), which moves their 1 / d^2 by more than 1e-3.
+            if (length(v.p - path[j - 1].p) < 0.2f || (j + 1 < path.size() && length(path[j + 1].p - v.p) < 0.2f)) continue;
+            medium_vertices += v.kind == VertexKind::Medium;
+            const double fwd = density(v, path[j - 1], pdfW_at(path[j - 1], j >= 2 ? &path[j - 2] : nullptr, v.p));
+            if (std::abs(v.pdf_fwd - fwd) > 1e-3 * fwd) {
+                ok = false;
+                report += "subpath " + std::to_string(i) + " vertex " + std::to_string(j) + ": pdf_fwd " + std::to_string(v.pdf_fwd) +
+                          " instead of " + std::to_string(fwd) + "\n";
+            }
+            if (j + 1 < path.size() && j >= 1 && path[j + 1].kind != VertexKind::Light) {
+                const PathVertexBase& prev = path[j - 1];
+                if (prev.kind == VertexKind::Camera) continue;
+                const double rev = density(prev, v, pdfW_at(v, &path[j + 1], prev.p));
+                const double stored = prev.pdf_rev;
+                if (std::abs(stored - rev) > 1e-3 * rev) {
+                    ok = false;
+                    report += "subpath " + std::to_string(i) + " vertex " + std::to_string(j - 1) + ": pdf_rev " + std::to_string(stored) +
+                              " instead of " + std::to_string(rev) + "\n";
+                }
+            }
+        }
+    }
+    return ok;
+}
+
+TEST(BidirMedia, RandomWalksStoreTheDensitiesOfTheirDefinitions) {
+    std::string report;
+    int medium_vertices = 0;
+    EXPECT_TRUE(walk_densities_match(MediumMis{}, report, medium_vertices)) << report;
+    EXPECT_GT(medium_vertices, 50);
+    BdptFaults faults;
+    faults.drop_distance_pdf = true;
+    EXPECT_FALSE(walk_densities_match(MediumMis(faults), report, medium_vertices));
+}
+
+}  // namespace
+}  // namespace pathlab::test

@@ -57,7 +57,7 @@ Volume read_volume(XmlSource& xml, const pugi::xml_node& n, const SceneBuilder& 
 
 const PluginInfo& null_bsdf_plugin() {
     static const PluginInfo info{"bsdf", "null",
-                                 "no surface at all: an index-matched boundary between media (only volpath sees it)", {}};
+                                 "no surface at all: an index-matched boundary between media (volpath, lt and bdpt see it)", {}};
     return info;
 }
 

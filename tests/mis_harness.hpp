@@ -11,20 +11,12 @@
 #include <string>
 
 #include "integrators/bidir/bdpt.hpp"
+#include "scene_helpers.hpp"
 
 namespace pathlab::test {
 namespace {
 
 constexpr uint32_t kDiffuse = 0, kGlossy = 1, kMirror = 2, kLight = 3;
-
-MeshDesc quad(const Vec3f& c, const Vec3f& u, const Vec3f& v, uint32_t material, Rgb emission = Rgb(0.0f)) {
-    MeshDesc m;
-    m.positions = {c - u - v, c + u - v, c + u + v, c - u + v};
-    m.triangles = {{0, 1, 2}, {0, 2, 3}};  // normal along u x v
-    m.material = material;
-    m.emission = emission;
-    return m;
-}
 
 enum class LightKind { Area, Point, Environment };
 

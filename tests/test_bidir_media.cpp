@@ -16,6 +16,7 @@
 #include "integrators/bidir/light_tracer.hpp"
 #include "judge/image_statistics.hpp"
 #include "render_helpers.hpp"
+#include "scene_helpers.hpp"
 #include "scenefile/scene_file.hpp"
 
 namespace pathlab::test {
@@ -26,32 +27,9 @@ std::string source_path(const std::string& relative) { return std::string(PATHLA
 // Per pixel and channel at 1e-3, the whole image's family at 1e-4 (the suite's usual rates).
 const AgreementOptions kAgreement{1e-3, 1e-4};
 
-// A box filling the course box's inside (a little smaller), an index-matched boundary.
-MeshDesc fog_box(int32_t medium) {
-    MeshDesc m = cube_mesh();
-    transform_mesh(m, Transform::translate({0.01, 0.02, 0}) * Transform::scale({1.27, 1.27, 1.27}));
-    m.name = "fog";
-    m.media.interior = medium;
-    m.media.index_matched = true;
-    return m;
-}
-
 // A 3-channel grid of densities between 0.1 and 1.35 filling [-0.9, 0.9]^3.
 HeterogeneousMedium grid_medium() {
-    VoxelGrid g;
-    g.res = {6, 5, 4};
-    g.channels = 3;
-    for (int z = 0; z < 4; ++z)
-        for (int y = 0; y < 5; ++y)
-            for (int x = 0; x < 6; ++x)
-                for (int c = 0; c < 3; ++c) g.data.push_back(0.1f + 0.25f * float((x * 5 + y * 3 + z * 7 + c * 4) % 6));
-    HeterogeneousMedium m;
-    m.sigma_t = Volume::of_grid(g, Transform::translate({-0.9, -0.9, -0.9}) * Transform::scale({1.8, 1.8, 1.8}));
-    m.albedo = Volume::constant_value(Rgb(0.9f, 0.8f, 0.7f));
-    m.scale = 1;
-    m.phase = HgPhase{-0.3f};
-    m.prepare();
-    return m;
+    return striped_grid_medium({{6, 5, 4}, 3, 0.1f, 0.25f, 6, 0.9, Rgb(0.9f, 0.8f, 0.7f), HgPhase{-0.3f}});
 }
 
 struct MediaScene {
@@ -188,14 +166,6 @@ SceneDescription medium_world() {
     d.camera = Camera::look_at({0, -4, 1.5f}, {0, 0, 0.5f}, {0, 0, 1}, 60, FovAxis::X);
     d.width = d.height = 64;
     d.materials = {make_phong(Rgb(0.6f)), make_phong(Rgb(0.0f))};
-    const auto quad = [](const Vec3f& c, const Vec3f& u, const Vec3f& v, uint32_t material, Rgb emission) {
-        MeshDesc m;
-        m.positions = {c - u - v, c + u - v, c + u + v, c - u + v};
-        m.triangles = {{0, 1, 2}, {0, 2, 3}};  // normal along u x v
-        m.material = material;
-        m.emission = emission;
-        return m;
-    };
     d.meshes.push_back(quad({0, 0, 0}, {3, 0, 0}, {0, 3, 0}, 0, Rgb(0.0f)));                 // floor, normal +z
     d.meshes.push_back(quad({0, 0.5f, 2.5f}, {0.5f, 0, 0}, {0, -0.5f, 0}, 1, Rgb(6.0f)));   // light, normal -z
     d.media.push_back(HomogeneousMedium{Rgb(kSigma), Rgb(0.8f * kSigma), HgPhase{kG}});

@@ -15,6 +15,7 @@
 #include "integrators/path/volpath.hpp"
 #include "judge/image_statistics.hpp"
 #include "render_helpers.hpp"
+#include "scene_helpers.hpp"
 #include "scenefile/scene_file.hpp"
 #include "spectral_helpers.hpp"
 #include "spectral/rgb_spectra.hpp"
@@ -65,31 +66,8 @@ TEST(SpectralVolpath, WithoutMediaItIsSpectralPtMisBitForBit) {
 
 // ---- a grey medium under a white light: RGB mode ------------------------------------------
 
-// A box filling the course box's inside (a little smaller), an index-matched boundary.
-MeshDesc fog_box(int32_t medium) {
-    MeshDesc m = cube_mesh();
-    transform_mesh(m, Transform::translate({0.01, 0.02, 0}) * Transform::scale({1.27, 1.27, 1.27}));
-    m.name = "fog";
-    m.media.interior = medium;
-    m.media.index_matched = true;
-    return m;
-}
-
 // A one-channel grid of densities between 0.2 and 1.7 filling [-0.8, 0.8]^3.
-HeterogeneousMedium grey_grid(float albedo) {
-    VoxelGrid g;
-    g.res = {6, 5, 4};
-    g.channels = 1;
-    for (int z = 0; z < 4; ++z)
-        for (int y = 0; y < 5; ++y)
-            for (int x = 0; x < 6; ++x) g.data.push_back(0.2f + 0.3f * float((x * 5 + y * 3 + z * 7) % 6));
-    HeterogeneousMedium m;
-    m.sigma_t = Volume::of_grid(g, Transform::translate({-0.8, -0.8, -0.8}) * Transform::scale({1.6, 1.6, 1.6}));
-    m.albedo = Volume::constant_value(Rgb(albedo));
-    m.phase = HgPhase{-0.3f};
-    m.prepare();
-    return m;
-}
+HeterogeneousMedium grey_grid(float albedo) { return striped_grid_medium({{6, 5, 4}, 1, 0.2f, 0.3f, 6, 0.8, Rgb(albedo), HgPhase{-0.3f}}); }
 
 // Spectral mode's expected colour of an RGB emitter, by quadrature every 0.25 nm (the film's
 // expectation): its largest relative difference from the RGB over the channels.
@@ -248,19 +226,7 @@ TEST(SpectralVolpath, FreeFlightStrategiesAgreeOnColouredMedia) {
     }
     {
         SceneDescription d = make_builtin_scene(2);
-        VoxelGrid g;
-        g.res = {5, 4, 3};
-        g.channels = 3;
-        for (int z = 0; z < 3; ++z)
-            for (int y = 0; y < 4; ++y)
-                for (int x = 0; x < 5; ++x)
-                    for (int c = 0; c < 3; ++c) g.data.push_back(0.1f + 0.4f * float((x * 5 + y * 3 + z * 7 + c * 4) % 5));
-        HeterogeneousMedium m;
-        m.sigma_t = Volume::of_grid(g, Transform::translate({-0.8, -0.8, -0.8}) * Transform::scale({1.6, 1.6, 1.6}));
-        m.albedo = Volume::constant_value(Rgb(0.9f, 0.7f, 0.4f));
-        m.phase = HgPhase{0.5f};
-        m.prepare();
-        d.media.push_back(m);
+        d.media.push_back(striped_grid_medium({{5, 4, 3}, 3, 0.1f, 0.4f, 5, 0.8, Rgb(0.9f, 0.7f, 0.4f), HgPhase{0.5f}}));
         d.meshes.push_back(fog_box(0));
         scenes.push_back(d);
     }

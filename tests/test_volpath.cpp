@@ -15,6 +15,7 @@
 #include "integrators/path/volpath.hpp"
 #include "judge/image_statistics.hpp"
 #include "render_helpers.hpp"
+#include "scene_helpers.hpp"
 #include "scenefile/scene_file.hpp"
 
 namespace pathlab::test {
@@ -100,16 +101,6 @@ TEST(Volpath, OtherEstimatorsDoNotSeeIndexMatchedBoundaries) {
     EXPECT_FALSE(bit_identical(x.film.mean(), y.film.mean()));
 }
 
-// A box filling the course box's inside (a little smaller), an index-matched boundary.
-MeshDesc fog_box(int32_t medium) {
-    MeshDesc m = cube_mesh();
-    transform_mesh(m, Transform::translate({0.01, 0.02, 0}) * Transform::scale({1.27, 1.27, 1.27}));
-    m.name = "fog";
-    m.media.interior = medium;
-    m.media.index_matched = true;
-    return m;
-}
-
 // Scene 2 (ceiling light) with an empty medium filling the box, and its blue sphere turned into
 // glass filled with another empty medium: volpath crosses the boundaries, switches media at the
 // glass, samples free flights that never end and ratio-tracks transmittances of 1.
@@ -156,22 +147,7 @@ SceneDescription emitting_sphere(const Medium& medium, Rgb Le) {
 }
 
 // A 3-channel grid of densities between 0.2 and 2.7 filling [-0.8, 0.8]^3.
-HeterogeneousMedium grid_medium(const Rgb& albedo) {
-    VoxelGrid g;
-    g.res = {6, 5, 4};
-    g.channels = 3;
-    for (int z = 0; z < 4; ++z)
-        for (int y = 0; y < 5; ++y)
-            for (int x = 0; x < 6; ++x)
-                for (int c = 0; c < 3; ++c) g.data.push_back(0.2f + 0.5f * float((x * 5 + y * 3 + z * 7 + c * 4) % 6));
-    HeterogeneousMedium m;
-    m.sigma_t = Volume::of_grid(g, Transform::translate({-0.8, -0.8, -0.8}) * Transform::scale({1.6, 1.6, 1.6}));
-    m.albedo = Volume::constant_value(albedo);
-    m.scale = 1;
-    m.phase = HgPhase{-0.3f};
-    m.prepare();
-    return m;
-}
+HeterogeneousMedium grid_medium(const Rgb& albedo) { return striped_grid_medium({{6, 5, 4}, 3, 0.2f, 0.5f, 6, 0.8, albedo, HgPhase{-0.3f}}); }
 
 TEST(Volpath, AnAlbedoOneMediumInAnEmittingEnclosureStaysAtLe) {
     const Rgb Le(0.5f, 1.0f, 1.5f);

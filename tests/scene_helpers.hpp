@@ -1,0 +1,62 @@
+// Pieces of test scenes that several tests build: quads, the index-matched fog box that fills the
+// course box, and voxel-grid media with a striped pattern of extinctions.
+#pragma once
+
+#include <array>
+
+#include "geometry/shape_meshes.hpp"
+#include "media/medium.hpp"
+#include "media/volume.hpp"
+#include "scene/scene_description.hpp"
+
+namespace pathlab::test {
+
+// A quad centred at c spanned by +-u and +-v, normal along u x v.
+inline MeshDesc quad(const Vec3f& c, const Vec3f& u, const Vec3f& v, uint32_t material, Rgb emission = Rgb(0.0f)) {
+    MeshDesc m;
+    m.positions = {c - u - v, c + u - v, c + u + v, c - u + v};
+    m.triangles = {{0, 1, 2}, {0, 2, 3}};
+    m.material = material;
+    m.emission = emission;
+    return m;
+}
+
+// A box filling the course box's inside (a little smaller), an index-matched boundary.
+inline MeshDesc fog_box(int32_t medium) {
+    MeshDesc m = cube_mesh();
+    transform_mesh(m, Transform::translate({0.01, 0.02, 0}) * Transform::scale({1.27, 1.27, 1.27}));
+    m.name = "fog";
+    m.media.interior = medium;
+    m.media.index_matched = true;
+    return m;
+}
+
+// A grid medium filling [-half, half]^3 whose voxel (x, y, z), channel c, has the extinction
+// base + step k, k = (5x + 3y + 7z + 4c) mod levels.
+struct StripedGrid {
+    std::array<int, 3> res;
+    int channels;
+    float base, step;
+    int levels;
+    double half;
+    Rgb albedo;
+    PhaseFunction phase;
+};
+inline HeterogeneousMedium striped_grid_medium(const StripedGrid& s) {
+    VoxelGrid g;
+    g.res = s.res;
+    g.channels = s.channels;
+    for (int z = 0; z < s.res[2]; ++z)
+        for (int y = 0; y < s.res[1]; ++y)
+            for (int x = 0; x < s.res[0]; ++x)
+                for (int c = 0; c < s.channels; ++c) g.data.push_back(s.base + s.step * float((x * 5 + y * 3 + z * 7 + c * 4) % s.levels));
+    HeterogeneousMedium m;
+    m.sigma_t = Volume::of_grid(g, Transform::translate({-s.half, -s.half, -s.half}) * Transform::scale({2 * s.half, 2 * s.half, 2 * s.half}));
+    m.albedo = Volume::constant_value(s.albedo);
+    m.scale = 1;
+    m.phase = s.phase;
+    m.prepare();
+    return m;
+}
+
+}  // namespace pathlab::test

@@ -50,10 +50,5 @@ float unbounded_spectrum_bound();
 // extinction is a one-channel grid or constant (exact there), else unbounded_spectrum_bound().
 float spectral_majorant_factor(const Medium& m);
 
-// The path's density over the common normaliser: mean(r) over the 4 lanes' techniques, or r_0
-// once the path carries the hero alone.
-inline float spectral_path_density(const Spectrum4& r, const SampledWavelengths& wl) {
-    return wl.secondary_terminated() ? r[0] : r.average();
-}
 
 }  // namespace pathlab

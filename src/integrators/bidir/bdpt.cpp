@@ -228,12 +228,10 @@ void Bdpt<T>::light_subpath(const RenderContext& ctx, Sampler& sampler, const Wa
     l.n = (flags & kLightSurface) ? es->normal : Vec3f(0.0f);
     l.emitter_n = es->normal;
     l.light = choice.index;
-    l.medium = scene.light_medium(choice.index);
+    l.medium = start->medium;
     l.beta = light_colour(scene, choice.index, es->Le, wl);
     l.pdf_fwd = choice.pmf * es->pdfA;
     path.push_back(l);
-    // Light from infinity through a medium that reaches infinity is all absorbed on its way.
-    if (l.infinite && l.medium >= 0 && has_extinction(scene.medium(l.medium))) return;
     const Colour beta = l.beta * (es->cos / (choice.pmf * es->pdfA * es->pdfW));
     const Ray ray = (flags & kLightSurface) ? spawn_ray(es->origin, es->normal, es->direction) : Ray{es->origin, es->direction, kInf};
     random_walk(ctx, ray, sampler, beta, es->pdfW, max_light_vertices(), TransportMode::Importance, wl, path, l.medium, hero);

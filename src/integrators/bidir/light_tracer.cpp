@@ -44,9 +44,7 @@ void LightTracer<T>::trace(const RenderContext& ctx, Sampler& sampler, SplatList
     // segment; contributions are divided by the path's density over the hero channel.
     const bool media = scene.has_media();
     MediumState<T> st{sampler, wl};
-    int32_t medium = scene.light_medium(choice.index);
-    // Light from infinity through a medium that reaches infinity is all absorbed on its way.
-    if ((flags & kLightInfinite) && medium >= 0 && has_extinction(scene.medium(medium))) return;
+    int32_t medium = start->medium;
     // Whether the segment to the camera is free, and its transmittance through media.
     const auto to_camera = [&](const Ray& segment, int32_t from_medium) {
         return shadow_transmittance(scene, segment, from_medium, st);

@@ -13,9 +13,12 @@ struct LightPathStart {
     const Light* light;
     EmissionSample emission;
     uint32_t flags;  // light_flags(*light)
+    int32_t medium;  // the medium the path starts in (Scene::light_medium; -1: none)
 };
 
-// Nothing where no light is chosen or its emission sample carries nothing.
+// Nothing where no light is chosen or its emission sample carries nothing, or where light from
+// infinity would cross a medium that reaches infinity (it is all absorbed on its way, as
+// volpath's escaped rays find).
 inline std::optional<LightPathStart> start_light_path(const Scene& scene, Sampler& sampler) {
     const LightChoice choice = scene.choose_light(sampler.next1d());
     const Vec2f u_pos = sampler.next2d(), u_dir = sampler.next2d();
@@ -23,7 +26,10 @@ inline std::optional<LightPathStart> start_light_path(const Scene& scene, Sample
     const Light& light = scene.lights()[size_t(choice.index)];
     const auto es = sample_emission(light, u_pos, u_dir, scene.scene_sphere());
     if (!es || is_black(es->Le) || !(es->pdfA > 0) || !(es->pdfW > 0)) return std::nullopt;
-    return LightPathStart{choice, &light, *es, light_flags(light)};
+    const uint32_t flags = light_flags(light);
+    const int32_t medium = scene.light_medium(choice.index);
+    if ((flags & kLightInfinite) && medium >= 0 && has_extinction(scene.medium(medium))) return std::nullopt;
+    return LightPathStart{choice, &light, *es, flags, medium};
 }
 
 }  // namespace pathlab

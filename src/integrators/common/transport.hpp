@@ -175,12 +175,13 @@ template <class Draw> int hero_channel(const RgbWavelengths&, Draw&& draw) { ret
 template <class Draw> int hero_channel(const SampledWavelengths&, Draw&&) { return 0; }
 // A path's density over the common normaliser of the channels' techniques (medium.hpp): their
 // mean, or the hero's alone once the path carries the hero alone.
-inline float path_density(const Rgb& r, const RgbWavelengths&) { return mean(r); }
-inline float path_density(const Spectrum4& r, const SampledWavelengths& wl) { return spectral_path_density(r, wl); }
-// The same for a path joined from two subpaths at the same wavelengths (bdpt): hero_only when a
-// vertex of either went through dispersion (it carries the hero alone).
+// path_density_of: the same where the caller knows whether the path carries the hero alone (a
+// path joined from two subpaths at the same wavelengths, bdpt: a vertex of either went through
+// dispersion).
 inline float path_density_of(const Rgb& r, bool) { return mean(r); }
 inline float path_density_of(const Spectrum4& r, bool hero_only) { return hero_only ? r[0] : r.average(); }
+inline float path_density(const Rgb& r, const RgbWavelengths&) { return mean(r); }
+inline float path_density(const Spectrum4& r, const SampledWavelengths& wl) { return path_density_of(r, wl.secondary_terminated()); }
 
 // ---- dispersion --------------------------------------------------------------------------------
 // A throughput after a dispersive interface: the hero lane alone (the other lanes' light went

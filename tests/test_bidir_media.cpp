@@ -14,6 +14,7 @@
 #include "geometry/shape_meshes.hpp"
 #include "integrators/bidir/bdpt.hpp"
 #include "integrators/bidir/light_tracer.hpp"
+#include "integrators/photon/vcm.hpp"
 #include "judge/image_statistics.hpp"
 #include "render_helpers.hpp"
 #include "scene_helpers.hpp"
@@ -120,14 +121,53 @@ TEST(BidirMedia, BdptAndLightTracingAgreeWithVolpath) {
     }
 }
 
-TEST(BidirMedia, BdptInSpectralModeAgreesWithVolpath) {
+// vcm and bpm: merging at medium vertices (the 3D kernel) beside the connections, one MIS, from
+// a radius of 3% of the scene's (as test_vcm.cpp: the default, two pixel footprints, is a
+// large blur at 10 x 10 pixels, whose bias these z-tests resolve). bpm gets 4096 iterations:
+// without connections, in-scattering from the light box in the fog is found only by phase
+// sampling hitting the light or by rare merges with the few photons of 100 light paths in a
+// small ball, a skewed estimate whose pixel means at 1024 still miss their normal z (4 seeds
+// pass at 4096; at 1024 and 2048 the first did not).
+TEST(BidirMedia, VcmAndBpmAgreeWithVolpath) {
+    const std::vector<MediaScene> scenes = media_scenes();
+    for (size_t i = 0; i < scenes.size(); ++i) {
+        const RenderResult& ref = references()[i].volpath;
+        IntegratorOptions o = depth_options();
+        o.photon_radius = 0.03f * Scene::build(scenes[i].d)->scene_sphere().radius;
+        for (const char* a : {"vcm", "bpm"}) {
+            const bool bpm = std::string(a) == "bpm";
+            const RenderResult r = render_integrator(scenes[i].d, *find_integrator(a)->make(o), kSize, kSize, bpm ? 4096 : 1024, 23);
+            const AgreementResult res = agreement(r, ref);
+            EXPECT_TRUE(res.agree) << scenes[i].name << ", " << a << ": " << res.describe();
+        }
+    }
+}
+
+// The test of the test: merging in a medium with the surfaces' kernel (N pi r^2, in the estimate
+// and the MIS) is too dark where merges carry weight.
+TEST(BidirMedia, AMediumMergeWithTheDiscKernelIsDetected) {
+    const MediaScene s = media_scenes()[0];
+    IntegratorOptions o = depth_options();
+    o.photon_radius = 0.03f * Scene::build(s.d)->scene_sphere().radius;
+    o.vcm_connections = false;
+    Vcm<RgbTransport> faulty(o, VcmFaults{.volume_kernel_as_disc = true});
+    const RenderResult r = render_integrator(s.d, faulty, kSize, kSize, 1024, 23);
+    const AgreementResult res = agreement(r, references()[0].volpath);
+    EXPECT_FALSE(res.agree) << res.describe();
+}
+
+TEST(BidirMedia, BdptAndVcmInSpectralModeAgreeWithVolpath) {
     const MediaScene s = media_scenes()[0];
     IntegratorOptions o = depth_options();
     o.spectral = true;
-    const auto volpath = find_integrator("volpath")->make(o), bdpt = find_integrator("bdpt")->make(o);
-    const RenderResult v = render_integrator(s.d, *volpath, kSize, kSize, 4096, 31), b = render_integrator(s.d, *bdpt, kSize, kSize, 1024, 32);
-    const AgreementResult r = agreement(b, v);
-    EXPECT_TRUE(r.agree) << r.describe();
+    const auto volpath = find_integrator("volpath")->make(o);
+    const RenderResult v = render_integrator(s.d, *volpath, kSize, kSize, 4096, 31);
+    o.photon_radius = 0.03f * Scene::build(s.d)->scene_sphere().radius;
+    for (const char* a : {"bdpt", "vcm"}) {
+        const RenderResult b = render_integrator(s.d, *find_integrator(a)->make(o), kSize, kSize, 1024, 32);
+        const AgreementResult r = agreement(b, v);
+        EXPECT_TRUE(r.agree) << a << ": " << r.describe();
+    }
 }
 
 // The test of the test: a connection that leaves out its transmittance is too bright.
@@ -142,7 +182,7 @@ TEST(BidirMedia, AConnectionWithoutItsTransmittanceIsDetected) {
 TEST(BidirMedia, OneAndTwoThreadsGiveTheSameBytes) {
     for (const char* f : {"scenes/fog-box.xml", "scenes/smoke.xml"}) {
         const SceneDescription d = load_scene_file(source_path(f));
-        for (const char* a : {"bdpt", "lt"}) {
+        for (const char* a : {"bdpt", "lt", "vcm", "bpm"}) {
             const auto with_threads = [&](int threads) {
                 tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
                 return render_scene(d, a, 16, 12, 4, 5);
@@ -268,7 +308,7 @@ public:
     // The subpaths of strategy (s, t) with the densities of their definitions (NaN where the
     // connection must set them) and their running MIS quantities.
     void subpaths(const MediumPath& f, int s, std::vector<PathVertex<RgbTransport>>& light,
-                  std::vector<PathVertex<RgbTransport>>& camera) const {
+                  std::vector<PathVertex<RgbTransport>>& camera, const MergeMis* vm = nullptr) const {
         const int n = k(f), t = n + 1 - s;
         camera.clear(), light.clear();
         for (int j = 0; j < t; ++j) {
@@ -284,18 +324,37 @@ public:
             v.pdf_rev = i + 2 <= s - 1 ? float(scatter_density(f, j - 2, j - 1, j)) : NAN;
             light.push_back(v);
         }
-        set_running_mis(light.data(), int(light.size()), true, MisRules(false, nullptr));
-        set_running_mis(camera.data(), int(camera.size()), false, MisRules(false, nullptr));
+        set_running_mis(light.data(), int(light.size()), true, MisRules(false, vm));
+        set_running_mis(camera.data(), int(camera.size()), false, MisRules(false, vm));
     }
-    float bdpt_weight(const MediumPath& f, int s) const {
+    float bdpt_weight(const MediumPath& f, int s, const MergeMis* vm = nullptr) const {
         std::vector<PathVertex<RgbTransport>> light, camera;
-        subpaths(f, s, light, camera);
+        subpaths(f, s, light, camera, vm);
         const int n = k(f), t = n + 1 - s;
         PathVertex<RgbTransport> sampled = s == 1 ? vertex(f, n, false) : vertex(f, 0, true);
         if (s == 1) sampled.pdf_fwd = float(light_origin());
         EdgeDensities known;
         if (s >= 1) known.T = float(std::exp(-kSigma * length(f.p[size_t(t)] - f.p[size_t(t - 1)])));
-        return bdpt_.mis_weight(ctx_, light, s, camera, t, sampled, known);
+        return bdpt_.mis_weight(ctx_, light, s, camera, t, sampled, known, vm);
+    }
+    // The light side's density of inner vertex x_j (from x_{j+1}).
+    double light_density(const MediumPath& f, int j) const {
+        return j + 1 == k(f) ? light_emission(f) : scatter_density(f, j + 2, j + 1, j);
+    }
+    // Merging at x_j: the connection with camera endpoint x_j, times the light side's density of
+    // x_j, times eta (per unit area on the floor, per unit volume in the medium).
+    double merge_density(const MediumPath& f, int j, const MergeMis& vm) const {
+        return strategy_density(f, k(f) - j) * light_density(f, j) * (f.in_medium[size_t(j)] ? vm.eta_volume : vm.eta);
+    }
+    // The photon x_j of the light subpath x_k .. x_j merged at x_j of the camera subpath x_0 .. x_j,
+    // by the running quantities and by the walk.
+    std::pair<float, float> merge_weights(const Vcm<RgbTransport>& vcm, const MediumPath& f, int j, const MergeMis& vm) const {
+        const int s = k(f) - j + 1;
+        std::vector<PathVertex<RgbTransport>> light, camera, unused;
+        subpaths(f, s, light, unused, &vm);
+        subpaths(f, s - 1, unused, camera, &vm);
+        return {vcm.merge_weight(*scene_, light.data(), s, camera, j + 1, vm),
+                vcm.merge_weight_oracle(*scene_, light.data(), s, camera, j + 1, vm)};
     }
 
     std::vector<MediumPath> paths() const {
@@ -345,6 +404,57 @@ bool weights_match(const MediumMis& h, std::string& report) {
 TEST(BidirMedia, WeightsWithMediumVerticesAreTheBalanceHeuristicOfTheDensities) {
     std::string report;
     EXPECT_TRUE(weights_match(MediumMis{}, report)) << report;
+}
+
+// vcm's weights on the same paths: every connection and a merge at every inner vertex (on the
+// floor with eta = N pi r^2, in the medium with eta_volume = N 4/3 pi r^3: the point-point
+// estimator of UPBP) get the balance heuristic of the densities written out above, by the
+// running quantities and by the walk, and sum to 1; a medium merge weighed with the disc's eta
+// is caught.
+bool merge_weights_match(const MediumMis& h, VcmFaults faults, std::string& report) {
+    Vcm<RgbTransport> vcm(IntegratorOptions{}, faults);
+    bool ok = true;
+    for (const double r : {0.02, 0.1, 0.4}) {
+        const MergeMis vm = vcm.merge_mis(1000, r);
+        // What the render assumes (the fault lives in merge_mis): the densities of the definition.
+        MergeMis exact = vm;
+        exact.eta_volume = 1000 * 4.0 / 3.0 * M_PI * r * r * r;
+        for (const MediumPath& f : h.paths()) {
+            double total = 0;
+            for (int s = 0; s <= h.k(f); ++s) total += h.strategy_density(f, s);
+            for (int j = 1; j < h.k(f); ++j) total += h.merge_density(f, j, exact);
+            double sum = 0;
+            const auto check = [&](const std::string& what, double got, double expected) {
+                sum += got;
+                if (std::abs(got - expected) > 1e-4 * std::max(1e-3, expected)) {
+                    ok = false;
+                    report += f.name + " r=" + std::to_string(r) + " " + what + ": " + std::to_string(got) + " instead of " +
+                              std::to_string(expected) + "\n";
+                }
+            };
+            for (int s = 0; s <= h.k(f); ++s) check("s=" + std::to_string(s), h.bdpt_weight(f, s, &vm), h.strategy_density(f, s) / total);
+            for (int j = 1; j < h.k(f); ++j) {
+                const auto [running, walk] = h.merge_weights(vcm, f, j, vm);
+                if (std::abs(running - walk) > 1e-5 * walk + 1e-12) {
+                    ok = false;
+                    report += f.name + " merge at x_" + std::to_string(j) + ": running " + std::to_string(running) + ", walk " +
+                              std::to_string(walk) + "\n";
+                }
+                check("merge at x_" + std::to_string(j), running, h.merge_density(f, j, exact) / total);
+            }
+            if (std::abs(sum - 1) > 1e-4) {
+                ok = false;
+                report += f.name + " r=" + std::to_string(r) + ": the weights sum to " + std::to_string(sum) + "\n";
+            }
+        }
+    }
+    return ok;
+}
+
+TEST(BidirMedia, VcmWeightsWithMediumVerticesAreTheBalanceHeuristicOfTheDensities) {
+    std::string report;
+    EXPECT_TRUE(merge_weights_match(MediumMis{}, {}, report)) << report;
+    EXPECT_FALSE(merge_weights_match(MediumMis{}, VcmFaults{.volume_kernel_as_disc = true}, report));
 }
 
 TEST(BidirMedia, WeightsWithoutDistanceSamplingAreDetected) {

@@ -232,24 +232,24 @@ TEST_F(SceneFileMedia, IntegratorsWithoutMediaRefuseScenesWithMedia) {
             }
             EXPECT_TRUE(contains(message, info.name + " does not render participating media")) << message;
             EXPECT_TRUE(contains(message, where)) << message;
-            EXPECT_TRUE(contains(message, "The integrators that render media: lt, bdpt, volpath")) << message;
+            EXPECT_TRUE(contains(message, "The integrators that render media: lt, bdpt, bpm, vcm, volpath")) << message;
             ++refusing;
         }
     }
-    EXPECT_EQ(refusing, 2 * (int(integrators().size()) - 3));  // all but lt, bdpt, volpath
+    EXPECT_EQ(refusing, 2 * (int(integrators().size()) - 5));  // all but lt, bdpt, bpm, vcm, volpath
     // From the command line: exit code 2, and `pathlab algorithms` says which render media.
     std::ofstream(path("fog.xml")) << "<scene version=\"3.0.0\">\n<medium type=\"homogeneous\" id=\"fog\"/>\n"
                                       "<shape type=\"cube\"><ref name=\"interior\" id=\"fog\"/></shape>\n" + rest + "</scene>\n";
-    for (const char* a : {"vcm", "pt-mis"}) {
+    for (const char* a : {"sppm", "pt-mis"}) {
         const CliResult r = run({"--scene", path("fog.xml"), "-a", a, "--spp", "1", "--resolution", "8x8", "-o", path("out.exr")});
         EXPECT_EQ(r.code, 2) << r.err;
         EXPECT_TRUE(contains(r.err, "medium 'fog'")) << r.err;
         EXPECT_FALSE(fs::exists(path("out.exr")));
     }
-    for (const char* a : {"volpath", "bdpt", "lt"})
+    for (const char* a : {"volpath", "bdpt", "lt", "vcm", "bpm"})
         EXPECT_EQ(run({"--scene", path("fog.xml"), "-a", a, "--spp", "1", "--resolution", "8x8", "-q", "-o", path("out.exr")}).code, 0) << a;
     const CliResult list = run({"algorithms"});
-    EXPECT_TRUE(contains(list.out, "Participating media (scenes with a <medium>): lt, bdpt, volpath;")) << list.out;
+    EXPECT_TRUE(contains(list.out, "Participating media (scenes with a <medium>): lt, bdpt, bpm, vcm, volpath;")) << list.out;
 }
 
 }  // namespace

@@ -57,8 +57,8 @@ public:
         std::vector<PathVertex<RgbTransport>> light, camera, unused;
         h_.subpaths(f, s, light, unused, power_, &vm_);
         h_.subpaths(f, s - 1, unused, camera, power_, &vm_);
-        const float w = vcm_.merge_weight(light.data(), s, camera, j + 1, vm_);
-        const float oracle = vcm_.merge_weight_oracle(light.data(), s, camera, j + 1, vm_);
+        const float w = vcm_.merge_weight(h_.ctx().scene, light.data(), s, camera, j + 1, vm_);
+        const float oracle = vcm_.merge_weight_oracle(h_.ctx().scene, light.data(), s, camera, j + 1, vm_);
         EXPECT_NEAR(w, oracle, 1e-5 * oracle + 1e-12) << "merge at x_" << j << ": running vs walk";
         return w;
     }

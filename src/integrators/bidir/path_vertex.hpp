@@ -116,9 +116,9 @@ float pdf_light_origin(const Scene& scene, const PathVertexBase& v, const PathVe
 struct MisVertex {
     float pdf_fwd, pdf_rev;
     bool delta, delta_light;
-    bool surface;  // a surface vertex (where vertex merging may happen)
+    VertexKind kind;  // merging happens at surface and medium vertices
 };
-inline MisVertex mis_vertex(const PathVertexBase& v) { return {v.pdf_fwd, v.pdf_rev, v.delta, v.delta_light, v.kind == VertexKind::Surface}; }
+inline MisVertex mis_vertex(const PathVertexBase& v) { return {v.pdf_fwd, v.pdf_rev, v.delta, v.delta_light, v.kind}; }
 
 // Vertex merging (vcm, bpm; Georgiev et al. 2012): the strategies a path can also be sampled by.
 // Merging at vertex x (a non-Dirac surface vertex with at least one light vertex before it and
@@ -127,11 +127,18 @@ inline MisVertex mis_vertex(const PathVertexBase& v) { return {v.pdf_fwd, v.pdf_
 // light paths merged with (n_VM, against n_VC = 1 for connections) times the acceptance area
 // pi r^2 (the VCM report's formulation). After a Dirac vertex on the light side the density of
 // x is that lobe's coefficient times the edge's cos / d^2, as in every ratio (the delta cancels).
+// In a medium (the point-point estimator of UPBP, Krivanek et al. 2014) x is a medium vertex,
+// its densities are per unit volume and the acceptance region is the ball, eta_volume = the
+// number of light paths times 4/3 pi r^3.
 struct MergeMis {
-    double eta = 0;
+    double eta = 0, eta_volume = 0;
     bool merging = false;     // merging strategies take part
     bool connections = true;  // connection strategies with s >= 1 take part (s = 0 always does)
 };
+
+// Whether merging may happen at a vertex of this kind (if it is not Dirac), and with which eta.
+inline bool merges_at(VertexKind k) { return k == VertexKind::Surface || k == VertexKind::Medium; }
+inline double merge_eta(const MergeMis& vm, VertexKind k) { return k == VertexKind::Medium ? vm.eta_volume : vm.eta; }
 
 // The sum over the path's strategies other than (s, t) of (p_i / p_(s,t))^beta (beta = 2 for
 // the power heuristic, else 1): Veach's ratio walk over light(0..s) and camera(0..t), callables
@@ -148,7 +155,7 @@ double mis_ratio_sum(const LightAt& light, int s, const CameraAt& camera, int t,
     for (int i = t - 1; i > 0; --i) {
         const MisVertex c = camera(i);
         // Merging at camera vertex i: ri is here the ratio of the connection ending there.
-        if (merging && c.surface && !c.delta && s + (t - 1 - i) >= 1) sum += h(ri * double(c.pdf_rev) * vm->eta);
+        if (merging && merges_at(c.kind) && !c.delta && s + (t - 1 - i) >= 1) sum += h(ri * double(c.pdf_rev) * merge_eta(*vm, c.kind));
         ri *= remap0(c.pdf_rev) / remap0(c.pdf_fwd);
         if (connections && !c.delta && !camera(i - 1).delta) sum += h(ri);
     }
@@ -160,7 +167,7 @@ double mis_ratio_sum(const LightAt& light, int s, const CameraAt& camera, int t,
         const bool delta_before = i > 0 ? light(i - 1).delta : l.delta_light;
         if ((connections || i == 0) && !l.delta && !delta_before) sum += h(ri);
         // Merging at light vertex i, now the camera endpoint of the connection (i, s + t - i).
-        if (merging && i >= 1 && l.surface && !l.delta) sum += h(ri * double(l.pdf_fwd) * vm->eta);
+        if (merging && i >= 1 && merges_at(l.kind) && !l.delta) sum += h(ri * double(l.pdf_fwd) * merge_eta(*vm, l.kind));
     }
     return sum;
 }
@@ -196,11 +203,14 @@ float mis_weight_ratio_walk(const Vertex* light, int s, const Vertex* camera, in
 struct MisRules {
     bool power = false;
     bool merging = false, connections = true;
-    double eta = 0;
+    double eta = 0, eta_volume = 0;
     MisRules(bool power_heuristic, const MergeMis* vm) : power(power_heuristic) {
-        if (vm) merging = vm->merging, connections = vm->connections, eta = vm->eta;
+        if (vm) merging = vm->merging, connections = vm->connections, eta = vm->eta, eta_volume = vm->eta_volume;
     }
     double h(double r) const { return power ? r * r : r; }
+    // Whether a merge at vertex v is a strategy, and its eta.
+    bool merge_at(const PathVertexBase& v) const { return merging && merges_at(v.kind) && !v.delta; }
+    double eta_at(const PathVertexBase& v) const { return v.kind == VertexKind::Medium ? eta_volume : eta; }
     static double remap0(double f) { return f != 0 ? f : 1.0; }
 };
 
@@ -218,8 +228,7 @@ void set_running_mis(Vertex* v, int n, bool light_side, const MisRules& m) {
             const bool delta_before = i > 0 ? v[i - 1].delta : v[0].delta_light;
             double x = prefix;
             if ((m.connections || i == 0) && !v[i].delta && !delta_before) x += 1;
-            if (m.merging && i >= 1 && v[i].kind == VertexKind::Surface && !v[i].delta)
-                x += m.h(double(v[i].pdf_fwd) * m.eta);
+            if (i >= 1 && m.merge_at(v[i])) x += m.h(double(v[i].pdf_fwd) * m.eta_at(v[i]));
             v[k].mis_running = x;
             prefix = m.h(MisRules::remap0(v[i].pdf_rev) / MisRules::remap0(v[i].pdf_fwd)) * x;
         } else {
@@ -229,8 +238,7 @@ void set_running_mis(Vertex* v, int n, bool light_side, const MisRules& m) {
             if (m.connections && !v[i].delta && !v[i - 1].delta) y += 1;
             v[k].mis_running = y;
             prefix = m.h(MisRules::remap0(v[i].pdf_rev) / MisRules::remap0(v[i].pdf_fwd)) * y;
-            if (m.merging && v[i].kind == VertexKind::Surface && !v[i].delta)
-                prefix += m.h(double(v[i].pdf_rev) * m.eta);
+            if (m.merge_at(v[i])) prefix += m.h(double(v[i].pdf_rev) * m.eta_at(v[i]));
         }
     }
 }
@@ -243,7 +251,7 @@ double light_side_sum(const Vertex* y, int e, double rev_e, double rev_prev, con
     if (e == 0) return y[0].delta_light ? 0.0 : q;
     double inner = m.h(MisRules::remap0(rev_prev) / MisRules::remap0(y[e - 1].pdf_fwd)) * y[e].mis_running;
     if (m.connections && !y[e - 1].delta) inner += 1;
-    if (m.merging && y[e].kind == VertexKind::Surface) inner += m.h(double(y[e].pdf_fwd) * m.eta);
+    if (m.merging && merges_at(y[e].kind)) inner += m.h(double(y[e].pdf_fwd) * m.eta_at(y[e]));  // (y_e is connected: not Dirac here)
     return q * inner;
 }
 
@@ -257,11 +265,11 @@ double camera_side_sum(const Vertex* z, int e, double fwd_e, double rev_e, doubl
     double inner = 0;
     if (e >= 2) {
         inner = m.h(MisRules::remap0(rev_prev) / MisRules::remap0(z[e - 1].pdf_fwd)) * z[e].mis_running;
-        if (m.merging && z[e - 1].kind == VertexKind::Surface && !z[e - 1].delta) inner += m.h(rev_prev * m.eta);
+        if (m.merge_at(z[e - 1])) inner += m.h(rev_prev * m.eta_at(z[e - 1]));
     }
     if (m.connections && !z[e - 1].delta) inner += 1;
     double sum = m.h(MisRules::remap0(rev_e) / MisRules::remap0(fwd_e)) * inner;
-    if (merge_here && m.merging && z[e].kind == VertexKind::Surface) sum += m.h(psi_e * m.eta);
+    if (merge_here && m.merging && merges_at(z[e].kind)) sum += m.h(psi_e * m.eta_at(z[e]));
     return sum;
 }
 

@@ -183,6 +183,16 @@ inline float path_density_of(const Spectrum4& r, bool hero_only) { return hero_o
 inline float path_density(const Rgb& r, const RgbWavelengths&) { return mean(r); }
 inline float path_density(const Spectrum4& r, const SampledWavelengths& wl) { return path_density_of(r, wl.secondary_terminated()); }
 
+// a / b channel by channel, 0 where b is not positive (a throughput over a coefficient it includes).
+inline Rgb divide_where_positive(Rgb a, const Rgb& b) {
+    for (int c = 0; c < 3; ++c) a[c] = b[c] > 0 ? a[c] / b[c] : 0.0f;
+    return a;
+}
+inline Spectrum4 divide_where_positive(Spectrum4 a, const Spectrum4& b) {
+    for (int c = 0; c < kSpectrumLanes; ++c) a[c] = b[c] > 0 ? a[c] / b[c] : 0.0f;
+    return a;
+}
+
 // ---- dispersion --------------------------------------------------------------------------------
 // A throughput after a dispersive interface: the hero lane alone (the other lanes' light went
 // elsewhere; their values must not keep a path alive in the roulette).

@@ -1,4 +1,4 @@
-// A photon: where a light subpath met a non-Dirac surface, the direction it came from and the
+// A photon: where a light subpath met a non-Dirac surface (or scattered in a medium), the direction it came from and the
 // power it carries (the light subpath's throughput there, for one light path; divided by the
 // number of light paths when density is estimated), in the colour of transport T.
 #pragma once
@@ -16,6 +16,7 @@ struct Photon {
     ColourOf<T> power;        // throughput of its light path up to here
     uint16_t vertex;          // its index j on the light subpath (y_0 is on the light): j - 1 bounces before it
     bool dispersed = false;   // its light path met a dispersive interface: it carries the hero alone
+    bool in_medium = false;   // scattered in a medium (its power includes sigma_s there), not on a surface
 };
 
 // The sum of f(x, wo, wi_p) power_p (times any weight) over the photons merged at one camera

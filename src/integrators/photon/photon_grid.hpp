@@ -40,8 +40,9 @@ public:
     // within a cell), in place, and their positions copied into a dense array in that order: a
     // query's distance tests then read one contiguous run of 12-byte positions per cell (not one
     // item's cache line per candidate), and visit the items in the order build() would. f(i)
-    // gets indices into the reordered items.
-    template <class P> void build_sorted(std::vector<P>& items, float radius);
+    // gets indices into the reordered items. `companion`, unless empty, is an array of as many
+    // values that belong to the items (one each) and is reordered with them.
+    template <class P, class Q = char> void build_sorted(std::vector<P>& items, float radius, std::vector<Q>* companion = nullptr);
     template <typename F> void for_each_within(const Vec3f& q, float r, F&& f) const;
     size_t memory_bytes() const {
         return cell_ends_.capacity() * sizeof(uint32_t) + order_.capacity() * sizeof(uint32_t) + cell_of_.capacity() * sizeof(uint32_t) +
@@ -62,21 +63,26 @@ private:
     std::vector<Vec3f> sorted_p_;      // build_sorted: the items' positions, in cell order
 };
 
-template <class P> void PhotonGrid::build_sorted(std::vector<P>& items, float radius) {
+template <class P, class Q> void PhotonGrid::build_sorted(std::vector<P>& items, float radius, std::vector<Q>* companion) {
     build(Positions::of(items), radius);
+    const bool with = companion && !companion->empty();
     // Gather items[k] = old items[order_[k]] by following the permutation's cycles; a visited
     // slot is marked by order_[k] = k.
     for (size_t start = 0; start < items.size(); ++start) {
         if (order_[start] == start) continue;
         P held = std::move(items[start]);
+        Q held_companion{};
+        if (with) held_companion = std::move((*companion)[start]);
         size_t k = start;
         while (order_[k] != start) {
             const size_t from = order_[k];
             items[k] = std::move(items[from]);
+            if (with) (*companion)[k] = std::move((*companion)[from]);
             order_[k] = uint32_t(k);
             k = from;
         }
         items[k] = std::move(held);
+        if (with) (*companion)[k] = std::move(held_companion);
         order_[k] = uint32_t(k);
     }
     sorted_p_.resize(items.size());

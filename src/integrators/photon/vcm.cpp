@@ -23,7 +23,8 @@ size_t Vcm<T>::light_vertex_count() const {
 
 template <class T>
 size_t Vcm<T>::memory_bytes() const {
-    size_t bytes = grid_.memory_bytes() + photons_.capacity() * sizeof(MergeVertex<T>) + chunk_photons_.capacity() * sizeof(size_t) +
+    size_t bytes = grid_.memory_bytes() + photons_.capacity() * sizeof(MergeVertex<T>) + photon_r_.capacity() * sizeof(Colour) +
+                   chunk_photons_.capacity() * sizeof(size_t) +
                    path_begin_.capacity() * sizeof(uint32_t) + path_length_.capacity() * sizeof(uint16_t);
     for (const auto& c : chunk_vertices_) bytes += c.capacity() * sizeof(Vertex);
     return bytes;
@@ -31,13 +32,55 @@ size_t Vcm<T>::memory_bytes() const {
 
 namespace {
 
-// Whether light vertex y_j is stored as a photon (merging needs a non-Dirac surface).
+// Whether light vertex y_j is stored as a photon (merging needs a non-Dirac surface, or a medium).
 template <class Vertex>
 bool is_photon(const Vertex& y, size_t j, int max_bounces) {
-    return j >= 1 && y.kind == VertexKind::Surface && y.connectible() && int(j) <= max_bounces;
+    return j >= 1 && merges_at(y.kind) && y.connectible() && int(j) <= max_bounces;
+}
+
+// What a merge at vertex v needs of its scattering towards the world direction w (a photon's):
+// the BSDF (or phase function) value, and the solid-angle densities of sampling w from v's own
+// arrival direction and of sampling that from w.
+template <class T>
+struct MergeScatter {
+    Rgb f{0.0f};  // (a phase function's value is grey)
+    float pdf_to_light = 0, pdf_to_camera = 0;
+};
+
+template <class T>
+MergeScatter<T> merge_scatter(const Scene& scene, const PathVertexBase& z, const Vec3f& w) {
+    MergeScatter<T> m;
+    if (z.kind == VertexKind::Medium) {
+        const PhaseFunction& phase = medium_phase(scene.medium(z.medium));
+        m.f = Rgb(phase_eval(phase, z.dir, w));
+        m.pdf_to_light = phase_pdf(phase, z.dir, w);
+        m.pdf_to_camera = phase_pdf(phase, w, z.dir);
+        return m;
+    }
+    const Vec3f wo = z.sp.frame.to_local(w);
+    m.f = z.sp.material->eval_and_pdf(z.sp, z.sp.wi, wo, m.pdf_to_light);
+    if (!is_black(m.f)) m.pdf_to_camera = z.sp.material->pdf(z.sp, wo, z.sp.wi);
+    return m;
+}
+
+// The solid-angle density 1 at `from` towards `to` as a density at `to` (area or volume, with
+// the distance-sampling factor of the edge between them, whose transmittance `from` keeps).
+float reverse_density_factor(const PathVertexBase& from, const PathVertexBase& to) {
+    return to_area_density(1.0f, from, to) * to.distance_factor(from.T_in);
 }
 
 }  // namespace
+
+template <class T>
+MergeMis Vcm<T>::merge_mis(size_t light_paths, double r) const {
+    MergeMis vm;
+    vm.merging = options_.vcm_merging;
+    vm.connections = options_.vcm_connections;
+    const double pi = faults_.no_pi_in_kernel ? 1.0 : kPi;
+    vm.eta = double(light_paths) * pi * r * r;
+    vm.eta_volume = faults_.volume_kernel_as_disc ? vm.eta : double(light_paths) * 4.0 / 3.0 * pi * r * r * r;
+    return vm;
+}
 
 template <class T>
 MergeVertex<T> Vcm<T>::merge_vertex(const Vertex* y, int j) {
@@ -45,20 +88,21 @@ MergeVertex<T> Vcm<T>::merge_vertex(const Vertex* y, int j) {
     const Vertex& prev = y[j - 1];
     MergeVertex<T> m;
     m.p = v.p;
-    m.wi = v.sp.frame.to_world(v.sp.wi);
+    m.in_medium = v.kind == VertexKind::Medium;
+    m.wi = m.in_medium ? v.dir : v.sp.frame.to_world(v.sp.wi);
     m.power = v.beta;
     m.vertex = uint16_t(j);
     m.dispersed = v.dispersed;
     m.pdf_fwd = v.pdf_fwd;
     m.prev_pdf_fwd = prev.pdf_fwd;
-    m.prev_g = to_area_density(1.0f, v, prev);
+    m.prev_g = reverse_density_factor(v, prev);
     m.mis_running = float(v.mis_running);
     m.prev_delta = prev.delta;
     return m;
 }
 
 template <class T>
-uint64_t Vcm<T>::trace_light_paths(const RenderContext& ctx, uint64_t pass, const Wavelengths& wl, const MergeMis& vm) {
+uint64_t Vcm<T>::trace_light_paths(const RenderContext& ctx, uint64_t pass, const Wavelengths& wl, const MergeMis& vm, int hero) {
     const size_t paths = ctx.pixel_count(), per_chunk = Bdpt<T>::chunk_size(paths), chunks = (paths + per_chunk - 1) / per_chunk;
     chunk_vertices_.resize(chunks);
     chunk_photons_.resize(chunks + 1);
@@ -76,7 +120,7 @@ uint64_t Vcm<T>::trace_light_paths(const RenderContext& ctx, uint64_t pass, cons
         for (size_t j = c * per_chunk; j < std::min(paths, (c + 1) * per_chunk); ++j) {
             // Light path j is pixel j's, from bdpt's stream: the same path bdpt would connect.
             Sampler sampler(ctx.seed, Bdpt<T>::sample_stream(j, 1), pass, ctx.sampler);
-            bdpt_.light_subpath(ctx, sampler, wl, path, &vm);
+            bdpt_.light_subpath(ctx, sampler, wl, path, &vm, hero);
             path_begin_[j] = uint32_t(vertices.size());
             path_length_[j] = uint16_t(path.size());
             for (size_t v = 1; v < path.size(); ++v) photons += is_photon(path[v], v, max_bounces);
@@ -89,6 +133,8 @@ uint64_t Vcm<T>::trace_light_paths(const RenderContext& ctx, uint64_t pass, cons
     chunk_photons_[0] = 0;
     for (size_t c = 0; c < chunks; ++c) chunk_photons_[c + 1] += chunk_photons_[c];
     photons_.resize(vm.merging ? chunk_photons_[chunks] : 0);
+    const bool media = ctx.scene.has_media();
+    photon_r_.resize(vm.merging && media ? photons_.size() : 0);
     if (vm.merging) {
         tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
             size_t k = chunk_photons_[c];
@@ -96,7 +142,10 @@ uint64_t Vcm<T>::trace_light_paths(const RenderContext& ctx, uint64_t pass, cons
             for (size_t j = c * per_chunk; j < std::min(paths, (c + 1) * per_chunk); ++j) {
                 const Vertex* y = vertices.data() + path_begin_[j];
                 for (size_t v = 1; v < path_length_[j]; ++v)
-                    if (is_photon(y[v], v, max_bounces)) photons_[k++] = merge_vertex(y, int(v));
+                    if (is_photon(y[v], v, max_bounces)) {
+                        if (media) photon_r_[k] = y[v].r;
+                        photons_[k++] = merge_vertex(y, int(v));
+                    }
             }
         });
     }
@@ -113,7 +162,7 @@ float Vcm<T>::merge_weight(const MergeVertex<T>& photon, float pdf_to_light, flo
     const MisRules rules(bdpt_.power_heuristic(), &vm);
     const Vertex& z = camera[size_t(t - 1)];
     const double light_prev_rev = double(pdf_to_light) * double(photon.prev_g);
-    if (camera_prev_g < 0) camera_prev_g = to_area_density(1.0f, z, camera[size_t(t - 2)]);
+    if (camera_prev_g < 0) camera_prev_g = reverse_density_factor(z, camera[size_t(t - 2)]);
     const double camera_prev_rev = double(pdf_to_camera) * double(camera_prev_g);
     // The light side ends at y_{s-2}, whose density from z is light_prev_rev.
     const double light = rules.h(MisRules::remap0(light_prev_rev) / MisRules::remap0(photon.prev_pdf_fwd)) * double(photon.mis_running);
@@ -122,30 +171,29 @@ float Vcm<T>::merge_weight(const MergeVertex<T>& photon, float pdf_to_light, flo
     const double camera_sum = camera_side_sum(camera.data(), t - 1, z.pdf_fwd, photon.pdf_fwd, psi, true, camera_prev_rev, rules);
     // The connection (s - 1, t) is the reference, 1, where it exists.
     const double reference = vm.connections && !photon.prev_delta ? 1.0 : 0.0;
-    const double own = rules.h((faults_.merge_weight_without_light_pdf ? 1.0 : psi) * vm.eta);
+    const double own = rules.h((faults_.merge_weight_without_light_pdf ? 1.0 : psi) * merge_eta(vm, z.kind));
     const double total = reference + light + camera_sum;
     return total > 0 ? float(own / total) : 0.0f;
 }
 
 template <class T>
-float Vcm<T>::merge_weight(const Vertex* y, int s, const std::vector<Vertex>& camera, int t, const MergeMis& vm) const {
-    const Vertex& z = camera[size_t(t - 1)];
+float Vcm<T>::merge_weight(const Scene& scene, const Vertex* y, int s, const std::vector<Vertex>& camera, int t, const MergeMis& vm) const {
     const MergeVertex<T> photon = merge_vertex(y, s - 1);
-    const Vec3f wp = z.sp.frame.to_local(photon.wi);
-    return merge_weight(photon, z.sp.material->pdf(z.sp, z.sp.wi, wp), z.sp.material->pdf(z.sp, wp, z.sp.wi), camera, t, vm);
+    const MergeScatter<T> m = merge_scatter<T>(scene, camera[size_t(t - 1)], photon.wi);
+    return merge_weight(photon, m.pdf_to_light, m.pdf_to_camera, camera, t, vm);
 }
 
 template <class T>
-float Vcm<T>::merge_weight_oracle(const Vertex* y, int s, const std::vector<Vertex>& camera, int t, const MergeMis& vm) const {
+float Vcm<T>::merge_weight_oracle(const Scene& scene, const Vertex* y, int s, const std::vector<Vertex>& camera, int t,
+                                  const MergeMis& vm) const {
     // As merge_weight, by Veach's ratio walk over both subpaths.
     const Vertex& z = camera[size_t(t - 1)];
     const Vertex& photon = y[s - 1];
-    const Vec3f wp = z.sp.frame.to_local(photon.sp.frame.to_world(photon.sp.wi));
-    const float pdf_to_light = z.sp.material->pdf(z.sp, z.sp.wi, wp);   // z sampling the photon's direction
-    const float pdf_to_camera = z.sp.material->pdf(z.sp, wp, z.sp.wi);  // ... and the camera's, from the photon's
-    const float light_prev_rev = to_area_density(pdf_to_light, photon, y[s - 2]);
-    const float camera_prev_rev = to_area_density(pdf_to_camera, z, camera[size_t(t - 2)]);
-    const MisVertex zm{z.pdf_fwd, photon.pdf_fwd, false, false, true};
+    // z sampling the photon's direction, and the camera's from the photon's.
+    const MergeScatter<T> m = merge_scatter<T>(scene, z, merge_vertex(y, s - 1).wi);
+    const float light_prev_rev = m.pdf_to_light * reverse_density_factor(photon, y[s - 2]);
+    const float camera_prev_rev = m.pdf_to_camera * reverse_density_factor(z, camera[size_t(t - 2)]);
+    const MisVertex zm{z.pdf_fwd, photon.pdf_fwd, false, false, z.kind};
     const auto light_at = [&](int i) {
         MisVertex m = mis_vertex(y[i]);
         if (i == s - 2) m.pdf_rev = light_prev_rev;
@@ -162,35 +210,45 @@ float Vcm<T>::merge_weight_oracle(const Vertex* y, int s, const std::vector<Vert
     // (s - 1, t) is the reference, 1, where it exists.
     const double others = mis_ratio_sum(light_at, s - 1, camera_at, t, power, &vm);
     const double reference = vm.connections && !y[s - 2].delta ? 1.0 : 0.0;
-    double own = (faults_.merge_weight_without_light_pdf ? 1.0 : double(photon.pdf_fwd)) * vm.eta;
+    double own = (faults_.merge_weight_without_light_pdf ? 1.0 : double(photon.pdf_fwd)) * merge_eta(vm, z.kind);
     if (power) own *= own;
     const double total = reference + others;
     return total > 0 ? float(own / total) : 0.0f;
 }
 
 template <class T>
-ColourOf<T> Vcm<T>::merge(const std::vector<Vertex>& camera, int t, float r, const MergeMis& vm, const Wavelengths& wl) const {
+ColourOf<T> Vcm<T>::merge(const Scene& scene, const std::vector<Vertex>& camera, int t, float r, const MergeMis& vm,
+                          const Wavelengths& wl) const {
     const Vertex& z = camera[size_t(t - 1)];
+    const bool in_medium = z.kind == VertexKind::Medium;
+    const bool media = !photon_r_.empty();
     const int max_bounces = bdpt_.max_bounces();
     MergeSum<T> sum;
-    const float camera_prev_g = to_area_density(1.0f, z, camera[size_t(t - 2)]);
+    const float camera_prev_g = reverse_density_factor(z, camera[size_t(t - 2)]);
     grid_.for_each_within(z.p, r, [&](uint32_t k) {
         const MergeVertex<T>& ph = photons_[k];
+        if (ph.in_medium != in_medium) return;
         const int s = int(ph.vertex) + 1;
         const int depth = s + t - 3;
         if (depth > max_bounces || (options_.only_length >= 0 && depth != options_.only_length)) return;
-        const Vec3f wo = z.sp.frame.to_local(ph.wi);
-        float pdf_to_light = 0;
-        const Rgb f = z.sp.material->eval_and_pdf(z.sp, z.sp.wi, wo, pdf_to_light);
-        if (is_black(f)) return;
-        const float pdf_to_camera = z.sp.material->pdf(z.sp, wo, z.sp.wi);
-        sum.add(bsdf_colour(z.sp, wo, f, wl) * ph.power * merge_weight(ph, pdf_to_light, pdf_to_camera, camera, t, vm, camera_prev_g), ph.dispersed);
+        const MergeScatter<T> m = merge_scatter<T>(scene, z, ph.wi);
+        if (is_black(m.f)) return;
+        Colour c = (in_medium ? Colour(m.f.x) : bsdf_colour(z.sp, z.sp.frame.to_local(ph.wi), m.f, wl)) * ph.power *
+                   merge_weight(ph, m.pdf_to_light, m.pdf_to_camera, camera, t, vm, camera_prev_g);
+        // In media: the spectral MIS over the hero channel that both subpaths shared.
+        if (media) c /= path_density_of(photon_r_[k] * z.r, ph.dispersed || z.dispersed);
+        sum.add(c, ph.dispersed);
     });
     // The factor 4 once per path: a dispersed photon counts 4 times against a camera path of 4
     // lanes; against a dispersed camera path once, and that path's own hero_only() gives the 4.
     Wavelengths camera_wl = wl;
     if (z.dispersed) camera_wl.terminate_secondary();
-    const Colour m = z.beta * sum.total(camera_wl) / float(norm_);
+    Colour beta = z.beta;
+    if (in_medium) {
+        // Both throughputs include the scattering coefficient at the merged point: the path, once.
+        beta = divide_where_positive(beta, medium_view(scene.medium(z.medium), wl).coefficients(z.p).sigma_s);
+    }
+    const Colour m = beta * sum.total(camera_wl) / float(in_medium ? vm.eta_volume : vm.eta);
     return z.dispersed ? hero_only(m) : m;
 }
 
@@ -204,13 +262,11 @@ PassCounters Vcm<T>::render_passes(const RenderContext& ctx, Film& film, uint64_
         const uint64_t pass = first + uint64_t(k);
         const Wavelengths wl = T::pass_wavelengths(ctx.seed, ctx.sampler, pass);
         const float r = float(progressive_radius(r1, alpha, pass + 1));
-        MergeMis vm;
-        vm.merging = options_.vcm_merging;
-        vm.connections = options_.vcm_connections;
-        norm_ = double(pixels) * (faults_.no_pi_in_kernel ? 1.0 : kPi) * double(r) * double(r);
-        vm.eta = norm_;
-        rays += trace_light_paths(ctx, pass, wl, vm);
-        if (vm.merging) grid_.build_sorted(photons_, r);
+        const MergeMis vm = merge_mis(pixels, r);
+        // In media, one hero channel for every subpath of the iteration (see vcm.hpp).
+        const int hero = Bdpt<T>::sample_hero(ctx, pixels, pass, wl);
+        rays += trace_light_paths(ctx, pass, wl, vm, hero);
+        if (vm.merging) grid_.build_sorted(photons_, r, &photon_r_);
         if (progress) progress((double(k) + 0.25) / count);
         pass_.begin(pixels, chunks);
         const bool filtered = ctx.filter && !ctx.filter->is_box();
@@ -227,7 +283,7 @@ PassCounters Vcm<T>::render_passes(const RenderContext& ctx, Film& film, uint64_
                 SplatList& splats = pass_.chunk(c);
                 for (size_t pixel = size_t(c) * per_chunk; pixel < std::min(pixels, size_t(c + 1) * per_chunk); ++pixel) {
                     Sampler camera_sampler(ctx.seed, pixel, pass, ctx.sampler);
-                    bdpt_.camera_subpath(ctx, pixel, camera_sampler, wl, camera, filtered ? &shift : nullptr, &vm);
+                    bdpt_.camera_subpath(ctx, pixel, camera_sampler, wl, camera, filtered ? &shift : nullptr, &vm, hero);
                     // This pixel's light subpath, as stored (connections only read it).
                     const typename Bdpt<T>::SubpathView light(chunk_vertices_[pixel / per_chunk].data() + path_begin_[pixel],
                                                               path_length_[pixel]);
@@ -245,8 +301,8 @@ PassCounters Vcm<T>::render_passes(const RenderContext& ctx, Film& film, uint64_
                         [&](int, int, const StrategyResult<T>& res) { add(res.L * res.weight, res.splat, res.raster); },
                         [&](int t) {
                             const Vertex& z = camera[size_t(t - 1)];
-                            if (vm.merging && t >= 2 && z.kind == VertexKind::Surface && z.connectible()) {
-                                const Colour m = merge(camera, t, r, vm, wl);
+                            if (vm.merging && t >= 2 && merges_at(z.kind) && z.connectible()) {
+                                const Colour m = merge(ctx.scene, camera, t, r, vm, wl);
                                 if (!is_black(m)) add(m, false, {});
                             }
                         });
@@ -278,21 +334,28 @@ std::vector<ParamInfo> vcm_params() {
 }  // namespace
 
 const IntegratorInfo& vcm_integrator() {
-    static const IntegratorInfo info{"vcm", {}, "vertex connection and merging: bdpt's connections and photon merging, combined by MIS",
-                                     false, true, vcm_params(), [](const IntegratorOptions& o) { return make_for_transport<Vcm>(o); }, false,
-                                     true};
+    static const IntegratorInfo info = [] {
+        IntegratorInfo i{"vcm", {}, "vertex connection and merging: bdpt's connections and photon merging, combined by MIS",
+                         false, true, vcm_params(), [](const IntegratorOptions& o) { return make_for_transport<Vcm>(o); }, false, true};
+        i.media = true;
+        return i;
+    }();
     return info;
 }
 
 const IntegratorInfo& bpm_integrator() {
-    static const IntegratorInfo info{"bpm", {}, "bidirectional photon mapping: merging at every camera vertex, combined by MIS (vcm without connections)",
-                                     false, true, vcm_params(),
-                                     [](IntegratorOptions o) {
-                                         o.vcm_connections = false;
-                                         o.vcm_merging = true;
-                                         return make_for_transport<Vcm>(o);
-                                     },
-                                     false, true};
+    static const IntegratorInfo info = [] {
+        IntegratorInfo i{"bpm", {}, "bidirectional photon mapping: merging at every camera vertex, combined by MIS (vcm without connections)",
+                         false, true, vcm_params(),
+                         [](IntegratorOptions o) {
+                             o.vcm_connections = false;
+                             o.vcm_merging = true;
+                             return make_for_transport<Vcm>(o);
+                         },
+                         false, true};
+        i.media = true;
+        return i;
+    }();
     return info;
 }
 

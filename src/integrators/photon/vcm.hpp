@@ -27,6 +27,19 @@
 // Deterministic: light subpaths are traced in fixed chunks and stored in order, the grid's
 // order is fixed, and the camera pass splats (t = 1) through bdpt's per-chunk lists.
 //
+// Participating media (docs/volumes.md "vcm and bpm in media"): the subpaths scatter in media as
+// bdpt's do, a light vertex in a medium is a photon too, and a camera vertex in a medium merges
+// with the photons in media within the ball of radius r_i around it (the point-point 3D estimator
+// of UPBP, Krivanek et al. 2014): the estimate phase(z, wo, wi_y) beta_y beta_z / (sigma_s(z) N
+// 4/3 pi r_i^3) (both throughputs include the scattering coefficient of their vertex, the path
+// once), weighed with eta_volume = N 4/3 pi r_i^3 and the densities per unit volume
+// (path_vertex.hpp). Surface photons merge at surface vertices only, medium photons at medium
+// vertices only (of any medium within the ball, as a surface merge takes photons of any surface
+// within its disc). All subpaths of an iteration share one hero channel (in RGB; spectrally the
+// hero wavelength is lane 0 of the iteration's wavelengths anyway): a merge joins any light path
+// with any camera path, and its contribution is divided by the channels' mean of their distance
+// densities' product (media/medium.hpp), as a connection's is.
+//
 // Spectral mode (docs/spectral.md "Spectral vcm and bpm"): a merge multiplies a camera throughput
 // by a photon's power, and a connection two subpaths' throughputs, lane by lane, so every camera
 // and light path of an iteration carries the pass's wavelengths (pass_wavelengths, as the photon
@@ -64,6 +77,7 @@ struct MergeVertex : Photon<T> {
 struct VcmFaults {
     bool no_pi_in_kernel = false;  // the merge divides by N r^2 instead of N pi r^2 (also in the MIS)
     bool merge_weight_without_light_pdf = false;  // a merge's own density lacks the light side's density of its vertex
+    bool volume_kernel_as_disc = false;  // a merge in a medium divides by N pi r^2 (the surfaces' kernel; also in the MIS)
 };
 
 template <class T>
@@ -79,11 +93,12 @@ public:
                                const PassProgress& progress) override;
 
     // The light subpaths and photons of iteration `pass` at its wavelengths (kept until the next),
-    // with the running MIS quantities of the strategies in `vm`; returns the rays traced.
-    uint64_t trace_light_paths(const RenderContext& ctx, uint64_t pass, const Wavelengths& wl, const MergeMis& vm);
-    // The merging estimate at camera vertex z_{t-1} (t >= 2) with the current photons, radius r,
-    // MIS-weighted against every strategy in `vm` (times the camera throughput).
-    Colour merge(const std::vector<Vertex>& camera, int t, float r, const MergeMis& vm, const Wavelengths& wl) const;
+    // with the running MIS quantities of the strategies in `vm` and the hero channel of media;
+    // returns the rays traced.
+    uint64_t trace_light_paths(const RenderContext& ctx, uint64_t pass, const Wavelengths& wl, const MergeMis& vm, int hero = -1);
+    // The merging estimate at camera vertex z_{t-1} (t >= 2, on a surface or in a medium) with the
+    // current photons, radius r, MIS-weighted against every strategy in `vm` (times the camera throughput).
+    Colour merge(const Scene& scene, const std::vector<Vertex>& camera, int t, float r, const MergeMis& vm, const Wavelengths& wl) const;
     // The merge vertex of light vertex y_j of the subpath y (with its running MIS quantities).
     static MergeVertex<T> merge_vertex(const Vertex* y, int j);
     // The MIS weight of merging `photon` at camera vertex z_{t-1}, whose BSDF samples the photon's
@@ -94,8 +109,11 @@ public:
                        int t, const MergeMis& vm, float camera_prev_g = -1) const;
     // The MIS weight of merging photon y_{s-1} (light subpath y[0..s)) at camera vertex z_{t-1},
     // by the running quantities as the render does, and by Veach's ratio walk (the tests' oracle).
-    float merge_weight(const Vertex* y, int s, const std::vector<Vertex>& camera, int t, const MergeMis& vm) const;
-    float merge_weight_oracle(const Vertex* y, int s, const std::vector<Vertex>& camera, int t, const MergeMis& vm) const;
+    float merge_weight(const Scene& scene, const Vertex* y, int s, const std::vector<Vertex>& camera, int t, const MergeMis& vm) const;
+    float merge_weight_oracle(const Scene& scene, const Vertex* y, int s, const std::vector<Vertex>& camera, int t,
+                              const MergeMis& vm) const;
+    // The merge densities N pi r^2 (surfaces) and N 4/3 pi r^3 (media) of N light paths and radius r.
+    MergeMis merge_mis(size_t light_paths, double r) const;
 
     const Bdpt<T>& bdpt() const { return bdpt_; }
     size_t photon_count() const { return photons_.size(); }
@@ -114,10 +132,10 @@ private:
     std::vector<uint32_t> path_begin_;    // light path j: its chunk's vertices from here
     std::vector<uint16_t> path_length_;   // ... this many
     std::vector<MergeVertex<T>> photons_;  // made in path order, then sorted into the grid's cells
+    std::vector<Colour> photon_r_;         // in media: each photon's subpath's distance densities (PathVertex::r), in the same order
     PhotonGrid grid_;
     PassImage pass_;
     tbb::enumerable_thread_specific<std::pair<std::vector<Vertex>, std::vector<Vertex>>> subpaths_;  // camera, light
-    double norm_ = 1;  // N pi r^2 of the current iteration
 };
 extern template class Vcm<RgbTransport>;
 extern template class Vcm<SpectralTransport>;

@@ -14,6 +14,7 @@
 #include "geometry/shape_meshes.hpp"
 #include "integrators/bidir/bdpt.hpp"
 #include "integrators/bidir/light_tracer.hpp"
+#include "integrators/photon/sppm.hpp"
 #include "integrators/photon/vcm.hpp"
 #include "judge/image_statistics.hpp"
 #include "render_helpers.hpp"
@@ -143,6 +144,39 @@ TEST(BidirMedia, VcmAndBpmAgreeWithVolpath) {
     }
 }
 
+// sppm in media, both volume estimates: the beam radiance estimate along the camera rays (the
+// default) from a radius of 5% of the scene's, and the 3D kernel at the camera path's first
+// scattering point from 10% (it needs a photon within the ball around one sampled point: with
+// fewer than one on average, as at 5% here, its pixel means are too skewed for these z-tests),
+// 4096 photons per iteration, 256 iterations. (ppm is the same code through the pixel centres:
+// its image is not volpath's pixel average; see OneAndTwoThreadsGiveTheSameBytes.)
+RenderResult sppm_render(const SceneDescription& d, bool beams, float radius_fraction, SppmFaults faults = {}) {
+    IntegratorOptions o = depth_options();
+    o.photons = 4096;
+    o.photon_radius = radius_fraction * Scene::build(d)->scene_sphere().radius;
+    o.volume_beam = beams;
+    Sppm<RgbTransport> sppm(o, faults);
+    return render_integrator(d, sppm, kSize, kSize, 256, 24);
+}
+
+TEST(BidirMedia, SppmAgreesWithVolpathByBeamsAndByPoints) {
+    const std::vector<MediaScene> scenes = media_scenes();
+    for (size_t i = 0; i < scenes.size(); ++i) {
+        const RenderResult& ref = references()[i].volpath;
+        for (const bool beams : {true, false}) {
+            const AgreementResult res = agreement(sppm_render(scenes[i].d, beams, beams ? 0.05f : 0.1f), ref);
+            EXPECT_TRUE(res.agree) << scenes[i].name << ", sppm " << (beams ? "beams" : "points") << ": " << res.describe();
+        }
+    }
+}
+
+// The tests of the test: beams without their transmittance, and points with the disc's kernel.
+TEST(BidirMedia, SppmWithoutTheBeamsTransmittanceOrWithTheDiscKernelIsDetected) {
+    const MediaScene s = media_scenes()[0];
+    EXPECT_FALSE(agreement(sppm_render(s.d, true, 0.05f, SppmFaults{.beam_without_transmittance = true}), references()[0].volpath).agree);
+    EXPECT_FALSE(agreement(sppm_render(s.d, false, 0.1f, SppmFaults{.volume_kernel_as_disc = true}), references()[0].volpath).agree);
+}
+
 // The test of the test: merging in a medium with the surfaces' kernel (N pi r^2, in the estimate
 // and the MIS) is too dark where merges carry weight.
 TEST(BidirMedia, AMediumMergeWithTheDiscKernelIsDetected) {
@@ -156,7 +190,7 @@ TEST(BidirMedia, AMediumMergeWithTheDiscKernelIsDetected) {
     EXPECT_FALSE(res.agree) << res.describe();
 }
 
-TEST(BidirMedia, BdptAndVcmInSpectralModeAgreeWithVolpath) {
+TEST(BidirMedia, BdptVcmAndSppmInSpectralModeAgreeWithVolpath) {
     const MediaScene s = media_scenes()[0];
     IntegratorOptions o = depth_options();
     o.spectral = true;
@@ -167,6 +201,13 @@ TEST(BidirMedia, BdptAndVcmInSpectralModeAgreeWithVolpath) {
         const RenderResult b = render_integrator(s.d, *find_integrator(a)->make(o), kSize, kSize, 1024, 32);
         const AgreementResult r = agreement(b, v);
         EXPECT_TRUE(r.agree) << a << ": " << r.describe();
+    }
+    o.photons = 4096;
+    o.photon_radius = 0.05f * Scene::build(s.d)->scene_sphere().radius;
+    {
+        const RenderResult b = render_integrator(s.d, *find_integrator("sppm")->make(o), kSize, kSize, 256, 33);
+        const AgreementResult r = agreement(b, v);
+        EXPECT_TRUE(r.agree) << "sppm: " << r.describe();
     }
 }
 
@@ -182,7 +223,7 @@ TEST(BidirMedia, AConnectionWithoutItsTransmittanceIsDetected) {
 TEST(BidirMedia, OneAndTwoThreadsGiveTheSameBytes) {
     for (const char* f : {"scenes/fog-box.xml", "scenes/smoke.xml"}) {
         const SceneDescription d = load_scene_file(source_path(f));
-        for (const char* a : {"bdpt", "lt", "vcm", "bpm"}) {
+        for (const char* a : {"bdpt", "lt", "vcm", "bpm", "sppm", "ppm"}) {
             const auto with_threads = [&](int threads) {
                 tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
                 return render_scene(d, a, 16, 12, 4, 5);

@@ -174,7 +174,7 @@ TEST(SppmAgreement, DirectLightAloneAgreesWithThePathTracer) {
 TEST(SppmSceneFile, ParametersComeFromTheFileUnlessTheCommandLineGivesThem) {
     const std::string text = R"(<scene version="3.0.0">
         <integrator type="sppm"><integer name="photonCount" value="3000"/><float name="initial_radius" value="0.04"/>
-            <float name="alpha" value="0.5"/></integrator>
+            <float name="alpha" value="0.5"/><string name="volume_estimate" value="points"/></integrator>
         <shape type="rectangle"/><emitter type="constant"/></scene>)";
     const SceneDescription d = load_scene_text(text, "photons.xml", ".");
     RenderJob from_file(scene_choice_of(d), JobRequest{});
@@ -182,12 +182,24 @@ TEST(SppmSceneFile, ParametersComeFromTheFileUnlessTheCommandLineGivesThem) {
     EXPECT_EQ(from_file.integrator_options().photons, 3000);
     EXPECT_FLOAT_EQ(from_file.integrator_options().photon_radius, 0.04f);
     EXPECT_DOUBLE_EQ(from_file.integrator_options().photon_alpha, 0.5);
+    EXPECT_FALSE(from_file.integrator_options().volume_beam);
+    EXPECT_TRUE(RenderJob(scene_choice_of(load_scene_text("<scene version=\"3.0.0\"><integrator type=\"sppm\"/><shape type=\"rectangle\"/><emitter type=\"constant\"/></scene>", "default.xml", ".")),
+                          JobRequest{}).integrator_options().volume_beam);
     JobRequest r;
-    r.photons = 500, r.photon_alpha = 0.75;
+    r.photons = 500, r.photon_alpha = 0.75, r.volume_beam = true;
     RenderJob overridden(scene_choice_of(d), r);
     EXPECT_EQ(overridden.integrator_options().photons, 500);
     EXPECT_DOUBLE_EQ(overridden.integrator_options().photon_alpha, 0.75);
     EXPECT_FLOAT_EQ(overridden.integrator_options().photon_radius, 0.04f);
+    EXPECT_TRUE(overridden.integrator_options().volume_beam);
+    try {
+        load_scene_text("<scene version=\"3.0.0\">\n<integrator type=\"sppm\"><string name=\"volume_estimate\" value=\"line\"/></integrator></scene>",
+                        "bad.xml", ".");
+        ADD_FAILURE() << "volume_estimate = line was accepted";
+    } catch (const std::exception& e) {
+        EXPECT_NE(std::string(e.what()).find("bad.xml:2"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("volume_estimate must be beam or points, got 'line'"), std::string::npos) << e.what();
+    }
     try {
         load_scene_text("<scene version=\"3.0.0\">\n<integrator type=\"sppm\"><float name=\"alpha\" value=\"1.5\"/></integrator></scene>",
                         "bad.xml", ".");

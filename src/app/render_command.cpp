@@ -107,6 +107,9 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
                    "sppm, ppm, vcm, bpm: the first iteration's photon radius (default two pixel footprints at the scene's centre); pm: a fixed "
                    "radius instead of the k nearest");
     app.add_option("--alpha", o.photon_alpha, "sppm, ppm, vcm, bpm: the radius reduction, in (0, 1] (default 2/3)");
+    app.add_option("--volume-estimate", o.volume_estimate,
+                   "sppm, ppm in media: beam (the beam radiance estimate along the camera rays, default) or points (the 3D kernel at "
+                   "the camera path's first scattering point)");
     app.add_flag("--no-merging", o.no_merging, "vcm: connections only (then it is bdpt)");
     app.add_flag("--no-connections", o.no_connections, "vcm: merging only (then it is bpm)");
     app.add_option("--ic-rays", o.ic_rays, "ic: rays per irradiance record (stratified; default 256)");
@@ -167,6 +170,11 @@ std::vector<RenderJob> make_jobs(const RenderCommandOptions& o, bool check_paths
     request.photons = o.photons;
     request.photon_radius = o.photon_radius;
     request.photon_alpha = o.photon_alpha;
+    if (o.volume_estimate) {
+        if (*o.volume_estimate != "beam" && *o.volume_estimate != "points")
+            throw UsageError(fmt::format("unknown volume estimate '{}'. Valid estimates: beam, points", *o.volume_estimate));
+        request.volume_beam = *o.volume_estimate == "beam";
+    }
     request.vcm_merging = !o.no_merging;
     request.vcm_connections = !o.no_connections;
     if (o.ic_rays && (*o.ic_rays < 4 || *o.ic_rays > 65536)) throw UsageError(fmt::format("--ic-rays must be 4 to 65536, got {}", *o.ic_rays));
@@ -262,6 +270,8 @@ std::vector<RenderJob> make_jobs(const RenderCommandOptions& o, bool check_paths
             throw UsageError(fmt::format("--radius sets the photon radius of sppm, ppm, pm, vcm and bpm; {} has none", algorithm));
         if (o.photon_alpha && !one_of({"sppm", "ppm", "vcm", "bpm"}))
             throw UsageError(fmt::format("--alpha is the radius reduction of sppm, ppm, vcm and bpm, not {}'s", algorithm));
+        if (o.volume_estimate && !one_of({"sppm", "ppm"}))
+            throw UsageError(fmt::format("--volume-estimate chooses how sppm and ppm gather photons in media; {} has no such choice", algorithm));
         if (o.mis == "power" && !one_of({"bdpt", "vcm", "bpm"}))
             throw UsageError(fmt::format("--mis chooses the heuristic of bdpt, vcm and bpm; {} has its own", algorithm));
         const bool ic_options = o.ic_rays || o.ic_error || o.ic_no_gradients || !o.ic_records.empty();

@@ -38,6 +38,7 @@ struct RenderCommandOptions {
     std::optional<int64_t> photons;
     std::optional<float> photon_radius;
     std::optional<double> photon_alpha;
+    std::optional<std::string> volume_estimate;
     bool no_merging = false;      // vcm: connections only (= bdpt)
     bool no_connections = false;  // vcm: merging only (= bpm)
     std::optional<int> ic_rays;

@@ -95,6 +95,7 @@ RenderJob::RenderJob(SceneChoice scene, const JobRequest& r) : choice_(std::move
     options_.photons = r.photons ? *r.photons : d.photons.value_or(0);
     options_.photon_radius = r.photon_radius ? *r.photon_radius : d.photon_radius.value_or(0.0f);
     options_.photon_alpha = r.photon_alpha ? *r.photon_alpha : d.photon_alpha.value_or(2.0 / 3.0);
+    options_.volume_beam = r.volume_beam ? *r.volume_beam : d.volume_beam.value_or(true);
     options_.vcm_merging = r.vcm_merging;
     options_.vcm_connections = r.vcm_connections;
     options_.ic_rays = r.ic_rays ? *r.ic_rays : d.ic_rays.value_or(options_.ic_rays);

@@ -12,7 +12,9 @@
 //                                                  channel (factor > 1 inflates them: the tests)
 #pragma once
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "media/majorant_grid.hpp"
 #include "samplers/sampler.hpp"
@@ -146,6 +148,55 @@ typename View::Colour estimate_transmittance(const View& m, const Vec3f& o, cons
         }
     }
     return T;
+}
+
+// The transmittance from o along o + t d for every t in [0, tmax] at once (the beam radiance
+// estimate needs it at many points of one ray): exp(-sigma_t t) where the extinction is
+// constant; else one ratio-tracking walk, whose running product after the tentative collisions
+// before t is an unbiased estimate of T(0, t) for every t (a roulette that ends it makes the
+// rest 0, one that keeps it divides by its probability: still unbiased for every prefix).
+template <class Colour>
+struct TransmittanceTrack {
+    bool constant = false;
+    Colour sigma_t{0.0f};
+    std::vector<float> t;   // the tentative collisions, increasing
+    std::vector<Colour> T;  // the estimate after each
+
+    Colour at(float distance) const {
+        if (constant) return homogeneous_transmittance(sigma_t, distance);
+        const size_t k = size_t(std::upper_bound(t.begin(), t.end(), distance) - t.begin());
+        return k == 0 ? Colour(1.0f) : T[k - 1];
+    }
+};
+
+template <class View>
+void track_transmittance(const View& m, const Vec3f& o, const Vec3f& d, float tmax, Sampler& rng,
+                         TransmittanceTrack<typename View::Colour>& track) {
+    using Colour = typename View::Colour;
+    using namespace free_flight_detail;
+    track.t.clear(), track.T.clear();
+    track.constant = m.constant_extinction(track.sigma_t);
+    if (track.constant) return;
+    float scale;
+    MajorantIterator pieces = m.majorants(o, d, tmax, 1.0f, scale);
+    MajorantSegment seg;
+    Colour T(1.0f);
+    while (pieces.next(seg)) {
+        const float sigma_maj = seg.sigma_maj * scale;
+        if (!(sigma_maj > 0)) continue;
+        for (float t = seg.t0;;) {
+            t += exponential(rng) / sigma_maj;
+            if (t >= seg.t1) break;
+            T *= max(Colour(0.0f), Colour(1.0f) - m.extinction(o + d * t) / sigma_maj);
+            if (const float q = max_component(T); q < 0.1f) {
+                if (rng.next1d() >= q) T = Colour(0.0f);
+                else T /= q;
+            }
+            track.t.push_back(t);
+            track.T.push_back(T);
+            if (is_black(T)) return;
+        }
+    }
 }
 
 }  // namespace pathlab

@@ -80,6 +80,11 @@ void read_plain_integrator(XmlSource& xml, const pugi::xml_node& n, SceneBuilder
             if (!(a > 0 && a <= 1)) p.fail("alpha", fmt::format("alpha must be in (0, 1], got {}", a));
             b.desc.photon_alpha = a;
         }
+        if (plugin.find("volume_estimate") && p.has("volume_estimate")) {
+            const std::string v = p.get_string("volume_estimate");
+            if (v != "beam" && v != "points") p.fail("volume_estimate", fmt::format("volume_estimate must be beam or points, got '{}'", v));
+            b.desc.volume_beam = v == "beam";
+        }
         // ic (Mitsuba 0.6's irrcache: resolution R means R x 3R rays; gradients, clampNeighbor and
         // clampScreen switch the same things; its quality, a weight of Tabellion and Lamorlette's
         // error with another radius, has no counterpart and is refused as unknown).

@@ -57,7 +57,7 @@ Volume read_volume(XmlSource& xml, const pugi::xml_node& n, const SceneBuilder& 
 
 const PluginInfo& null_bsdf_plugin() {
     static const PluginInfo info{"bsdf", "null",
-                                 "no surface at all: an index-matched boundary between media (volpath, lt and bdpt see it)", {}};
+                                 "no surface at all: an index-matched boundary between media (the integrators that render media see it)", {}};
     return info;
 }
 

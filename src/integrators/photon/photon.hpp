@@ -5,6 +5,8 @@
 
 #include <cstdint>
 
+#include "integrators/bidir/path_vertex.hpp"
+#include "integrators/common/path_rules.hpp"
 #include "integrators/common/transport.hpp"
 
 namespace pathlab {
@@ -14,10 +16,18 @@ struct Photon {
     Vec3f p;
     Vec3f wi;                 // world direction back towards where the photon came from
     ColourOf<T> power;        // throughput of its light path up to here
-    uint16_t vertex;          // its index j on the light subpath (y_0 is on the light): j - 1 bounces before it
-    bool dispersed = false;   // its light path met a dispersive interface: it carries the hero alone
-    bool in_medium = false;   // scattered in a medium (its power includes sigma_s there), not on a surface
+    uint16_t vertex : 15;     // its index j on the light subpath (y_0 is on the light): j - 1 bounces before it
+    uint16_t dispersed : 1;   // its light path met a dispersive interface: it carries the hero alone
+    // Where it scattered in a medium (its power includes sigma_s there): that medium; -1 on a surface.
+    int16_t medium = -1;
+
+    bool in_medium() const { return medium >= 0; }
 };
+static_assert(kMaxBounces + 1 < (1 << 15));
+
+// The `medium` of a photon at light vertex v.
+template <class Vertex>
+int16_t photon_medium(const Vertex& v) { return v.kind == VertexKind::Medium ? int16_t(v.medium) : int16_t(-1); }
 
 // The sum of f(x, wo, wi_p) power_p (times any weight) over the photons merged at one camera
 // vertex, in transport T's colour. Spectral mode keeps photons that carry the hero alone apart

@@ -56,8 +56,7 @@ uint64_t PhotonMapper<T>::build_maps(const RenderContext& ctx, uint64_t pass, co
                 const PathVertex<T>& y = path[v];
                 if (y.kind != VertexKind::Surface) break;
                 if (y.connectible()) {
-                    const Photon<T> ph{y.p, y.sp.frame.to_world(y.sp.wi), y.beta / float(paths), uint16_t(std::min<size_t>(v, 65535)),
-                                       y.dispersed};
+                    const Photon<T> ph{y.p, y.sp.frame.to_world(y.sp.wi), y.beta / float(paths), uint16_t(v), y.dispersed};
                     global.push_back(ph);
                     if (v >= 2 && through_dirac_only) caustic.push_back(ph);
                 }

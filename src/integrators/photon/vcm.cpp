@@ -88,8 +88,8 @@ MergeVertex<T> Vcm<T>::merge_vertex(const Vertex* y, int j) {
     const Vertex& prev = y[j - 1];
     MergeVertex<T> m;
     m.p = v.p;
-    m.in_medium = v.kind == VertexKind::Medium;
-    m.wi = m.in_medium ? v.dir : v.sp.frame.to_world(v.sp.wi);
+    m.medium = photon_medium(v);
+    m.wi = m.in_medium() ? v.dir : v.sp.frame.to_world(v.sp.wi);
     m.power = v.beta;
     m.vertex = uint16_t(j);
     m.dispersed = v.dispersed;
@@ -221,13 +221,15 @@ ColourOf<T> Vcm<T>::merge(const Scene& scene, const std::vector<Vertex>& camera,
                           const Wavelengths& wl) const {
     const Vertex& z = camera[size_t(t - 1)];
     const bool in_medium = z.kind == VertexKind::Medium;
+    // Photons of the same medium only (in a medium; a ball may reach across a boundary).
+    const int16_t merged_medium = photon_medium(z);
     const bool media = !photon_r_.empty();
     const int max_bounces = bdpt_.max_bounces();
     MergeSum<T> sum;
     const float camera_prev_g = reverse_density_factor(z, camera[size_t(t - 2)]);
     grid_.for_each_within(z.p, r, [&](uint32_t k) {
         const MergeVertex<T>& ph = photons_[k];
-        if (ph.in_medium != in_medium) return;
+        if (ph.medium != merged_medium) return;
         const int s = int(ph.vertex) + 1;
         const int depth = s + t - 3;
         if (depth > max_bounces || (options_.only_length >= 0 && depth != options_.only_length)) return;

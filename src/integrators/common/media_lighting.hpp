@@ -1,0 +1,137 @@
+// Direct light where a path scatters in a scene with media (a surface, or a point in a medium),
+// as volpath gathers it at every vertex and the photon methods (sppm, ppm) at their visible
+// points: a light sample whose shadow ray carries its transmittance, and a BSDF or phase sample
+// whose walk through the media may reach an emitter, combined by the balance heuristic. The
+// sample's walk is also the path's continuation (volpath goes on along it).
+#pragma once
+
+#include "integrators/common/direct_lighting.hpp"
+#include "integrators/common/media_walk.hpp"
+
+namespace pathlab {
+
+// A point where the path scatters: a surface (sp) or a point in a medium (phase).
+struct ScatterVertex {
+    const ShadingPoint* sp = nullptr;
+    const MediumWalk* hit = nullptr;  // the walk that ended on the surface (its geometric normal, its shape's media)
+    Vec3f p;
+    Vec3f wi;  // medium vertices: unit world direction back along the path
+    const PhaseFunction* phase = nullptr;
+    int32_t medium = -1;  // the medium the path arrived in
+};
+
+// Next-event estimation at a vertex: pt-mis's estimate_light_sample (the same random numbers,
+// the same arithmetic at a surface), with the shadow ray's transmittance.
+template <class T>
+ColourOf<T> estimate_light(const Scene& scene, const ScatterVertex& v, Sampler& sampler, MediumState<T>& st, bool mis,
+                           WavelengthsOf<T>& wl) {
+    using Colour = ColourOf<T>;
+    const LightChoice choice = scene.choose_light(sampler.next1d());
+    const Vec2f u = sampler.next2d();
+    if (choice.index < 0) return Colour(0.0f);
+    const auto ls = sample_light(scene.lights()[size_t(choice.index)], v.p, u);
+    if (!ls || is_black(ls->Le)) return Colour(0.0f);
+    Colour f;
+    float pdf_scatter, cosine;
+    Ray shadow;
+    int32_t medium = v.medium;
+    if (v.sp) {
+        const ShadingPoint& sp = *v.sp;
+        if (dot(ls->wi, sp.ng) <= 0 && !sp.material->is_dielectric()) return Colour(0.0f);
+        const Vec3f wo = sp.frame.to_local(ls->wi);
+        f = bsdf_eval(sp, wo, wl, pdf_scatter);
+        if (is_black(f)) return Colour(0.0f);
+        cosine = std::abs(wo.z);
+        shadow = std::isinf(ls->distance) ? spawn_ray(sp.p, sp.ng, ls->wi) : spawn_segment(sp.p, sp.ng, ls->point, ls->normal);
+        medium = medium_after(v.hit->media, v.hit->isect.ng, ls->wi, medium);
+    } else {
+        const float p = phase_eval(*v.phase, v.wi, ls->wi);
+        if (!(p > 0)) return Colour(0.0f);
+        f = Colour(p);
+        pdf_scatter = phase_pdf(*v.phase, v.wi, ls->wi);
+        cosine = 1;
+        if (std::isinf(ls->distance)) {
+            shadow = Ray{v.p, ls->wi, kInf};
+        } else {
+            const Vec3f to = is_black(ls->normal) ? ls->point
+                                                  : offset_ray_origin(ls->point, dot(ls->point - v.p, ls->normal) <= 0 ? ls->normal : -ls->normal);
+            shadow = Ray{v.p, to - v.p, 1.0f - 1e-4f};
+        }
+    }
+    const Colour Tr = shadow_transmittance(scene, shadow, medium, st);
+    if (is_black(Tr)) return Colour(0.0f);
+    const float pdf_light = choice.pmf * ls->pdfW;
+    const float weight = !ls->delta ? (mis ? balance_heuristic(pdf_light, pdf_scatter) : 1.0f) : 1.0f;
+    const Colour contribution = f * light_colour(scene, choice.index, ls->Le, wl) * (cosine * weight / pdf_light);
+    return scene.has_media() ? contribution * Tr : contribution;
+}
+
+// The radiance a walk that ended on a surface or in the sky finds (Le towards the path, in RGB),
+// the density with which light sampling at `from` would have chosen it (trace_to_emitter's), and
+// the light it belongs to.
+inline EmitterHit emission_found(const Scene& scene, const MediumWalk& w, const Vec3f& from, int& light) {
+    EmitterHit e;
+    light = -1;
+    if (w.kind == MediumWalk::kEscaped) {
+        const int env = scene.environment_light();
+        if (env >= 0) {
+            light = env;
+            e.Le = scene.escaped_radiance(w.dir);
+            e.pdf_light = scene.light_pmf(env) * environment_pdf_li(scene.lights()[size_t(env)], w.dir);
+        }
+    } else if (w.kind == MediumWalk::kSurface) {
+        e.Le = emitted_radiance(scene, w.isect, -w.dir / length(w.dir));
+        if (!is_black(e.Le)) {
+            light = w.isect.light;
+            const Light& l = scene.lights()[size_t(w.isect.light)];
+            e.pdf_light = scene.light_pmf(w.isect.light) * surface_light_pdf_li(l, from, w.isect.p, w.isect.ng);
+        }
+    }
+    return e;
+}
+
+// A BSDF or phase sample at a vertex and the walk along it.
+template <class T>
+struct ScatterSample {
+    bool sampled = false;             // false: no sample (the path ends, nothing found)
+    MediumWalk next;                  // the walk along the sampled direction
+    ColourOf<T> next_seg{1.0f};       // its free-flight weights
+    ColourOf<T> weight{0.0f};         // f cos / pdf of the sampled direction
+    ColourOf<T> found{0.0f};          // the emission the walk reached, times f cos / pdf and the MIS weight against light sampling
+};
+
+// The second half of the MIS pair at v (the first is estimate_light): a BSDF sample at a surface
+// (whose vertex and walk are v.sp and v.hit) or a phase sample in a medium, and the emission its
+// walk finds; the caller adds beta * next_seg * found / density.
+template <class T>
+ScatterSample<T> sample_scatter(const Scene& scene, const ScatterVertex& v, Sampler& sampler, MediumState<T>& st, bool mis,
+                                WavelengthsOf<T>& wl) {
+    using Colour = ColourOf<T>;
+    ScatterSample<T> n;
+    int light;
+    if (v.sp) {
+        const ShadingPoint& sp = *v.sp;
+        const MediumWalk& w = *v.hit;
+        const auto s = bsdf_sample(sp, sampler.next2d(), wl);
+        if (!s) return n;
+        n.sampled = true;
+        n.next = walk_media(scene, sp.spawn(s->wo), medium_after(w.media, w.isect.ng, sp.frame.to_world(s->wo), w.medium), st, n.next_seg);
+        const Colour f = bsdf_sample_colour(sp, *s, wl);
+        n.weight = f * (std::abs(s->wo.z) / s->pdfW);
+        const EmitterHit e = emission_found(scene, n.next, sp.p, light);
+        const float weight = s->delta ? 1.0f : (mis ? balance_heuristic(s->pdfW, e.pdf_light) : 0.0f);
+        if (!is_black(e.Le)) n.found = f * light_colour(scene, light, e.Le, wl) * (std::abs(s->wo.z) * weight / s->pdfW);
+    } else {
+        const PhaseSample ps = phase_sample(*v.phase, v.wi, sampler.next2d());
+        if (!(ps.pdfW > 0)) return n;
+        n.sampled = true;
+        n.next = walk_media(scene, Ray{v.p, ps.wo, kInf}, v.medium, st, n.next_seg);
+        const EmitterHit e = emission_found(scene, n.next, v.p, light);
+        const float weight = mis ? balance_heuristic(ps.pdfW, e.pdf_light) : 0.0f;
+        if (!is_black(e.Le)) n.found = Colour(ps.p) * light_colour(scene, light, e.Le, wl) * (weight / ps.pdfW);
+        n.weight = Colour(ps.p / ps.pdfW);
+    }
+    return n;
+}
+
+}  // namespace pathlab

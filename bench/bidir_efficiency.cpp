@@ -43,11 +43,12 @@ void judge_images(const std::vector<std::string>& specs, const Reference& ref) {
 
 void bidir_efficiency_suite(const BidirEfficiencyOptions& o) {
     const int threads = tbb::info::default_concurrency();
-    fmt::print("# Bidirectional methods against pt-mis at {0}x{0}, {1} iterations per render, {2} threads, medians of {3}{4}\n\n", o.size,
-               o.iterations, threads, o.repeats, o.max_depth > 0 ? fmt::format(", at most {} bounces", o.max_depth) : "");
+    fmt::print("# Bidirectional methods against {5} at {0}x{0}, {1} iterations per render, {2} threads, medians of {3}{4}\n\n", o.size,
+               o.iterations, threads, o.repeats, o.max_depth > 0 ? fmt::format(", at most {} bounces", o.max_depth) : "",
+               o.algorithms.front());
     fmt::print("MSE per sample = MSE x iterations, against bdpt at {} spp (its noise subtracted); efficiency = 1 / (MSE x seconds), "
-               "relative to pt-mis's.\n",
-               o.ref_spp);
+               "relative to {}'s.\n",
+               o.ref_spp, o.algorithms.front());
     for (const std::string& key : o.scenes) {
         const auto scene = Scene::build(load_scene_file(std::string(PATHLAB_SOURCE_DIR) + "/scenes/" + key));
         const auto t0 = std::chrono::steady_clock::now();

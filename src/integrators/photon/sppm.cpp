@@ -139,8 +139,9 @@ ColourOf<T> Sppm<T>::beam(const Vec3f& o, const Vec3f& d, float tmax, int32_t me
             if (!(tp >= a && tp < b) || dot(op, op) - tp * tp > r2) return;
             const int bounces = t + int(ph.vertex) - 1;
             if (bounces > max_bounces_ || !counts(bounces)) return;
-            // The camera side is not sampled by distance here: the photon's density alone.
-            const Colour c = (faults_.beam_without_transmittance ? Colour(1.0f) : Tr.at(tp)) * phase_eval(phase, wi, ph.wi) * ph.power / path_density_of(photon_r_[i], ph.dispersed);
+            // The camera side is not sampled by distance here: the photon's densities alone.
+            const Colour Tp = faults_.beam_without_transmittance ? Colour(1.0f) : Tr.at(tp);
+            const Colour c = Tp * phase_eval(phase, wi, ph.wi) * ph.power / path_density_of(photon_r_[i], ph.dispersed || camera_dispersed);
             sum.add(c, ph.dispersed);
         });
     }

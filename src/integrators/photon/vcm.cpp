@@ -41,15 +41,13 @@ bool is_photon(const Vertex& y, size_t j, int max_bounces) {
 // What a merge at vertex v needs of its scattering towards the world direction w (a photon's):
 // the BSDF (or phase function) value, and the solid-angle densities of sampling w from v's own
 // arrival direction and of sampling that from w.
-template <class T>
 struct MergeScatter {
     Rgb f{0.0f};  // (a phase function's value is grey)
     float pdf_to_light = 0, pdf_to_camera = 0;
 };
 
-template <class T>
-MergeScatter<T> merge_scatter(const Scene& scene, const PathVertexBase& z, const Vec3f& w) {
-    MergeScatter<T> m;
+MergeScatter merge_scatter(const Scene& scene, const PathVertexBase& z, const Vec3f& w) {
+    MergeScatter m;
     if (z.kind == VertexKind::Medium) {
         const PhaseFunction& phase = medium_phase(scene.medium(z.medium));
         m.f = Rgb(phase_eval(phase, z.dir, w));
@@ -179,7 +177,7 @@ float Vcm<T>::merge_weight(const MergeVertex<T>& photon, float pdf_to_light, flo
 template <class T>
 float Vcm<T>::merge_weight(const Scene& scene, const Vertex* y, int s, const std::vector<Vertex>& camera, int t, const MergeMis& vm) const {
     const MergeVertex<T> photon = merge_vertex(y, s - 1);
-    const MergeScatter<T> m = merge_scatter<T>(scene, camera[size_t(t - 1)], photon.wi);
+    const MergeScatter m = merge_scatter(scene, camera[size_t(t - 1)], photon.wi);
     return merge_weight(photon, m.pdf_to_light, m.pdf_to_camera, camera, t, vm);
 }
 
@@ -190,7 +188,7 @@ float Vcm<T>::merge_weight_oracle(const Scene& scene, const Vertex* y, int s, co
     const Vertex& z = camera[size_t(t - 1)];
     const Vertex& photon = y[s - 1];
     // z sampling the photon's direction, and the camera's from the photon's.
-    const MergeScatter<T> m = merge_scatter<T>(scene, z, merge_vertex(y, s - 1).wi);
+    const MergeScatter m = merge_scatter(scene, z, merge_vertex(y, s - 1).wi);
     const float light_prev_rev = m.pdf_to_light * reverse_density_factor(photon, y[s - 2]);
     const float camera_prev_rev = m.pdf_to_camera * reverse_density_factor(z, camera[size_t(t - 2)]);
     const MisVertex zm{z.pdf_fwd, photon.pdf_fwd, false, false, z.kind};
@@ -233,7 +231,7 @@ ColourOf<T> Vcm<T>::merge(const Scene& scene, const std::vector<Vertex>& camera,
         const int s = int(ph.vertex) + 1;
         const int depth = s + t - 3;
         if (depth > max_bounces || (options_.only_length >= 0 && depth != options_.only_length)) return;
-        const MergeScatter<T> m = merge_scatter<T>(scene, z, ph.wi);
+        const MergeScatter m = merge_scatter(scene, z, ph.wi);
         if (is_black(m.f)) return;
         Colour c = (in_medium ? Colour(m.f.x) : bsdf_colour(z.sp, z.sp.frame.to_local(ph.wi), m.f, wl)) * ph.power *
                    merge_weight(ph, m.pdf_to_light, m.pdf_to_camera, camera, t, vm, camera_prev_g);

@@ -188,6 +188,22 @@ TEST_F(Cli, IcOptionsRecordsAndStatistics) {
     EXPECT_GE(stats["integrator"]["records_gathered"].get<double>(), stats["integrator"]["records"].get<double>());
 }
 
+// Sample indices that would wrap round (issue 45: --first-sample 2^64 - 1 rendered for a minute
+// and wrote an image of 0 samples) are refused before anything renders; the last valid ones render.
+TEST_F(Cli, SampleIndicesPastTheLastAreRefusedUpFront) {
+    for (const char* first : {"18446744073709551615", "4611686018427387904"}) {
+        const CliResult r = run({"-s", "2", "--first-sample", first, "--resolution", "8x8", "-o", path("far.exr")});
+        EXPECT_EQ(r.code, 2) << first;
+        EXPECT_TRUE(contains(r.err, "reaches past the last sample index, 2^62 = 4611686018427387904")) << r.err;
+    }
+    CliResult r = run({"-s", "2", "--first-sample", "4611686018427387902", "--spp", "3", "--resolution", "8x8", "-o", path("far.exr")});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_FALSE(fs::exists(path("far.exr")));
+    r = run({"-s", "2", "--first-sample", "4611686018427387902", "--spp", "2", "--resolution", "8x8", "-q", "-o", path("far.exr")});
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(fs::exists(path("far.exr")));
+}
+
 // sppm's options: only with sppm, in range; a render with them runs.
 TEST_F(Cli, SppmOptionsAreChecked) {
     CliResult r = run({"-s", "2", "-a", "pt-mis", "--photons", "1000", "-o", path("x.exr")});

@@ -490,6 +490,42 @@ TEST(SceneFileMeshes, PlyAndSerializedRenderAsTheSameObj) {
     EXPECT_THROW(load_ply_mesh(dir + "/bad.ply"), MeshLoadError);
 }
 
+// Hostile PLY headers are refused before Assimp reads them (issue 45): a header that never ends
+// (Assimp hung on it), a misspelled end_header in a binary file (Assimp crashed), counts that the
+// file cannot hold (a 198-byte file claiming 1e9 vertices grew to 9.8 GB), unknown lines.
+TEST(SceneFileMeshes, HostilePlyHeadersAreRefusedWithTheirProblem) {
+    const std::string dir = temp_dir("hostile-ply");
+    const auto refused = [&](const std::string& name, const std::string& bytes, const std::string& problem) {
+        write_file(dir + "/" + name, bytes);
+        try {
+            load_ply_mesh(dir + "/" + name);
+            ADD_FAILURE() << name << " was accepted";
+        } catch (const MeshLoadError& e) {
+            EXPECT_NE(std::string(e.what()).find(problem), std::string::npos) << name << ": " << e.what();
+            EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+        }
+    };
+    const std::string vertex = "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n";
+    std::string endless = "ply\nformat ascii 1.0\n" + vertex;
+    for (int i = 0; i < 1000; ++i) endless += "0 0 0\n";
+    refused("endless.ply", endless, "header line 7: unknown header line '0 0 0'");
+    refused("unended.ply", "ply\nformat ascii 1.0\n" + vertex, "no end_header line");
+    std::string misspelled = "ply\nformat binary_little_endian 1.0\n" + vertex + "end_headr\n";
+    misspelled.append(36, '\0');
+    refused("misspelled.ply", misspelled, "unknown header line 'end_headr'");
+    refused("billion.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 1000000000\nproperty float x\nend_header\n", "too large");
+    refused("claims.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 1000000\nproperty float x\nend_header\n0000",
+            "need at least 4000000 bytes, the file holds 4 after it");
+    refused("ascii-claims.ply", "ply\nformat ascii 1.0\n" + vertex + "end_header\n0 0 0\n", "need at least 17 bytes");
+    refused("no-format.ply", "ply\n" + vertex + "end_header\n", "no format line");
+    refused("not-ply.ply", "PLY\nformat ascii 1.0\nend_header\n", "starts with the line 'ply'");
+    refused("type.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty real x\nend_header\n0\n", "unknown property type 'real'");
+    // The smallest body the header allows is accepted (3 ASCII values need 5 bytes: "0 0 0").
+    write_file(dir + "/tight.ply", "ply\nformat ascii 1.0\n" + vertex + "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                                  "0 0 0\n1 0 0\n0 1 0\n3 0 1 2");
+    EXPECT_EQ(load_ply_mesh(dir + "/tight.ply").triangles.size(), 1u);
+}
+
 TEST(SceneFileMeshes, InstancesRenderAsTheGeometryWrittenOut) {
     const std::string dir = temp_dir("instances");
     write_mesh_files(dir);

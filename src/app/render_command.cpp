@@ -210,7 +210,15 @@ std::vector<RenderJob> make_jobs(const RenderCommandOptions& o, bool check_paths
             jobs.emplace_back(choice, request);
         }
     }
-    for (RenderJob& job : jobs) job.settings.first_sample = o.first_sample;
+    // Sample indices from 2^62 on are refused up front: first + spp must not wrap round (an image of
+    // 0 samples after a minute's work), and no render reaches them.
+    constexpr uint64_t kMaxSampleIndex = uint64_t(1) << 62;
+    for (RenderJob& job : jobs) {
+        job.settings.first_sample = o.first_sample;
+        if (o.first_sample >= kMaxSampleIndex || job.settings.spp > kMaxSampleIndex - o.first_sample)
+            throw UsageError(fmt::format("--first-sample {} with {} samples per pixel reaches past the last sample index, 2^62 = {}",
+                                         o.first_sample, job.settings.spp, kMaxSampleIndex));
+    }
     if (!(o.checkpoint_every >= 0) || !std::isfinite(o.checkpoint_every))
         throw UsageError("--checkpoint-every must be zero (only at the end) or a positive number of seconds");
 

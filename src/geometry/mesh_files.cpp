@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 
 #include <fmt/format.h>
 
@@ -34,10 +35,94 @@ void check_finite(const MeshDesc& m, const std::string& path) {
     if (m.triangles.empty()) throw MeshLoadError(fmt::format("mesh '{}' has no faces", path));
 }
 
+// A PLY header read and checked before Assimp sees the file (Assimp hangs on a header without
+// end_header and crashes on some broken binary ones): it must start with "ply", give its format,
+// end with end_header within kMaxPlyHeader bytes, and declare no more elements than the rest of
+// the file can hold at their smallest (a binary property's size; an ASCII value at least "0 ").
+constexpr size_t kMaxPlyHeader = size_t(1) << 20;
+
+size_t ply_type_size(const std::string& type) {
+    static const std::pair<const char*, size_t> sizes[] = {{"char", 1},   {"uchar", 1},   {"int8", 1},  {"uint8", 1},   {"short", 2},
+                                                          {"ushort", 2}, {"int16", 2},   {"uint16", 2}, {"int", 4},     {"uint", 4},
+                                                          {"int32", 4},  {"uint32", 4},  {"float", 4}, {"float32", 4}, {"double", 8},
+                                                          {"float64", 8}};
+    for (const auto& [name, size] : sizes)
+        if (type == name) return size;
+    return 0;
+}
+
+void check_ply_header(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw MeshLoadError(fmt::format("cannot read mesh '{}'", path));
+    const uint64_t file_size = std::filesystem::file_size(path);
+    const auto fail = [&](int line, const std::string& what) {
+        throw MeshLoadError(fmt::format("mesh '{}', header line {}: {}", path, line, what));
+    };
+    std::string text;
+    bool binary = false, format = false, ended = false;
+    uint64_t minimum_body = 0, element_bytes = 0, element_count = 0;
+    const auto close_element = [&] { minimum_body += element_count * element_bytes; };
+    size_t header_bytes = 0;
+    for (int line = 1; std::getline(in, text); ++line) {
+        header_bytes += text.size() + 1;
+        if (header_bytes > kMaxPlyHeader) fail(line, fmt::format("no end_header within the first {} bytes", kMaxPlyHeader));
+        if (!text.empty() && text.back() == '\r') text.pop_back();
+        std::istringstream words(text);
+        std::string key;
+        words >> key;
+        if (line == 1) {
+            if (key != "ply") fail(1, "a PLY file starts with the line 'ply'");
+            continue;
+        }
+        if (key == "end_header") {
+            ended = true;
+            break;
+        }
+        if (key.empty() || key == "comment" || key == "obj_info") continue;
+        if (key == "format") {
+            std::string f;
+            words >> f;
+            if (f != "ascii" && f != "binary_little_endian" && f != "binary_big_endian")
+                fail(line, fmt::format("unknown format '{}' (ascii, binary_little_endian or binary_big_endian)", f));
+            binary = f != "ascii", format = true;
+        } else if (key == "element") {
+            close_element();
+            std::string name, count;
+            words >> name >> count;
+            if (count.empty() || count.find_first_not_of("0123456789") != std::string::npos || count.size() > 12)
+                fail(line, fmt::format("element '{}' has no count", name));
+            element_count = std::stoull(count), element_bytes = 0;
+            if (element_count > kMaxElements) fail(line, fmt::format("element '{}' claims {} items: too large", name, element_count));
+        } else if (key == "property") {
+            std::string type;
+            words >> type;
+            if (type == "list") {
+                std::string count_type, item_type;
+                words >> count_type >> item_type;
+                if (!ply_type_size(count_type) || !ply_type_size(item_type)) fail(line, "a list property needs two known types");
+                element_bytes += binary ? ply_type_size(count_type) : 2;
+            } else {
+                if (!ply_type_size(type)) fail(line, fmt::format("unknown property type '{}'", type));
+                element_bytes += binary ? ply_type_size(type) : 2;
+            }
+        } else {
+            fail(line, fmt::format("unknown header line '{}'", text.substr(0, 40)));
+        }
+    }
+    if (!ended) throw MeshLoadError(fmt::format("mesh '{}': the header has no end_header line (the file ends in it)", path));
+    if (!format) throw MeshLoadError(fmt::format("mesh '{}': the header has no format line", path));
+    close_element();
+    if (!binary && minimum_body > 0) --minimum_body;  // (the last value needs no separator after it)
+    const uint64_t body = file_size > header_bytes ? file_size - header_bytes : 0;
+    if (minimum_body > body)
+        throw MeshLoadError(fmt::format("mesh '{}': the header's elements need at least {} bytes, the file holds {} after it", path, minimum_body, body));
+}
+
 }  // namespace
 
 MeshDesc load_ply_mesh(const std::string& path) {
     require_regular_file(path);
+    check_ply_header(path);
     Assimp::Importer importer;
     // No post-processing: Assimp's own steps would triangulate differently, join identical
     // vertices or reorder; the fan below is Mitsuba's.

@@ -67,6 +67,7 @@ RenderStats render_into(const Scene& scene, Integrator& integrator, const Render
     if (settings.spp <= 0 && settings.time_limit <= 0)
         throw std::invalid_argument("a render needs a positive sample count or time limit");
     const uint64_t first = settings.first_sample;
+    if (settings.spp > UINT64_MAX - first) throw std::invalid_argument(fmt::format("sample indices {} + {} wrap round", first, settings.spp));
     const PassSet target = settings.spp > 0 ? PassSet::range(first, first + settings.spp) : PassSet::range(first, UINT64_MAX);
     if (!target.contains(settings.done))
         throw std::invalid_argument(fmt::format("the film holds passes {} outside the render's passes {}", settings.done.to_string(),

@@ -1,9 +1,11 @@
 // Pieces of test scenes that several tests build: quads, the index-matched fog box that fills the
-// course box, and voxel-grid media with a striped pattern of extinctions.
+// course box, a glass ball filled with a medium, and voxel-grid media with a striped pattern of
+// extinctions.
 #pragma once
 
 #include <array>
 
+#include "bsdfs/material.hpp"
 #include "geometry/shape_meshes.hpp"
 #include "media/medium.hpp"
 #include "media/volume.hpp"
@@ -29,6 +31,16 @@ inline MeshDesc fog_box(int32_t medium) {
     m.media.interior = medium;
     m.media.index_matched = true;
     return m;
+}
+
+// Turns the scene's last sphere (the course scenes' blue ball) into glass of index 1.5 filled with
+// medium `interior`, medium `exterior` around it.
+inline void make_last_sphere_glass(SceneDescription& d, int32_t interior, int32_t exterior) {
+    d.materials.push_back(make_dielectric(1.5f));
+    SphereDesc& glass = d.spheres.back();
+    glass.material = uint32_t(d.materials.size() - 1);
+    glass.media.interior = interior;
+    glass.media.exterior = exterior;
 }
 
 // A grid medium filling [-half, half]^3 whose voxel (x, y, z), channel c, has the extinction

@@ -67,11 +67,7 @@ std::vector<MediaScene> media_scenes() {
         d.media.push_back(grid_medium());
         d.media.push_back(HomogeneousMedium{Rgb(2.0f, 1.0f, 0.5f), Rgb(1.5f, 0.5f, 0.4f), IsotropicPhase{}});
         d.meshes.push_back(fog_box(0));
-        d.materials.push_back(make_dielectric(1.5f));
-        SphereDesc& glass = d.spheres.back();
-        glass.material = uint32_t(d.materials.size() - 1);
-        glass.media.interior = 1;
-        glass.media.exterior = 0;
+        make_last_sphere_glass(d, 1, 0);
         scenes.push_back({"smoke grid and a glass ball of ink", d, false});
     }
     {  // The sky through the open front, fog inside the box.

@@ -109,11 +109,7 @@ SceneDescription empty_media_scene() {
     d.media.push_back(HomogeneousMedium{Rgb(0.0f), Rgb(0.0f), HgPhase{0.5f}});
     d.media.push_back(HomogeneousMedium{Rgb(0.0f), Rgb(0.0f), IsotropicPhase{}});
     d.meshes.push_back(fog_box(0));
-    d.materials.push_back(make_dielectric(1.5f));
-    SphereDesc& glass = d.spheres.back();
-    glass.material = uint32_t(d.materials.size() - 1);
-    glass.media.interior = 1;
-    glass.media.exterior = 0;
+    make_last_sphere_glass(d, 1, 0);
     return d;
 }
 

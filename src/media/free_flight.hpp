@@ -118,16 +118,14 @@ FreeFlight sample_free_flight(const View& m, const Vec3f& o, const Vec3f& d, flo
     return {false, tmax};
 }
 
-// An unbiased estimate of the transmittance along o + t d, t in [0, tmax] (closed form where
-// the extinction is constant, unless majorant_factor > 1 asks for ratio tracking).
-template <class View>
-typename View::Colour estimate_transmittance(const View& m, const Vec3f& o, const Vec3f& d, float tmax, Sampler& rng,
-                                             float majorant_factor = 1) {
+// Ratio tracking along o + t d, t in [0, tmax]: the running estimate after every tentative
+// collision goes to step(t, T); returns the estimate of T(0, tmax). A Russian roulette on a small
+// transmittance (unbiased, and thick media end early) may end it, with T = 0.
+template <class View, class Step>
+typename View::Colour ratio_tracking(const View& m, const Vec3f& o, const Vec3f& d, float tmax, Sampler& rng, float majorant_factor,
+                                     Step&& step) {
     using Colour = typename View::Colour;
     using namespace free_flight_detail;
-    Colour sigma_t;
-    if (m.constant_extinction(sigma_t) && (majorant_factor == 1 || !std::isfinite(tmax))) return homogeneous_transmittance(sigma_t, tmax);
-    // Ratio tracking.
     float scale;
     MajorantIterator pieces = m.majorants(o, d, tmax, majorant_factor, scale);
     MajorantSegment seg;
@@ -138,16 +136,30 @@ typename View::Colour estimate_transmittance(const View& m, const Vec3f& o, cons
         for (float t = seg.t0;;) {
             t += exponential(rng) / sigma_maj;
             if (t >= seg.t1) break;
-            const Colour sigma_t_here = m.extinction(o + d * t);
-            T *= max(Colour(0.0f), Colour(1.0f) - sigma_t_here / sigma_maj);
-            // Russian roulette on a small transmittance: unbiased, and thick media end early.
+            T *= max(Colour(0.0f), Colour(1.0f) - m.extinction(o + d * t) / sigma_maj);
             if (const float q = max_component(T); q < 0.1f) {
-                if (rng.next1d() >= q) return Colour(0.0f);
+                if (rng.next1d() >= q) {
+                    T = Colour(0.0f);
+                    step(t, T);
+                    return T;
+                }
                 T /= q;
             }
+            step(t, T);
         }
     }
     return T;
+}
+
+// An unbiased estimate of the transmittance along o + t d, t in [0, tmax] (closed form where
+// the extinction is constant, unless majorant_factor > 1 asks for ratio tracking).
+template <class View>
+typename View::Colour estimate_transmittance(const View& m, const Vec3f& o, const Vec3f& d, float tmax, Sampler& rng,
+                                             float majorant_factor = 1) {
+    using Colour = typename View::Colour;
+    Colour sigma_t;
+    if (m.constant_extinction(sigma_t) && (majorant_factor == 1 || !std::isfinite(tmax))) return homogeneous_transmittance(sigma_t, tmax);
+    return ratio_tracking(m, o, d, tmax, rng, majorant_factor, [](float, const Colour&) {});
 }
 
 // The transmittance from o along o + t d for every t in [0, tmax] at once (the beam radiance
@@ -172,31 +184,13 @@ struct TransmittanceTrack {
 template <class View>
 void track_transmittance(const View& m, const Vec3f& o, const Vec3f& d, float tmax, Sampler& rng,
                          TransmittanceTrack<typename View::Colour>& track) {
-    using Colour = typename View::Colour;
-    using namespace free_flight_detail;
     track.t.clear(), track.T.clear();
     track.constant = m.constant_extinction(track.sigma_t);
     if (track.constant) return;
-    float scale;
-    MajorantIterator pieces = m.majorants(o, d, tmax, 1.0f, scale);
-    MajorantSegment seg;
-    Colour T(1.0f);
-    while (pieces.next(seg)) {
-        const float sigma_maj = seg.sigma_maj * scale;
-        if (!(sigma_maj > 0)) continue;
-        for (float t = seg.t0;;) {
-            t += exponential(rng) / sigma_maj;
-            if (t >= seg.t1) break;
-            T *= max(Colour(0.0f), Colour(1.0f) - m.extinction(o + d * t) / sigma_maj);
-            if (const float q = max_component(T); q < 0.1f) {
-                if (rng.next1d() >= q) T = Colour(0.0f);
-                else T /= q;
-            }
-            track.t.push_back(t);
-            track.T.push_back(T);
-            if (is_black(T)) return;
-        }
-    }
+    ratio_tracking(m, o, d, tmax, rng, 1.0f, [&track](float t, const typename View::Colour& T) {
+        track.t.push_back(t);
+        track.T.push_back(T);
+    });
 }
 
 }  // namespace pathlab

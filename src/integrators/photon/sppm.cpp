@@ -75,6 +75,13 @@ uint64_t Sppm<T>::trace_photons(const RenderContext& ctx, uint64_t pass, size_t 
 }
 
 template <class T>
+Ray Sppm<T>::pixel_ray(const RenderContext& ctx, size_t pixel, Sampler& sampler) const {
+    const Vec2f jitter = rays_ == CameraRays::Jittered ? sampler.next2d() : Vec2f(0.5f, 0.5f);
+    const float px = float(pixel % size_t(ctx.width)), py = float(pixel / size_t(ctx.width));
+    return ctx.camera.generate(px + jitter.x, py + jitter.y);
+}
+
+template <class T>
 ColourOf<T> Sppm<T>::gather(const Scene& scene, const ScatterVertex& v, const ShadingPoint& sp, const ColourOf<T>& r_camera, int t, float r,
                             size_t paths, const WavelengthsOf<T>& wl) const {
     using Colour = ColourOf<T>;
@@ -155,9 +162,7 @@ Vec3d Sppm<T>::camera_sample_in_media(const RenderContext& ctx, size_t pixel, ui
     using Colour = ColourOf<T>;
     const Scene& scene = ctx.scene;
     Sampler sampler(ctx.seed, pixel, pass, ctx.sampler);
-    const Vec2f jitter = rays_ == CameraRays::Jittered ? sampler.next2d() : Vec2f(0.5f, 0.5f);
-    const float px = float(pixel % size_t(ctx.width)), py = float(pixel / size_t(ctx.width));
-    Ray ray = ctx.camera.generate(px + jitter.x, py + jitter.y);
+    Ray ray = pixel_ray(ctx, pixel, sampler);
     WavelengthsOf<T> wl = pass_wl;  // this camera path's: a dispersive interface would reduce it
     MediumState<T> st{sampler, wl};
     st.hero = hero;
@@ -251,9 +256,7 @@ Vec3d Sppm<T>::camera_sample(const RenderContext& ctx, size_t pixel, uint64_t pa
     using Colour = ColourOf<T>;
     const Scene& scene = ctx.scene;
     Sampler sampler(ctx.seed, pixel, pass, ctx.sampler);
-    const Vec2f jitter = rays_ == CameraRays::Jittered ? sampler.next2d() : Vec2f(0.5f, 0.5f);
-    const float px = float(pixel % size_t(ctx.width)), py = float(pixel / size_t(ctx.width));
-    Ray ray = ctx.camera.generate(px + jitter.x, py + jitter.y);
+    Ray ray = pixel_ray(ctx, pixel, sampler);
     WavelengthsOf<T> wl = pass_wl;  // this camera path's: a dispersive interface would reduce it
     Colour L(0.0f);
     const auto counts = [this](int length) { return this->counts(length); };

@@ -86,6 +86,8 @@ private:
     // The photons of one iteration into photons_ (and, in media, their subpaths' distance
     // densities into photon_r_), in chunk order; returns the rays traced.
     uint64_t trace_photons(const RenderContext& ctx, uint64_t pass, size_t paths, const WavelengthsOf<T>& wl, int hero);
+    // The camera ray of a pixel: jittered (sppm) or through its centre (ppm).
+    Ray pixel_ray(const RenderContext& ctx, size_t pixel, Sampler& sampler) const;
     // One pixel's sample of the iteration, as the film's colour.
     Vec3d camera_sample(const RenderContext& ctx, size_t pixel, uint64_t pass, float r, size_t paths, const WavelengthsOf<T>& pass_wl) const;
     // The same in a scene with media (the iteration's hero channel).

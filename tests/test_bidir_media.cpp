@@ -12,9 +12,12 @@
 #include <cmath>
 #include <optional>
 
+#include <fmt/format.h>
+
 #include "geometry/shape_meshes.hpp"
 #include "integrators/bidir/bdpt.hpp"
 #include "integrators/bidir/light_tracer.hpp"
+#include "integrators/photon/pm.hpp"
 #include "integrators/photon/sppm.hpp"
 #include "integrators/photon/vcm.hpp"
 #include "judge/image_statistics.hpp"
@@ -92,6 +95,16 @@ const RenderResult& reference(size_t i) {
     static std::vector<std::optional<RenderResult>> refs(media_scenes().size());
     if (!refs[i]) refs[i] = render_scene(media_scenes()[i].d, "volpath", kSize, kSize, 4096, 11, depth_options());
     return *refs[i];
+}
+
+// volpath's spectral render of the first scene, made once.
+const RenderResult& spectral_reference() {
+    static const RenderResult ref = [] {
+        IntegratorOptions o = depth_options();
+        o.spectral = true;
+        return render_integrator(media_scenes()[0].d, *find_integrator("volpath")->make(o), kSize, kSize, 4096, 31);
+    }();
+    return ref;
 }
 
 AgreementResult agreement(const RenderResult& a, const RenderResult& ref) {
@@ -175,6 +188,79 @@ TEST(BidirMedia, SppmWithoutTheBeamsTransmittanceOrWithTheDiscKernelIsDetected) 
     }
 }
 
+// pm in media (Jensen and Christensen's volume map), both volume estimates with the k nearest
+// photons (pm's default). pm's maps are made once, so its image keeps their noise and bias
+// however many camera samples it takes: the z-tests hold where the maps' error is below the
+// camera samples' (beams: 64000 light paths, 256 samples per pixel; points, noisier per sample:
+// 256000 and 1024), on the two scenes where the volume map has no boundary in view. Where it
+// has (the fog box open to the sky: the balls of photons by the box's walls reach outside the
+// fog, where there are none, and the estimate is too dark there), the bias must shrink as the
+// photon count grows.
+RenderResult pm_render(size_t scene, bool beams, int64_t photons, uint64_t spp, PmFaults faults = {}, bool spectral = false) {
+    IntegratorOptions o = depth_options();
+    o.photons = photons;
+    o.volume_beam = beams;
+    o.spectral = spectral;
+    if (spectral) return render_integrator(media_scenes()[scene].d, *find_integrator("pm")->make(o), kSize, kSize, spp, 26);
+    PhotonMapper<RgbTransport> pm(o, faults);
+    return render_integrator(media_scenes()[scene].d, pm, kSize, kSize, spp, 25);
+}
+
+RenderResult pm_render(size_t scene, bool beams, PmFaults faults = {}) {
+    return pm_render(scene, beams, beams ? 64000 : 256000, beams ? 256 : 1024, faults);
+}
+
+TEST(BidirMedia, PmAgreesWithVolpathByBeamsAndByPoints) {
+    for (const size_t i : {0u, 1u}) {
+        for (const bool beams : {true, false}) {
+            const AgreementResult res = agreement(pm_render(i, beams), reference(i));
+            EXPECT_TRUE(res.agree) << media_scenes()[i].name << ", pm " << (beams ? "beams" : "points") << ": " << res.describe();
+        }
+    }
+}
+
+// The tests of the test: beams without their transmittance, and points with the disc's kernel.
+TEST(BidirMedia, PmWithoutTheBeamsTransmittanceOrWithTheDiscKernelIsDetected) {
+    const AgreementResult beams = agreement(pm_render(0, true, PmFaults{.beam_without_transmittance = true}), reference(0));
+    EXPECT_FALSE(beams.agree) << beams.describe();
+    const AgreementResult points = agreement(pm_render(0, false, PmFaults{.volume_kernel_as_disc = true}), reference(0));
+    EXPECT_FALSE(points.agree) << points.describe();
+}
+
+// The image mean's difference from volpath's, in standard errors of that difference.
+double mean_bias_z(const RenderResult& a, const RenderResult& ref) {
+    const Image m = a.film.mean(), se = a.film.standard_error(), rm = ref.film.mean(), rse = ref.film.standard_error();
+    double d = 0, var = 0;
+    for (int y = 0; y < kSize; ++y)
+        for (int x = 0; x < kSize; ++x)
+            for (int c = 0; c < 3; ++c) {
+                d += double(m.at(x, y)[c]) - double(rm.at(x, y)[c]);
+                var += double(se.at(x, y)[c]) * se.at(x, y)[c] + double(rse.at(x, y)[c]) * rse.at(x, y)[c];
+            }
+    return d / std::sqrt(var);
+}
+
+TEST(BidirMedia, PmBoundaryBiasShrinksAsThePhotonCountGrows) {
+    for (const bool beams : {true, false}) {
+        const double few = mean_bias_z(pm_render(3, beams, 16000, 256), reference(3));
+        const double many = mean_bias_z(pm_render(3, beams, 256000, 256), reference(3));
+        const std::string all = fmt::format("{}: the mean's bias in standard errors with 16000 light paths {:.1f}, 256000 {:.1f}",
+                                            beams ? "beams" : "points", few, many);
+        EXPECT_LT(few, -6.0) << "the boundary's bias must be seen: " << all;
+        EXPECT_GT(many, 0.6 * few) << all;
+        EXPECT_LT(many, 0.0) << all;
+    }
+}
+
+// Spectral mode makes the maps anew in every pass at its wavelengths: the passes are independent,
+// and 64 of them with 16000 light paths each agree with volpath's spectral image.
+TEST(BidirMedia, PmInSpectralModeAgreesWithVolpath) {
+    for (const bool beams : {true, false}) {
+        const AgreementResult r = agreement(pm_render(0, beams, 16000, 64, {}, true), spectral_reference());
+        EXPECT_TRUE(r.agree) << (beams ? "beams: " : "points: ") << r.describe();
+    }
+}
+
 // The test of the test: merging in a medium with the surfaces' kernel (N pi r^2, in the estimate
 // and the MIS) is too dark where merges carry weight.
 TEST(BidirMedia, AMediumMergeWithTheDiscKernelIsDetected) {
@@ -192,8 +278,7 @@ TEST(BidirMedia, BdptVcmAndSppmInSpectralModeAgreeWithVolpath) {
     const MediaScene s = media_scenes()[0];
     IntegratorOptions o = depth_options();
     o.spectral = true;
-    const auto volpath = find_integrator("volpath")->make(o);
-    const RenderResult v = render_integrator(s.d, *volpath, kSize, kSize, 4096, 31);
+    const RenderResult& v = spectral_reference();
     o.photon_radius = 0.03f * Scene::build(s.d)->scene_sphere().radius;
     for (const char* a : {"bdpt", "vcm"}) {
         const RenderResult b = render_integrator(s.d, *find_integrator(a)->make(o), kSize, kSize, 1024, 32);
@@ -221,7 +306,7 @@ TEST(BidirMedia, AConnectionWithoutItsTransmittanceIsDetected) {
 TEST(BidirMedia, OneAndTwoThreadsGiveTheSameBytes) {
     for (const char* f : {"scenes/fog-box.xml", "scenes/smoke.xml"}) {
         const SceneDescription d = load_scene_file(source_path(f));
-        for (const char* a : {"bdpt", "lt", "vcm", "bpm", "sppm", "ppm"}) {
+        for (const char* a : {"bdpt", "lt", "vcm", "bpm", "sppm", "ppm", "pm"}) {
             const auto with_threads = [&](int threads) {
                 tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
                 return render_scene(d, a, 16, 12, 4, 5);

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "cli_runner.hpp"
+#include "core/memory.hpp"
 #include "render/film.hpp"
 
 namespace pathlab::test {
@@ -88,14 +89,6 @@ TEST_F(CliLimits, OutputsNeverOverwriteInputsOrEachOther) {
     EXPECT_EQ(read(path("refs/0.pfm")), ref);
 }
 
-uint64_t available_memory() {
-    std::ifstream in("/proc/meminfo");
-    std::string key, unit;
-    uint64_t kib = 0;
-    while (in >> key >> kib >> unit)
-        if (key == "MemAvailable:") return kib * 1024;
-    return 0;
-}
 
 // A film too large for memory is refused before it is allocated, saying how much it needs;
 // the other scenes of the command still render.
@@ -117,6 +110,29 @@ TEST_F(CliLimits, AFilmTooLargeForMemoryFailsThatSceneOnly) {
                              "--spp", "1", "--resolution", "32768x32768"});
     EXPECT_EQ(c.code, 2);
     EXPECT_TRUE(contains(c.err, "is 512x512, but --resolution asks for 32768x32768")) << c.err;
+}
+
+// Photon counts and strategy images that cannot fit are refused before they are allocated, with
+// the figure and the option to lower (they ran for minutes and ended in std::bad_alloc): the
+// photons per light path come from a pilot of 256 light paths; nothing is written.
+TEST_F(CliLimits, PhotonMapsAndStrategyImagesTooLargeForMemoryAreRefusedUpFront) {
+    if (available_memory() == 0 || available_memory() > (uint64_t(900) << 30))
+        GTEST_SKIP() << "this machine could hold 10^10 light paths' photons (or does not say how much memory it has)";
+    for (const char* a : {"pm", "sppm"}) {
+        const CliResult r = run({"-s", "2", "-a", a, "--photons", "10000000000", "--resolution", "8x8", "--spp", "1", "-q", "-o", path("p.pfm")});
+        EXPECT_EQ(r.code, 1) << a << ": " << r.err;
+        EXPECT_TRUE(contains(r.err, std::string(a) + "'s 10000000000 light paths (about ")) << r.err;
+        EXPECT_TRUE(contains(r.err, "GiB is available: lower --photons (about ")) << r.err;
+        EXPECT_FALSE(fs::exists(path("p.pfm")));
+    }
+    const CliResult s = run({"-s", "2", "-a", "bdpt", "--strategies", path("st"), "--strategies-depth", "1000000", "--max-depth", "1000",
+                             "--resolution", "1024x1024", "--spp", "1", "-q", "-o", path("b.pfm")});
+    EXPECT_EQ(s.code, 1) << s.err;
+    EXPECT_TRUE(contains(s.err, "--strategies images of paths up to 1000 bounces")) << s.err;
+    EXPECT_TRUE(contains(s.err, ": lower --strategies-depth (at most ")) << s.err;
+    EXPECT_FALSE(fs::exists(path("b.pfm")));
+    // what fits still renders
+    EXPECT_EQ(run({"-s", "2", "-a", "pm", "--photons", "2000", "--resolution", "8x8", "--spp", "1", "-q", "-o", path("p.pfm")}).code, 0);
 }
 
 // Sample counts are 64-bit: a pixel past 2^32 samples keeps counting and averaging.

@@ -232,35 +232,36 @@ TEST_F(SceneFileMedia, IntegratorsWithoutMediaRefuseScenesWithMedia) {
             }
             EXPECT_TRUE(contains(message, info.name + " does not render participating media")) << message;
             EXPECT_TRUE(contains(message, where)) << message;
-            EXPECT_TRUE(contains(message, "The integrators that render media: lt, bdpt, ppm, sppm, bpm, vcm, volpath")) << message;
+            EXPECT_TRUE(contains(message, "The integrators that render media: lt, bdpt, pm, ppm, sppm, bpm, vcm, volpath")) << message;
             ++refusing;
         }
     }
-    EXPECT_EQ(refusing, 2 * (int(integrators().size()) - 7));  // all but lt, bdpt, ppm, sppm, bpm, vcm, volpath
+    EXPECT_EQ(refusing, 2 * (int(integrators().size()) - 8));  // all but lt, bdpt, pm, ppm, sppm, bpm, vcm, volpath
     // From the command line: exit code 2, and `pathlab algorithms` says which render media.
     std::ofstream(path("fog.xml")) << "<scene version=\"3.0.0\">\n<medium type=\"homogeneous\" id=\"fog\"/>\n"
                                       "<shape type=\"cube\"><ref name=\"interior\" id=\"fog\"/></shape>\n" + rest + "</scene>\n";
-    for (const char* a : {"pm", "pt-mis"}) {
+    for (const char* a : {"ic", "pt-mis"}) {
         const CliResult r = run({"--scene", path("fog.xml"), "-a", a, "--spp", "1", "--resolution", "8x8", "-o", path("out.exr")});
         EXPECT_EQ(r.code, 2) << r.err;
         EXPECT_TRUE(contains(r.err, "medium 'fog'")) << r.err;
         EXPECT_FALSE(fs::exists(path("out.exr")));
     }
-    for (const char* a : {"volpath", "bdpt", "lt", "vcm", "bpm", "sppm", "ppm"})
+    for (const char* a : {"volpath", "bdpt", "lt", "vcm", "bpm", "sppm", "ppm", "pm"})
         EXPECT_EQ(run({"--scene", path("fog.xml"), "-a", a, "--spp", "1", "--resolution", "8x8", "-q", "-o", path("out.exr")}).code, 0) << a;
-    // sppm and ppm's choice of volume estimate: a value they do not know, or another integrator, is refused.
-    for (const char* v : {"beam", "points"})
-        EXPECT_EQ(run({"--scene", path("fog.xml"), "-a", "sppm", "--volume-estimate", v, "--spp", "1", "--resolution", "8x8", "-q", "-o",
-                       path("out.exr")}).code, 0) << v;
+    // sppm, ppm and pm's choice of volume estimate: a value they do not know, or another integrator, is refused.
+    for (const char* a : {"sppm", "pm"})
+        for (const char* v : {"beam", "points"})
+            EXPECT_EQ(run({"--scene", path("fog.xml"), "-a", a, "--volume-estimate", v, "--spp", "1", "--resolution", "8x8", "-q", "-o",
+                           path("out.exr")}).code, 0) << a << " " << v;
     const CliResult bad = run({"--scene", path("fog.xml"), "-a", "sppm", "--volume-estimate", "lines", "-o", path("bad.exr")});
     EXPECT_EQ(bad.code, 2);
     EXPECT_TRUE(contains(bad.err, "unknown volume estimate 'lines'. Valid estimates: beam, points")) << bad.err;
     const CliResult other = run({"--scene", path("fog.xml"), "-a", "vcm", "--volume-estimate", "points", "-o", path("bad.exr")});
     EXPECT_EQ(other.code, 2);
-    EXPECT_TRUE(contains(other.err, "--volume-estimate chooses how sppm and ppm gather photons in media")) << other.err;
+    EXPECT_TRUE(contains(other.err, "--volume-estimate chooses how sppm, ppm and pm gather photons in media")) << other.err;
     EXPECT_FALSE(fs::exists(path("bad.exr")));
     const CliResult list = run({"algorithms"});
-    EXPECT_TRUE(contains(list.out, "Participating media (scenes with a <medium>): lt, bdpt, ppm, sppm, bpm, vcm, volpath;")) << list.out;
+    EXPECT_TRUE(contains(list.out, "Participating media (scenes with a <medium>): lt, bdpt, pm, ppm, sppm, bpm, vcm, volpath;")) << list.out;
 }
 
 }  // namespace

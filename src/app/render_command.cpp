@@ -108,8 +108,8 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
                    "radius instead of the k nearest");
     app.add_option("--alpha", o.photon_alpha, "sppm, ppm, vcm, bpm: the radius reduction, in (0, 1] (default 2/3)");
     app.add_option("--volume-estimate", o.volume_estimate,
-                   "sppm, ppm in media: beam (the beam radiance estimate along the camera rays, default) or points (the 3D kernel at "
-                   "the camera path's first scattering point)");
+                   "sppm, ppm, pm in media: beam (the beam radiance estimate along the camera rays, default) or points (the 3D "
+                   "kernel at the camera path's scattering points)");
     app.add_flag("--no-merging", o.no_merging, "vcm: connections only (then it is bdpt)");
     app.add_flag("--no-connections", o.no_connections, "vcm: merging only (then it is bpm)");
     app.add_option("--ic-rays", o.ic_rays, "ic: rays per irradiance record (stratified; default 256)");
@@ -278,8 +278,9 @@ std::vector<RenderJob> make_jobs(const RenderCommandOptions& o, bool check_paths
             throw UsageError(fmt::format("--radius sets the photon radius of sppm, ppm, pm, vcm and bpm; {} has none", algorithm));
         if (o.photon_alpha && !one_of({"sppm", "ppm", "vcm", "bpm"}))
             throw UsageError(fmt::format("--alpha is the radius reduction of sppm, ppm, vcm and bpm, not {}'s", algorithm));
-        if (o.volume_estimate && !one_of({"sppm", "ppm"}))
-            throw UsageError(fmt::format("--volume-estimate chooses how sppm and ppm gather photons in media; {} has no such choice", algorithm));
+        if (o.volume_estimate && !one_of({"sppm", "ppm", "pm"}))
+            throw UsageError(
+                fmt::format("--volume-estimate chooses how sppm, ppm and pm gather photons in media; {} has no such choice", algorithm));
         if (o.mis == "power" && !one_of({"bdpt", "vcm", "bpm"}))
             throw UsageError(fmt::format("--mis chooses the heuristic of bdpt, vcm and bpm; {} has its own", algorithm));
         const bool ic_options = o.ic_rays || o.ic_error || o.ic_no_gradients || !o.ic_records.empty();

@@ -60,7 +60,7 @@ struct IntegratorOptions {
     int64_t photons = 0;
     float photon_radius = 0;
     double photon_alpha = 2.0 / 3.0;
-    // sppm, ppm in media: the beam radiance estimate along camera rays (true), or the 3D kernel
+    // sppm, ppm, pm in media: the beam radiance estimate along camera rays (true), or the 3D kernel
     // at the camera path's first scattering point (false).
     bool volume_beam = true;
     // vcm: its two families of strategies (off: merging = bdpt, connections = bpm).

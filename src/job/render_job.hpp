@@ -40,7 +40,7 @@ struct JobRequest {
     std::optional<int64_t> photons;       // --photons N (sppm, pm)
     std::optional<float> photon_radius;   // --radius R (sppm, pm)
     std::optional<double> photon_alpha;   // --alpha A (sppm, vcm, bpm)
-    std::optional<bool> volume_beam;      // --volume-estimate beam|points (sppm, ppm)
+    std::optional<bool> volume_beam;      // --volume-estimate beam|points (sppm, ppm, pm)
     bool vcm_merging = true;              // not --no-merging (vcm)
     bool vcm_connections = true;          // not --no-connections (vcm)
     std::optional<int> ic_rays;           // --ic-rays (ic)

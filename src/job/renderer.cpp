@@ -1,13 +1,13 @@
 #include "job/renderer.hpp"
 
 #include <chrono>
-#include <fstream>
 #include <algorithm>
 #include <new>
 #include <stdexcept>
 
 #include <fmt/format.h>
 
+#include "core/memory.hpp"
 #include "render/progress.hpp"
 
 namespace pathlab {
@@ -20,23 +20,11 @@ void resolve_size(const Scene& scene, const RenderSettings& s, int& w, int& h) {
         throw std::invalid_argument(fmt::format("resolution must be positive, got {}x{}", w, h));
 }
 
-// Memory this machine can still give (MemAvailable), or 0 when unknown.
-uint64_t available_memory() {
-    std::ifstream in("/proc/meminfo");
-    std::string key;
-    uint64_t kib = 0;
-    std::string unit;
-    while (in >> key >> kib >> unit)
-        if (key == "MemAvailable:") return kib * 1024;
-    return 0;
-}
-
 }  // namespace
 
 Film make_film(int w, int h) {
     const uint64_t pixels = uint64_t(w) * uint64_t(h), bytes = pixels * kRenderBytesPerPixel;
     const uint64_t available = available_memory();
-    const auto gib = [](uint64_t b) { return double(b) / double(uint64_t(1) << 30); };
     if (available > 0 && bytes > available)
         throw FilmTooLarge(fmt::format("a {}x{} render needs {:.1f} GiB of memory ({} bytes per pixel for the film and its "
                                        "images), but only {:.1f} GiB is available",

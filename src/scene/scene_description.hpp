@@ -49,7 +49,7 @@ struct SceneDescription {
     std::optional<int64_t> photons;               // sppm, pm: light paths (per iteration for sppm)
     std::optional<float> photon_radius;           // sppm: the first iteration's radius
     std::optional<double> photon_alpha;           // sppm: the radius reduction
-    std::optional<bool> volume_beam;              // sppm, ppm in media: beams (true) or points
+    std::optional<bool> volume_beam;              // sppm, ppm, pm in media: beams (true) or points
     std::optional<int> pbgi_surfels, pbgi_bounces, pbgi_resolution, pbgi_direct_samples, pbgi_spacing;  // pbgi
     std::optional<float> pbgi_cutoff;                                                     // pbgi
     std::optional<int> ic_rays;                                                            // ic

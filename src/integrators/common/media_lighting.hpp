@@ -1,5 +1,5 @@
 // Direct light where a path scatters in a scene with media (a surface, or a point in a medium),
-// as volpath gathers it at every vertex and the photon methods (sppm, ppm) at their visible
+// as volpath gathers it at every vertex and the photon methods (sppm, ppm, pm) at their visible
 // points: a light sample whose shadow ray carries its transmittance, and a BSDF or phase sample
 // whose walk through the media may reach an emitter, combined by the balance heuristic. The
 // sample's walk is also the path's continuation (volpath goes on along it).
@@ -94,6 +94,8 @@ inline EmitterHit emission_found(const Scene& scene, const MediumWalk& w, const 
 template <class T>
 struct ScatterSample {
     bool sampled = false;             // false: no sample (the path ends, nothing found)
+    Ray ray{};                        // the sampled ray
+    int32_t medium = -1;              // the medium it starts in
     MediumWalk next;                  // the walk along the sampled direction
     ColourOf<T> next_seg{1.0f};       // its free-flight weights
     ColourOf<T> weight{0.0f};         // f cos / pdf of the sampled direction
@@ -115,7 +117,9 @@ ScatterSample<T> sample_scatter(const Scene& scene, const ScatterVertex& v, Samp
         const auto s = bsdf_sample(sp, sampler.next2d(), wl);
         if (!s) return n;
         n.sampled = true;
-        n.next = walk_media(scene, sp.spawn(s->wo), medium_after(w.media, w.isect.ng, sp.frame.to_world(s->wo), w.medium), st, n.next_seg);
+        n.ray = sp.spawn(s->wo);
+        n.medium = medium_after(w.media, w.isect.ng, sp.frame.to_world(s->wo), w.medium);
+        n.next = walk_media(scene, n.ray, n.medium, st, n.next_seg);
         const Colour f = bsdf_sample_colour(sp, *s, wl);
         n.weight = f * (std::abs(s->wo.z) / s->pdfW);
         const EmitterHit e = emission_found(scene, n.next, sp.p, light);
@@ -125,7 +129,9 @@ ScatterSample<T> sample_scatter(const Scene& scene, const ScatterVertex& v, Samp
         const PhaseSample ps = phase_sample(*v.phase, v.wi, sampler.next2d());
         if (!(ps.pdfW > 0)) return n;
         n.sampled = true;
-        n.next = walk_media(scene, Ray{v.p, ps.wo, kInf}, v.medium, st, n.next_seg);
+        n.ray = Ray{v.p, ps.wo, kInf};
+        n.medium = v.medium;
+        n.next = walk_media(scene, n.ray, n.medium, st, n.next_seg);
         const EmitterHit e = emission_found(scene, n.next, v.p, light);
         const float weight = mis ? balance_heuristic(ps.pdfW, e.pdf_light) : 0.0f;
         if (!is_black(e.Le)) n.found = Colour(ps.p) * light_colour(scene, light, e.Le, wl) * (weight / ps.pdfW);

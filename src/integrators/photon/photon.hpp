@@ -3,7 +3,14 @@
 // number of light paths when density is estimated), in the colour of transport T.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "core/memory.hpp"
 
 #include "integrators/bidir/path_vertex.hpp"
 #include "integrators/common/path_rules.hpp"
@@ -51,5 +58,28 @@ private:
     ColourOf<T> full_{0.0f}, hero_{0.0f};
     bool any_hero_ = false;
 };
+
+// A photon pass's memory, checked before it is traced when it is large (2^20 light paths or
+// more): the first 256 light paths (trace(j, path) fills light path j's vertices) give the
+// photons per path, and NotEnoughMemory refuses the pass if `paths` of them, bytes_per_photon
+// each, would not fit, saying which option (`option`, e.g. "--photons") lowers it and how far.
+template <class Vertex, typename Trace>
+void check_photon_memory(const std::string& who, size_t paths, uint64_t bytes_per_photon, const std::string& option, Trace&& trace) {
+    if (paths < (size_t(1) << 20)) return;
+    constexpr size_t kPilot = 256;
+    std::vector<Vertex> path;
+    size_t photons = 0;
+    for (size_t j = 0; j < kPilot; ++j) {
+        trace(j, path);
+        for (size_t v = 1; v < path.size(); ++v)
+            if ((path[v].kind == VertexKind::Surface || path[v].kind == VertexKind::Medium) && path[v].connectible()) ++photons;
+    }
+    const double per_path = double(photons) / kPilot;
+    const double bytes = double(paths) * per_path * double(bytes_per_photon);
+    const uint64_t available = available_memory();
+    if (available == 0 || bytes <= double(available)) return;
+    check_memory(uint64_t(std::min(bytes, 1.8e19)), fmt::format("{}'s {} light paths (about {:.1f} photons each, {} bytes per photon)", who, paths, per_path, bytes_per_photon),
+                 fmt::format(": lower {} (about {} light paths fit)", option, uint64_t(double(available) / (std::max(per_path, 1e-3) * double(bytes_per_photon)))));
+}
 
 }  // namespace pathlab

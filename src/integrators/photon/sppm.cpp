@@ -38,6 +38,16 @@ template <class T>
 uint64_t Sppm<T>::trace_photons(const RenderContext& ctx, uint64_t pass, size_t paths, const WavelengthsOf<T>& wl, int hero) {
     const size_t per_chunk = paths_per_chunk(paths), chunks = (paths + per_chunk - 1) / per_chunk;
     const bool media = ctx.scene.has_media();
+    // (each photon: its chunk's copy and the pass's, their densities in media, the grid's four arrays)
+    if (&ctx.scene != checked_scene_) {
+        check_photon_memory<PathVertex<T>>(rays_ == CameraRays::Jittered ? "sppm" : "ppm", paths,
+                                           2 * (sizeof(Photon<T>) + (media ? sizeof(ColourOf<T>) : 0)) + 24, "--photons",
+                                           [&](size_t j, std::vector<PathVertex<T>>& path) {
+                                               Sampler sampler(ctx.seed, light_path_stream(j), pass, ctx.sampler);
+                                               light_paths_.light_subpath(ctx, sampler, wl, path, nullptr, hero);
+                                           });
+        checked_scene_ = &ctx.scene;
+    }
     chunk_photons_.resize(chunks);
     chunk_r_.resize(chunks);
     std::atomic<uint64_t> rays{0};
@@ -166,86 +176,29 @@ Vec3d Sppm<T>::camera_sample_in_media(const RenderContext& ctx, size_t pixel, ui
     WavelengthsOf<T> wl = pass_wl;  // this camera path's: a dispersive interface would reduce it
     MediumState<T> st{sampler, wl};
     st.hero = hero;
-    const bool beams = options_.volume_beam;
-    thread_local TransmittanceTrack<Colour> track;
-    Colour L(0.0f), beta(1.0f);
-    int32_t medium = scene.camera_medium();
+    Colour L(0.0f);
     // Through media and Dirac lobes to the first other scattering point (the emission found on
     // the way is seen directly or through Dirac lobes only: no other strategy has it). With
     // beams the camera path does not scatter in media: it gathers the photons along each piece
     // of ray in a medium, and goes on with the piece's transmittance.
-    for (int t = 1; t - 1 <= max_bounces_; ++t) {
-        MediumWalk w;
-        if (!beams) {
-            Colour seg(1.0f);
-            w = walk_media(scene, ray, medium, st, seg);
-            beta *= seg;
-        } else {
-            for (int crossings = 0;; ++crossings) {
-                w = MediumWalk{};
-                w.dir = ray.d;
-                w.medium = medium;
-                const bool hit = crossings < kMaxCrossings && intersect_with_boundaries(scene, ray, w.isect, w.media);
-                if (medium >= 0 && has_extinction(scene.medium(medium))) {
-                    const float len = length(ray.d);
-                    const Vec3f d = ray.d / len;
-                    const float tmax = hit ? w.isect.t * len : kInf;
-                    track_transmittance(medium_view(scene.medium(medium), wl), ray.o, d, tmax, st.rng(), track);
-                    if (medium_photons_ > 0)
-                        L += beta * beam(ray.o, d, tmax, medium, track, medium_phase(scene.medium(medium)), t, r, paths, wl);
-                    beta *= track.at(tmax);
-                    if (is_black(beta)) return film_colour(L, wl);
-                }
-                if (!hit) {
-                    w.kind = crossings < kMaxCrossings ? MediumWalk::kEscaped : MediumWalk::kLost;
-                    break;
-                }
-                if (!(w.media && w.media->index_matched)) {
-                    w.kind = MediumWalk::kSurface;
-                    break;
-                }
-                medium = medium_after(w.media, w.isect.ng, ray.d, medium);
-                ray = spawn_ray(w.isect.p, w.isect.ng, ray.d);
-            }
-        }
-        if (w.kind == MediumWalk::kLost) break;
-        if (w.kind == MediumWalk::kEscaped) {
-            if (counts(t - 1)) L += beta * escaped_radiance(scene, w.dir, wl) / st.density();
-            break;
-        }
-        ShadingPoint sp;
-        ScatterVertex v;
-        v.medium = w.medium;
-        if (w.kind == MediumWalk::kSurface) {
-            if (counts(t - 1)) L += beta * emitted_radiance(scene, w.isect, -w.dir / length(w.dir), wl) / st.density();
-            sp = make_shading_point(scene, w.isect, w.dir);
-            if (sp.material->is_black() || t > max_bounces_) break;
-            if (sp.material->is_delta()) {
-                const auto s = bsdf_sample(sp, sampler.next2d(), wl);
-                if (!s) break;
-                beta *= bsdf_sample_colour(sp, *s, wl) * (std::abs(s->wo.z) / s->pdfW);
-                medium = medium_after(w.media, w.isect.ng, sp.frame.to_world(s->wo), w.medium);
-                ray = sp.spawn(s->wo);
-                continue;
-            }
-            v.sp = &sp;
-            v.hit = &w;
-            v.p = sp.p;
-        } else {
-            if (t > max_bounces_) break;
-            v.p = w.p;
-            v.wi = -w.dir / length(w.dir);
-            v.phase = &medium_phase(scene.medium(w.medium));
-        }
-        // The visible point: the photons (with the camera path's distance densities as they are
-        // here), and direct light by volpath's MIS pair.
-        L += beta * gather(scene, v, sp, st.r, t, r, paths, wl);
-        if (counts(t)) {
-            L += beta * estimate_light(scene, v, sampler, st, /*mis=*/true, wl) / st.density();
-            const ScatterSample<T> n = sample_scatter(scene, v, sampler, st, /*mis=*/true, wl);
-            if (n.sampled) L += beta * n.next_seg * n.found / st.density();
-        }
-        break;
+    const auto beams = [&](const Vec3f& o, const Vec3f& d, float tmax, int32_t medium, const TransmittanceTrack<Colour>& Tr,
+                           const PhaseFunction& phase, int t) {
+        return medium_photons_ > 0 ? beam(o, d, tmax, medium, Tr, phase, t, r, paths, wl) : Colour(0.0f);
+    };
+    const auto counts = [this](int length) { return this->counts(length); };
+    const MediaWalkRules rules{1, max_bounces_, max_bounces_ + 1, options_.volume_beam, true};
+    const auto x = trace_to_visible_point_in_media<T>(scene, ray, scene.camera_medium(), Colour(1.0f), sampler, st, rules, counts, beams, L, wl);
+    if (!x) return film_colour(L, wl);
+    // The visible point: the photons (with the camera path's distance densities as they are
+    // here), and direct light by volpath's MIS pair.
+    const ScatterVertex v = x->vertex(scene);
+    const Colour& beta = x->beta;
+    const int t = x->t;
+    L += beta * gather(scene, v, x->sp, st.r, t, r, paths, wl);
+    if (counts(t)) {
+        L += beta * estimate_light(scene, v, sampler, st, /*mis=*/true, wl) / st.density();
+        const ScatterSample<T> n = sample_scatter(scene, v, sampler, st, /*mis=*/true, wl);
+        if (n.sampled) L += beta * n.next_seg * n.found / st.density();
     }
     return film_colour(L, wl);
 }

@@ -118,6 +118,7 @@ private:
     size_t medium_photons_ = 0;          // how many photons lie in media, and their bounds
     Vec3f medium_lo_{0.0f}, medium_hi_{0.0f};
     PhotonGrid grid_;
+    const Scene* checked_scene_ = nullptr;  // the photons' memory was checked for it (check_photon_memory)
     tbb::enumerable_thread_specific<std::vector<PathVertex<T>>> paths_;  // each thread's light subpath
     std::vector<Vec3d> image_;                                           // one iteration's image
 };

@@ -1,0 +1,28 @@
+// Memory a render is about to take, checked before it is allocated: a film, a photon map, a
+// set of per-strategy images. A request the machine cannot give is refused with the figure and
+// what to lower, where a blind allocation would run for minutes and end in std::bad_alloc (or
+// the kernel's OOM killer).
+#pragma once
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+
+namespace pathlab {
+
+// Memory this machine can still give (MemAvailable of /proc/meminfo), or 0 when unknown.
+uint64_t available_memory();
+
+// Bytes in GiB, for messages.
+inline double gib(uint64_t bytes) { return double(bytes) / double(uint64_t(1) << 30); }
+
+// A render whose film, maps or images do not fit in memory; what() says how much it needs.
+struct NotEnoughMemory : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+// Throws NotEnoughMemory("<what> would need X GiB of memory, but only Y GiB is available<advice>")
+// when `bytes` is more than the machine can give (nothing when that is unknown).
+void check_memory(uint64_t bytes, const std::string& what, const std::string& advice = "");
+
+}  // namespace pathlab

@@ -10,6 +10,9 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+
+#include <fmt/format.h>
 
 #include "chi2.hpp"
 #include "media/grid_files.hpp"
@@ -388,6 +391,48 @@ TEST_F(GridFiles, VdbGridReadsBackInItsWorldSpace) {
     std::ofstream(path("junk.vdb")) << "not a vdb";
     const std::string junk = expect_grid_error([&] { read_vdb_file(path("junk.vdb")); });
     EXPECT_NE(junk.find(path("junk.vdb")), std::string::npos) << junk;
+}
+
+// Hostile .vdb files made from a good one: OpenVDB trusts a file's layout, and looped forever on
+// a grid offset pointing backwards and on a file cut inside its header; each is refused with the
+// file and its problem before OpenVDB reads it.
+TEST_F(GridFiles, VdbFilesWithABrokenLayoutAreRefusedBeforeOpenVdbReadsThem) {
+    VoxelGrid g;
+    g.res = {3, 3, 3};
+    g.data.assign(27, 1.0f);
+    write_vdb_file(path("good.vdb"), g, "density", 0.5);
+    std::ifstream in(path("good.vdb"), std::ios::binary);
+    const std::string good((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    // The first grid descriptor: after the header (57 bytes), no metadata (4), the grid count (4),
+    // then the name, type and parent name (each a 4-byte length and its bytes), then the grid's
+    // three positions.
+    size_t at = 65;
+    for (int k = 0; k < 3; ++k) {
+        uint32_t n;
+        std::memcpy(&n, good.data() + at, 4);
+        at += 4 + n;
+    }
+    const auto with = [&](size_t offset, int64_t value) {
+        std::string bad = good;
+        std::memcpy(bad.data() + offset, &value, 8);
+        return bad;
+    };
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {with(at, -5), "grid 1 spans bytes -5"},                        // (it looped forever)
+        {with(at + 8, int64_t(1) << 40), "not within its part of the file"},
+        {with(at + 16, int64_t(good.size()) + 1), "not within its part of the file"},
+        {good.substr(0, 40), "it ends inside its UUID"},                // (it looped forever)
+        {good.substr(0, at + 4), "it ends inside its grid position"},
+        {with(8, 300), "file format version 300"},
+    };
+    for (size_t i = 0; i < cases.size(); ++i) {
+        const std::string file = path(fmt::format("bad{}.vdb", i));
+        std::ofstream(file, std::ios::binary) << cases[i].first;
+        const std::string m = expect_grid_error([&] { read_vdb_file(file); });
+        EXPECT_NE(m.find(file), std::string::npos) << m;
+        EXPECT_NE(m.find(cases[i].second), std::string::npos) << i << ": " << m;
+    }
+    EXPECT_NO_THROW(read_vdb_file(path("good.vdb")));
 }
 
 }  // namespace

@@ -92,6 +92,33 @@ TEST(SceneFileStructure, IncludesNestedDefaultsAndLoops) {
         EXPECT_EQ(std::filesystem::path(e.file).filename().string(), "b.xml");
         EXPECT_EQ(e.line, 3);
     }
+    // Fan-out without a loop: each level includes the next 8 times, 6 levels deep (8^6 = 262144
+    // includes; it ran for minutes and grew without bound): refused at the 4097th include.
+    for (int level = 0; level < 6; ++level) {
+        std::string text = "<scene version=\"3.0.0\">\n";
+        for (int k = 0; k < 8; ++k) text += fmt::format("  <include filename=\"fan{}.xml\"/>\n", level + 1);
+        write_file(dir + fmt::format("/fan{}.xml", level), text + "</scene>");
+    }
+    write_file(dir + "/fan6.xml", "<scene version=\"3.0.0\"><bsdf type=\"diffuse\"/></scene>");
+    try {
+        load_scene_file(dir + "/fan0.xml");
+        ADD_FAILURE() << "no error for an include tree that fans out";
+    } catch (const SceneFileError& e) {
+        EXPECT_NE(e.message.find("more than 4096 includes in all"), std::string::npos) << e.what();
+    }
+    // Within the count, too many bytes: a 1 MiB file included 8 x 8 x 8 times (512 MiB).
+    write_file(dir + "/big.xml", "<scene version=\"3.0.0\"><!--" + std::string(1 << 20, 'x') + "--></scene>");
+    for (int level = 0; level < 3; ++level) {
+        std::string text = "<scene version=\"3.0.0\">\n";
+        for (int k = 0; k < 8; ++k) text += level < 2 ? fmt::format("  <include filename=\"big{}.xml\"/>\n", level + 1) : "  <include filename=\"big.xml\"/>\n";
+        write_file(dir + fmt::format("/big{}.xml", level), text + "</scene>");
+    }
+    try {
+        load_scene_file(dir + "/big0.xml");
+        ADD_FAILURE() << "no error for 512 MiB of includes";
+    } catch (const SceneFileError& e) {
+        EXPECT_NE(e.message.find("the includes bring more than 256 MiB of scene text in all"), std::string::npos) << e.what();
+    }
     // A file including itself.
     write_file(dir + "/self.xml", "<scene version=\"3.0.0\"><include filename=\"self.xml\"/></scene>");
     EXPECT_THROW(load_scene_file(dir + "/self.xml"), SceneFileError);

@@ -75,6 +75,12 @@ struct Loader {
     std::shared_ptr<LoadContext> context;
     SceneBuilder b;
     std::vector<std::string> chain;  // the files being read: the main file, then each include
+    // The whole include tree's files and bytes: a file that includes another many times over,
+    // nested, multiplies them (as entity expansion does in XML), where depth and loops are fine.
+    size_t includes = 0;
+    uint64_t included_bytes = 0;
+    static constexpr size_t kMaxIncludes = 4096;
+    static constexpr uint64_t kMaxIncludedBytes = uint64_t(256) << 20;
 
     void read_children(XmlSource& xml, const pugi::xml_node& scene);
     void include(XmlSource& xml, const pugi::xml_node& n);
@@ -144,12 +150,18 @@ void Loader::include(XmlSource& xml, const pugi::xml_node& n) {
             xml.fail(n, fmt::format("include loop: {}", fmt::join(names, " includes ")));
         }
     if (chain.size() >= 64) xml.fail(n, "includes nested more than 64 deep");
+    if (++includes > kMaxIncludes)
+        xml.fail(n, fmt::format("more than {} includes in all (files included many times over, nested?)", kMaxIncludes));
     if (!std::filesystem::is_regular_file(path, ec)) xml.fail(n, fmt::format("included file '{}' is not a regular file", path));
     std::ifstream in(path, std::ios::binary);
     if (!in) xml.fail(n, fmt::format("cannot open the included file '{}'", path));
     std::ostringstream text;
     text << in.rdbuf();
     const std::string content = text.str();
+    included_bytes += content.size();
+    if (included_bytes > kMaxIncludedBytes)
+        xml.fail(n, fmt::format("the includes bring more than {} MiB of scene text in all (files included many times over, nested?)",
+                                kMaxIncludedBytes >> 20));
     XmlSource inner(content, path, context);
     const pugi::xml_node root = inner.root();
     if (std::string(root.name()) != "scene") inner.fail(root, fmt::format("an included file's root element must be <scene>, not <{}>", root.name()));

@@ -161,6 +161,17 @@ TEST(SceneFileStructure, PathsAreSearchedForEveryFile) {
     }
     EXPECT_NE(error_of("<scene version=\"3\"><path value=\"no/such/folder\"/><shape type=\"sphere\"/></scene>", dir).find("folder"),
               std::string::npos);
+    // A spectrum file over 16 MiB is refused (it was read cut at 16 MiB, silently).
+    std::string big = "# big\n360 0.5\n";
+    while (big.size() <= (size_t(1) << 24)) big += "# padding padding padding padding padding padding padding padding\n";
+    write_file(dir + "/assets/spectra/big.spd", big + "830 0.5\n");
+    write_file(dir + "/big.xml", R"(<scene version="3.0.0"><path value="assets/spectra"/><shape type="sphere"><bsdf type="diffuse"><spectrum name="reflectance" filename="big.spd"/></bsdf></shape></scene>)");
+    try {
+        load_scene_file(dir + "/big.xml");
+        ADD_FAILURE() << "a 16 MiB spectrum file was read";
+    } catch (const SceneFileError& e) {
+        EXPECT_NE(e.message.find("more than the 16 MiB a spectrum file may have"), std::string::npos) << e.what();
+    }
 }
 
 TEST(SceneFileStructure, RefsAliasesAndVersions) {

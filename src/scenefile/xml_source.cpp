@@ -353,9 +353,15 @@ std::string XmlSource::spectrum_value(const pugi::xml_node& c, const PluginInfo&
         std::ifstream in(path, std::ios::binary);
         std::error_code ec;
         if (!in || !std::filesystem::is_regular_file(path, ec)) fail(c, fmt::format("cannot read the spectrum file '{}'", path));
-        std::string text;
-        text.resize(std::min<uint64_t>(std::filesystem::file_size(path, ec), 1 << 24));
+        // A spectrum of more than 16 MiB of text is no measured spectrum (it was read cut short,
+        // silently: the spectrum of its first 16 MiB).
+        const uint64_t bytes = std::filesystem::file_size(path, ec);
+        if (ec) fail(c, fmt::format("cannot read the spectrum file '{}': {}", path, ec.message()));
+        if (bytes > (uint64_t(1) << 24))
+            fail(c, fmt::format("spectrum file '{}' is {} bytes, more than the 16 MiB a spectrum file may have", path, bytes));
+        std::string text(bytes, '\0');
         in.read(text.data(), std::streamsize(text.size()));
+        if (!in) fail(c, fmt::format("cannot read the spectrum file '{}'", path));
         const std::string why = parse_spectrum_file(text, s);
         if (!why.empty()) fail(c, fmt::format("spectrum file '{}': {}", path, why));
         return convert(s);

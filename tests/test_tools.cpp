@@ -340,6 +340,22 @@ TEST_F(Tools, ReferenceThenCheckReportsOkMissingAndBlackByDesign) {
     EXPECT_EQ(r.code, 1) << r.out << r.err;
     EXPECT_TRUE(std::regex_search(r.out, std::regex("2 ceiling-diffuse +FAIL "))) << r.out;
     fs::rename(path("manifest.json"), path("refs/manifest.json"));
+    // A corrupt manifest is refused (exit 2), naming it: ignored, it let that FAIL pass unseen as
+    // PASSED references of another estimator. `reference` leaves it as it is.
+    const std::string good = read_text(path("refs/manifest.json"));
+    for (const std::string& bad : {std::string("{\"scenes\": [ {\"file\": \"2-ceiling-diffuse.exr\","), std::string("[1, 2]"),
+                                   std::string("{\"scenes\": {}}"), std::string("{\"scenes\": [{\"file\": \"2-ceiling-diffuse.exr\", \"resolution\": [\"a\", 2]}]}")}) {
+        std::ofstream(path("refs/manifest.json")) << bad;
+        r = run({"check", "-a", "pt-mis", "--references", path("refs"), "--scene", "2", "--spp", "16"});
+        EXPECT_EQ(r.code, 2) << bad << ": " << r.out << r.err;
+        EXPECT_TRUE(contains(r.err, path("refs/manifest.json") + ": ")) << r.err;
+        EXPECT_FALSE(contains(r.out, "PASSED")) << r.out;
+        r = run({"reference", "--out", path("refs"), "--scene", "2", "--algorithm", "direct-mis", "--resolution", "24x20", "--spp", "4", "-q"});
+        EXPECT_EQ(r.code, 2) << bad;
+        EXPECT_TRUE(contains(r.err, path("refs/manifest.json") + ": ")) << r.err;
+        EXPECT_EQ(read_text(path("refs/manifest.json")), bad);
+    }
+    std::ofstream(path("refs/manifest.json")) << good;
 
     // A reference of another size: refused (exit 2), naming both sizes.
     r = run({"check", "-a", "1", "--references", path("refs"), "--scene", "2", "--spp", "4", "--resolution", "12x10"});

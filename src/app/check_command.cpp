@@ -100,7 +100,13 @@ int run_check_command(const CheckOptions& o) {
         ref.file = s.builtin ? find_reference(o.references, *s.builtin, mapping, &ref.tried)
                              : find_reference_named(o.references, s.name, &ref.tried);
         if (!ref.file) continue;
-        if (ref.file->kind == ReferenceKind::Linear) ref.record = find_reference_record(ref.file->path);
+        if (ref.file->kind == ReferenceKind::Linear) {
+            try {
+                ref.record = find_reference_record(ref.file->path);
+            } catch (const ManifestError& e) {
+                throw UsageError(e.what());  // what the references are of is unknown: nothing can be judged
+            }
+        }
         try {
             ref.loaded = load_reference(*ref.file);
         } catch (const ImageIoError& e) {

@@ -98,6 +98,11 @@ int run_reference_command(const ReferenceOptions& o) {
             } catch (const ImageIoError& e) {
                 throw UsageError(fmt::format("--out {}: {}", dir, e.what()));
             }
+            try {
+                check_manifest(dir);
+            } catch (const ManifestError& e) {
+                throw UsageError(e.what());
+            }
             for (const char* suffix : {".exr", ".stderr.exr", ".png"})
                 paths.output((fs::path(dir) / (stem + suffix)).string(), "a reference", /*image=*/true);
             dirs.push_back(dir);

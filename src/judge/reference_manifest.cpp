@@ -14,13 +14,36 @@ namespace fs = std::filesystem;
 namespace {
 
 nlohmann::json read_manifest(const fs::path& path) {
-    if (!fs::is_regular_file(path)) return nlohmann::json::object();
+    std::error_code ec;
+    if (!fs::exists(fs::symlink_status(path, ec))) return nlohmann::json::object();
+    const auto fail = [&](const std::string& why) {
+        return ManifestError(fmt::format("{}: {} (fix it, or remove it and render the references again)", path.string(), why));
+    };
+    if (!fs::is_regular_file(path, ec)) throw fail("not a regular file");
+    std::ifstream in(path);
+    if (!in) throw fail("cannot read it");
+    nlohmann::json j;
     try {
-        nlohmann::json j = nlohmann::json::parse(std::ifstream(path));
-        if (j.is_object()) return j;
-    } catch (const nlohmann::json::exception&) {
+        j = nlohmann::json::parse(in);
+    } catch (const nlohmann::json::exception& e) {
+        throw fail(fmt::format("not valid JSON: {}", e.what()));
     }
-    return nlohmann::json::object();
+    if (!j.is_object()) throw fail("not a JSON object");
+    if (j.contains("scenes")) {
+        if (!j["scenes"].is_array()) throw fail("its \"scenes\" is not an array");
+        for (const nlohmann::json& e : j["scenes"]) {
+            if (!e.is_object()) throw fail("an entry of \"scenes\" is not an object");
+            const std::string file = e.contains("file") && e["file"].is_string() ? e["file"].get<std::string>() : "?";
+            if (!e.contains("file") || !e["file"].is_string()) throw fail("an entry of \"scenes\" has no \"file\" name");
+            if (e.contains("index") && !e["index"].is_number_integer()) throw fail(fmt::format("the entry of '{}': its index is not a whole number", file));
+            try {
+                (void)reference_record_from_json(e);
+            } catch (const nlohmann::json::exception& x) {
+                throw fail(fmt::format("the entry of '{}': {}", file, x.what()));
+            }
+        }
+    }
+    return j;
 }
 
 std::string describe_scene(const ReferenceRecord& r) {
@@ -102,6 +125,8 @@ std::optional<ReferenceRecord> find_reference_record(const std::string& image_pa
         if (e.is_object() && e.value("file", "") == name) return reference_record_from_json(e);
     return std::nullopt;
 }
+
+void check_manifest(const std::string& dir) { (void)read_manifest(fs::path(dir) / "manifest.json"); }
 
 void record_reference(const std::string& dir, const ReferenceRecord& record) {
     const fs::path path = fs::path(dir) / "manifest.json";

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <map>
 #include <optional>
+#include <stdexcept>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -41,12 +42,22 @@ nlohmann::json to_json(const ReferenceRecord& r);
 // algorithm and the depth.
 ReferenceRecord reference_record_from_json(const nlohmann::json& j);
 
+// A manifest.json that exists but is not one (not JSON, not an object, "scenes" not an array
+// of records, a field of the wrong type): what() names the file and the problem. A corrupt
+// manifest cannot be ignored: a reference it would have refused would then judge a render.
+struct ManifestError : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
 // The record of `image_path` in the manifest.json of its directory; nullopt when there is no
-// manifest or it does not list the file.
+// manifest or it does not list the file; ManifestError for a corrupt one.
 std::optional<ReferenceRecord> find_reference_record(const std::string& image_path);
 
+// Throws ManifestError if DIR/manifest.json exists and is corrupt (before anything is rendered into DIR).
+void check_manifest(const std::string& dir);
+
 // Adds the record to DIR/manifest.json (replacing one of the same file; others kept), sorted
-// by course index, then file name.
+// by course index, then file name; ManifestError for a corrupt one (left as it is).
 void record_reference(const std::string& dir, const ReferenceRecord& record);
 
 // Empty when the recorded reference fits a render of `scene` by an estimator of `family` at

@@ -141,7 +141,7 @@ TEST_F(Hostile, RegressionCorporaFailCleanlyInBoundedTimeAndMemory) {
         {"no-end-of-image.jpg", "cannot read JPEG: truncated: the file ends before its end-of-image marker"},
         {"segment-past-end.jpg", "cannot read JPEG: truncated: the file ends inside a segment of 65535 bytes"},
         {"exponent-int-overflow.obj", "a number with an exponent of 10 digits"},
-        {"index-out-of-range.obj", "refers to a vertex that does not exist"},
+        {"index-out-of-range.obj", "line 4: index '99999999999' is out of range"},
     };
     int files = 0, checked = 0;
     for (const char* dir : {"tests/data/image_regressions", "tests/data/obj_regressions"}) {
@@ -167,6 +167,30 @@ TEST_F(Hostile, RegressionCorporaFailCleanlyInBoundedTimeAndMemory) {
 }
 
 // Every prefix of a valid file (stb_image hung on many of the .hdr ones), in one child.
+// Numbers tinyobjloader reads as other numbers without a word ("nan" and "inf" as 0, a face index
+// past 32 bits wrapped: 4294967299 was vertex 3) are refused with their line; the same file with
+// the numbers in range loads.
+TEST_F(Hostile, ObjNumbersReadAsOtherNumbersAreRefusedWithTheirLine) {
+    const std::string head = "# hostile\nv 0 0 0\nv 1 0 0\n";
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {head + "v nan 1 0\nf 1 2 3\n", "line 4: 'nan' is not a finite number"},
+        {head + "v 0 -inf 0\nf 1 2 3\n", "line 4: '-inf' is not a finite number"},
+        {head + "v 0 1 0\nvn 0 0 NaN\nf 1//1 2//1 3//1\n", "line 5: 'NaN' is not a finite number"},
+        {head + "v 0 1 0\nf 1 2 4294967299\n", "line 5: index '4294967299' is out of range"},
+        {head + "v 0 1 0\r\nf 1/99999999999/1 2 3\r\n", "line 5: index '99999999999' is out of range"},
+    };
+    for (size_t i = 0; i < cases.size(); ++i) {
+        const std::string file = path(fmt::format("numbers{}.obj", i));
+        std::ofstream(file, std::ios::binary) << cases[i].first;
+        const BoundedResult r = run_bounded([&] { (void)load_obj_mesh(file); }, 10, size_t(256) << 20);
+        EXPECT_EQ(r.outcome, Outcome::CleanError) << i << ": " << outcome_name(r.outcome) << ": " << r.message;
+        EXPECT_NE(r.message.find(file), std::string::npos) << r.message;
+        EXPECT_NE(r.message.find(cases[i].second), std::string::npos) << i << ": " << r.message;
+    }
+    std::ofstream(path("fine.obj")) << head + "v 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1\nf -1 -2 -3\n";
+    EXPECT_EQ(load_obj_mesh(path("fine.obj")).triangles.size(), 2u);
+}
+
 TEST_F(Hostile, EveryTruncationOfAValidFileFailsCleanly) {
     for (const char* ext : {"hdr", "pfm", "exr", "png", "jpg"}) {
         const std::string bytes = valid_file(ext);

@@ -8,8 +8,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <climits>
 #include <map>
+#include <string_view>
 #include <tuple>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -127,6 +130,53 @@ void avoid_tinyobj_undefined_behaviour(std::string& text, const std::string& pat
     }
 }
 
+// Two inputs tinyobjloader reads as other numbers, silently: "nan" and "inf" as 0 in a vertex,
+// and a face index past 32 bits wrapped (4294967299 is vertex 3). Refused with the line.
+void refuse_obj_numbers_read_wrongly(const std::string& text, const std::string& path) {
+    size_t line = 1;
+    for (size_t i = 0; i < text.size();) {
+        const size_t end = std::min(text.find_first_of("\r\n", i), text.size());
+        size_t first = i;
+        while (first < end && (text[first] == ' ' || text[first] == '\t')) ++first;
+        const char c0 = first < end ? text[first] : '#';
+        std::vector<std::string_view> tokens;  // only for the lines below (a few per mesh line)
+        if (c0 == 'v' || c0 == 'f' || c0 == 'l' || c0 == 'p')
+            for (size_t j = first; j < end;) {
+                while (j < end && (text[j] == ' ' || text[j] == '\t')) ++j;
+                const size_t k = j;
+                while (j < end && text[j] != ' ' && text[j] != '\t') ++j;
+                if (j > k) tokens.emplace_back(text.data() + k, j - k);
+            }
+        const auto fail = [&](const std::string& why) {
+            return MeshLoadError(fmt::format("cannot read mesh '{}': line {}: {}", path, line, why));
+        };
+        if (!tokens.empty() && (tokens[0] == "v" || tokens[0] == "vn" || tokens[0] == "vt")) {
+            for (size_t t = 1; t < tokens.size(); ++t) {
+                std::string_view w = tokens[t];
+                if (!w.empty() && (w[0] == '+' || w[0] == '-')) w.remove_prefix(1);
+                if (!w.empty() && (w[0] == 'n' || w[0] == 'N' || w[0] == 'i' || w[0] == 'I'))
+                    throw fail(fmt::format("'{}' is not a finite number", tokens[t]));
+            }
+        } else if (!tokens.empty() && (tokens[0] == "f" || tokens[0] == "l" || tokens[0] == "p")) {
+            for (size_t t = 1; t < tokens.size(); ++t)
+                for (size_t a = 0; a <= tokens[t].size();) {
+                    const size_t b = std::min(tokens[t].find('/', a), tokens[t].size());
+                    size_t digits = 0;
+                    uint64_t value = 0;
+                    for (size_t c = a; c < b; ++c)
+                        if (tokens[t][c] >= '0' && tokens[t][c] <= '9' && ++digits <= 12) value = value * 10 + uint64_t(tokens[t][c] - '0');
+                    if (digits > 10 || value > uint64_t(INT32_MAX)) throw fail(fmt::format("index '{}' is out of range", tokens[t].substr(a, b - a)));
+                    a = b + 1;
+                }
+        }
+        i = end;
+        if (i < text.size()) {
+            if (text[i] == '\r' && i + 1 < text.size() && text[i + 1] == '\n') ++i;
+            ++i, ++line;
+        }
+    }
+}
+
 }  // namespace
 
 MeshDesc load_obj_mesh(const std::string& path) {
@@ -146,6 +196,7 @@ MeshDesc load_obj_mesh(const std::string& path) {
     std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     if (in.bad()) throw MeshLoadError(fmt::format("cannot read mesh '{}': read error", path));
     avoid_tinyobj_undefined_behaviour(text, path);
+    refuse_obj_numbers_read_wrongly(text, path);
     tinyobj::ObjReader reader;
     if (!reader.ParseFromString(text, "", config)) {
         std::string why = reader.Error();

@@ -355,14 +355,14 @@ TEST_F(Hostile, EveryWriterReportsAFullDevice) {
     ::close(fd);
 }
 
-// Runs the binary with a file size limit (RLIMIT_FSIZE; SIGXFSZ ignored, so writes beyond it
-// fail with EFBIG as they would on a full disk); returns its exit status, stderr in err.txt.
+// Runs the binary with a file size limit (RLIMIT_FSIZE; pathlab ignores SIGXFSZ itself, so writes
+// beyond it fail with EFBIG as they would on a full disk: the default action killed it without a
+// word); returns its exit status, stderr in err.txt.
 int run_with_file_size_limit(const std::vector<std::string>& args, rlim_t limit, const std::string& err_file) {
     const pid_t pid = fork();
     if (pid == 0) {
         const rlimit rl{limit, limit};
         setrlimit(RLIMIT_FSIZE, &rl);
-        signal(SIGXFSZ, SIG_IGN);
         const int err = ::open(err_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);  // before the limit matters: small
         dup2(err, STDERR_FILENO);
         std::vector<char*> argv{const_cast<char*>(PATHLAB_BINARY)};
@@ -395,6 +395,24 @@ TEST_F(Hostile, AWriteBeyondTheFileSizeLimitKeepsTheOldFile) {
     EXPECT_EQ(WEXITSTATUS(status), 1);
     EXPECT_NE(read_file(path("err.txt")).find("(no file was written)"), std::string::npos) << read_file(path("err.txt"));
     EXPECT_FALSE(fs::exists(path("new.pfm")));
+    EXPECT_TRUE(temporaries().empty());
+}
+
+// A checkpoint that cannot be written (here the file-size limit lets the 64x64 image through,
+// 49 KiB, but not the exact film, 640 KiB): the render's image is written, the failure is said
+// and counted, and the exit code is 1 (it reported "1 checkpoint(s) written" and exited 0).
+TEST_F(Hostile, AFinalCheckpointThatCannotBeWrittenFailsTheRender) {
+    const int status = run_with_file_size_limit({"--scene", "3", "--resolution", "64x64", "--spp", "2", "--checkpoint", path("r.ckpt"), "-o",
+                                                 path("r.pfm")}, 100 << 10, path("err.txt"));
+    const std::string err = read_file(path("err.txt"));
+    ASSERT_TRUE(WIFEXITED(status)) << err;
+    EXPECT_EQ(WEXITSTATUS(status), 1) << err;
+    EXPECT_NE(err.find("checkpoint not written"), std::string::npos) << err;
+    EXPECT_NE(err.find("the final checkpoint " + path("r.ckpt") + " could not be written"), std::string::npos) << err;
+    EXPECT_NE(err.find("1 checkpoint(s) could not be written"), std::string::npos) << err;
+    EXPECT_EQ(err.find("checkpoint(s) written in"), std::string::npos) << err;
+    EXPECT_TRUE(fs::exists(path("r.pfm")));
+    EXPECT_FALSE(fs::exists(path("r.ckpt")));
     EXPECT_TRUE(temporaries().empty());
 }
 

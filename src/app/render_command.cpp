@@ -344,6 +344,7 @@ void print_summary(const RenderJob& job, const std::string& name, const RenderSt
         fmt::print(stderr, "  film reduction {:.3f}s\n", s.reduce_seconds);
     }
     if (s.checkpoints) fmt::print(stderr, "  {} checkpoint(s) written in {:.3f}s\n", s.checkpoints, s.checkpoint_seconds);
+    if (s.failed_checkpoints) fmt::print(stderr, "  {} checkpoint(s) could not be written\n", s.failed_checkpoints);
 }
 
 }  // namespace
@@ -456,9 +457,11 @@ int run_render_command(const RenderCommandOptions& o, RankGroup* ranks) {
                 const CheckpointInfo info{identity, done, width, height, seconds_before + st.seconds, PATHLAB_VERSION};
                 try {
                     write_checkpoint(checkpoints[j], parts, film, info);
+                    return true;
                 } catch (const std::exception& e) {
                     // The render goes on; the file keeps the last complete checkpoint.
                     fmt::print(stderr, "pathlab: warning: {}: checkpoint not written: {}\n", name, e.what());
+                    return false;
                 }
             };
         }
@@ -481,6 +484,14 @@ int run_render_command(const RenderCommandOptions& o, RankGroup* ranks) {
                 continue;
             }
             if (!o.quiet) print_summary(job, name, s);
+            if (s.last_checkpoint_failed) {
+                // The image is written, but the checkpoint asked for does not hold this render's end.
+                fmt::print(stderr, "pathlab: error: {}: the final checkpoint {} could not be written; it holds {}\n", name, checkpoints[j],
+                           s.checkpoints > 0 ? "an earlier checkpoint of this render" : "what it held before");
+                ++failed;
+                if (s.interrupted) return 1;
+                continue;
+            }
         }
         if (s.interrupted) {
             if (root && j + 1 < jobs.size()) fmt::print(stderr, "pathlab: interrupted; {} render(s) not done\n", jobs.size() - j - 1);

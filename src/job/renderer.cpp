@@ -129,8 +129,8 @@ RenderStats render_into(const Scene& scene, Integrator& integrator, const Render
         if (settings.checkpoint && settings.checkpoint_every > 0 && st.seconds - last_checkpoint >= settings.checkpoint_every &&
             done.count() < (settings.spp > 0 ? settings.spp : UINT64_MAX)) {
             const double t0 = seconds_since_start();
-            settings.checkpoint(ranks, film, done, st);
-            ++st.checkpoints;
+            if (settings.checkpoint(ranks, film, done, st)) ++st.checkpoints;
+            else ++st.failed_checkpoints;
             st.checkpoint_seconds += seconds_since_start() - t0;
             last_checkpoint = st.seconds;
         }
@@ -176,8 +176,9 @@ RenderStats render_into(const Scene& scene, Integrator& integrator, const Render
         integrator.finish(ctx);
         if (settings.checkpoint) {
             const double t0 = seconds_since_start();
-            settings.checkpoint(alone, film, done, st);
-            ++st.checkpoints;
+            st.last_checkpoint_failed = !settings.checkpoint(alone, film, done, st);
+            if (st.last_checkpoint_failed) ++st.failed_checkpoints;
+            else ++st.checkpoints;
             st.checkpoint_seconds += seconds_since_start() - t0;
         }
     }

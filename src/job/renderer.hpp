@@ -50,8 +50,9 @@ struct RenderStats {
     // Across processes (on the root): each rank's part, and the time the film reduction took.
     std::vector<RankStats> ranks;
     double reduce_seconds = 0;
-    // Checkpoints written during this run and the time they took.
-    uint64_t checkpoints = 0;
+    // Checkpoints written during this run (and those that could not be), and the time they took.
+    uint64_t checkpoints = 0, failed_checkpoints = 0;
+    bool last_checkpoint_failed = false;  // the final one: the file keeps an earlier state
     double checkpoint_seconds = 0;
 };
 
@@ -78,9 +79,10 @@ struct RenderSettings {
     // Checkpoints: checkpoint(parts, film, done, stats) is called every checkpoint_every
     // seconds (0: never) after a round, on every rank with its own film and parts = the ranks
     // (it sums them with parts.reduce_film), and at the end, also of an interrupted render, on
-    // the root alone with the summed film and parts = one process.
+    // the root alone with the summed film and parts = one process. It returns whether the
+    // checkpoint was written (a failed one is counted apart; the render goes on).
     double checkpoint_every = 0;
-    std::function<void(RankGroup& parts, const Film& film, const PassSet& done, const RenderStats& stats)> checkpoint;
+    std::function<bool(RankGroup& parts, const Film& film, const PassSet& done, const RenderStats& stats)> checkpoint;
 };
 
 struct RenderResult {

@@ -2,6 +2,9 @@
 // checkpoint file, resume, merge, and MPI ranks (through mpirun, as CI runs it: as root, two
 // ranks oversubscribed on one machine).
 #include <gtest/gtest.h>
+#include <xxhash.h>
+
+#include <cstddef>
 
 #include <signal.h>
 #include <sys/wait.h>
@@ -340,6 +343,34 @@ TEST_F(Distributed, TruncatedOrCorruptedCheckpointIsRefusedAndKept) {
         EXPECT_FALSE(fs::exists(path("b.exr")));
     }
     EXPECT_THROW(read_checkpoint(path("missing.ckpt")), CheckpointError);
+
+    // Forged: a pixel's sums changed and the checksum recomputed (the checksum alone accepted
+    // them): the first pixel's count raised past the passes, and its first channel's sum of
+    // squares zeroed while its sum is not.
+    uint32_t h = 0;
+    std::memcpy(&h, good.data() + 12, 4);
+    const size_t first_pixel = 16 + h + 8;
+    const size_t count_at = first_pixel + offsetof(PixelSums, count), sumsq_at = first_pixel + offsetof(PixelSums, sumsq);
+    const auto forged = [&](size_t at, const std::string& bytes) {
+        std::string f = good;
+        f.replace(at, bytes.size(), bytes);
+        const uint64_t checksum = XXH3_64bits(f.data(), f.size() - 8);
+        std::memcpy(f.data() + f.size() - 8, &checksum, 8);
+        return f;
+    };
+    const uint64_t many = 1000;
+    const std::vector<Damage> forgeries = {
+        {"a count past the passes", forged(count_at, std::string(reinterpret_cast<const char*>(&many), 8)), "pixel 0 is invalid: 1000 samples in 2 passes"},
+        {"squares smaller than the sum allows", forged(sumsq_at, std::string(sizeof(PixelSums::sumsq[0]), '\0')), "pixel 0 is invalid: channel 0"},
+    };
+    for (const Damage& d : forgeries) {
+        std::ofstream(path("forged.ckpt"), std::ios::binary) << d.bytes;
+        const CliResult r = run({"--scene", "3", "--resolution", "16x12", "--seed", "5", "-q", "--spp", "4", "--resume", path("forged.ckpt"), "-o",
+                                 path("b.exr")});
+        EXPECT_EQ(r.code, 2) << d.what << ": " << r.err;
+        EXPECT_TRUE(contains(r.err, d.message)) << d.what << ": " << r.err;
+        EXPECT_FALSE(fs::exists(path("b.exr")));
+    }
 }
 
 // ---- merge -------------------------------------------------------------------------------

@@ -2,6 +2,7 @@
 
 #include <xxhash.h>
 
+#include <cmath>
 #include <cstring>
 #include <sstream>
 
@@ -155,9 +156,25 @@ Checkpoint read_checkpoint(const std::string& path) {
         throw CheckpointError(fmt::format("{}: corrupted: its checksum is {:016x} but its content sums to {:016x}; it cannot be used",
                                           path, le64(stored), computed));
     // A checksum passes by chance once in 2^64: still check what the film's use depends on.
-    for (size_t i = 0; i < n; ++i)
+    // And sums no render could have made (a forged file with a valid checksum): a pixel takes at
+    // most one sample per pass, and per channel its sum of squares is at least sum^2 / count
+    // (Cauchy-Schwarz), all finite.
+    const uint64_t passes = c.info.passes.count();
+    for (size_t i = 0; i < n; ++i) {
+        const PixelSums& p = c.film.data()[i];
+        const auto invalid = [&](const std::string& why) {
+            return CheckpointError(fmt::format("{}: corrupted: pixel {} is invalid: {}; it cannot be used", path, i, why));
+        };
         for (int k = 0; k < 6; ++k)
-            if (c.film.data()[i].top[k] > 80) throw CheckpointError(fmt::format("{}: corrupted: pixel {} is invalid", path, i));
+            if (p.top[k] > 80) throw invalid("its sums are out of range");
+        if (p.count > passes) throw invalid(fmt::format("{} samples in {} passes", p.count, passes));
+        for (int ch = 0; ch < 3; ++ch) {
+            const double sum = exact::value(p.sum[ch], p.top[ch]), sumsq = exact::value(p.sumsq[ch], p.top[3 + ch]);
+            if (!std::isfinite(sum) || !std::isfinite(sumsq) || sumsq < 0) throw invalid("a sum that is not finite, or a negative sum of squares");
+            if (p.count == 0 ? (sum != 0 || sumsq != 0) : sumsq * double(p.count) < sum * sum * (1 - 1e-9))
+                throw invalid(fmt::format("channel {}: sum {} and sum of squares {} of {} samples", ch, sum, sumsq, p.count));
+        }
+    }
     return c;
 }
 

@@ -198,6 +198,8 @@ py::tuple py_render(const py::object& scene_obj, const py::object& algorithm, st
     }
     if (spp) {
         if (*spp == 0) throw py::value_error("spp must be a positive number of samples");
+        // As the command line: sample indices from 2^62 on are refused (such a render never ends).
+        if (*spp >= (uint64_t(1) << 62)) throw py::value_error(fmt::format("spp {} reaches past the last sample index, 2^62", *spp));
         request.spp = *spp;
     }
     if (time < 0 || !std::isfinite(time)) throw py::value_error("time must be a positive number of seconds (0: none)");
@@ -298,6 +300,8 @@ PYBIND11_MODULE(pathlab, m) {
         const Image a = to_image(img, "image"), r = to_image(reference, "reference");
         const Image se = reference_se.is_none() ? Image() : to_image(reference_se, "reference_se");
         if (a.width() != r.width() || a.height() != r.height()) throw py::value_error("image and reference differ in size");
+        if (!reference_se.is_none() && (se.width() != r.width() || se.height() != r.height()))
+            throw py::value_error(fmt::format("reference_se is {}x{} but the reference {}x{}", se.width(), se.height(), r.width(), r.height()));
         return rmse_against_reference(a, r, se);
     }, py::arg("image"), py::arg("reference"), py::arg("reference_se") = py::none(),
           "RMSE against a reference with the reference's own noise (its standard errors, if given) removed, as pathlab report computes it");

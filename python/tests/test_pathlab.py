@@ -83,6 +83,17 @@ def test_compare_gives_the_command_lines_statistics(tmp_path):
     assert pathlab.compare(a, b) == expected
     assert pathlab.compare(str(tmp_path / "a.exr"), b) == expected
     assert pathlab.compare(a, a)["all"]["rmse"] == 0
+    # Nothing to compare (every pixel NaN): no statistic (NaN), not a perfect 0.
+    nan = np.full_like(a, np.nan)
+    stats = pathlab.compare(nan, b)
+    assert stats["compared"] == 0 and np.isnan(stats["all"]["rmse"])
+    assert np.isnan(pathlab.rmse(nan, b))
+    # reference_se of another shape than the reference is refused, not ignored.
+    with pytest.raises(ValueError, match="reference_se is 8x8 but the reference 16x16"):
+        pathlab.rmse(a, b, np.zeros((8, 8, 3), dtype=np.float32))
+    # A sample count past the last sample index is refused at once (it never returned).
+    with pytest.raises(ValueError, match="past the last sample index"):
+        pathlab.render(2, spp=2**63, resolution=(4, 4))
 
 
 def test_write_and_read_round_trip(tmp_path):

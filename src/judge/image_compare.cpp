@@ -1,6 +1,7 @@
 #include "judge/image_compare.hpp"
 
 #include <cmath>
+#include <limits>
 
 #include <fmt/format.h>
 
@@ -24,7 +25,11 @@ struct Accumulator {
         max_abs = std::max(max_abs, o.max_abs);
     }
     ChannelStatistics statistics() const {
-        if (n == 0) return {};
+        // Nothing compared (every pair had a NaN or an infinity): no statistic, not a perfect 0.
+        if (n == 0) {
+            const double nan = std::numeric_limits<double>::quiet_NaN();
+            return {nan, nan, nan, nan, nan};
+        }
         const double dn = double(n);
         return {sum / dn, sum_abs / dn, std::sqrt(sum_sq / dn), sum_rel / dn, max_abs};
     }
@@ -85,6 +90,9 @@ double rmse_against_reference(const Image& image, const Image& reference, const 
     if (image.width() != reference.width() || image.height() != reference.height())
         throw ImageSizeMismatch(fmt::format("images differ in size: {}x{} and {}x{}", image.width(), image.height(),
                                             reference.width(), reference.height()));
+    if (reference_se.pixel_count() != 0 && (reference_se.width() != reference.width() || reference_se.height() != reference.height()))
+        throw ImageSizeMismatch(fmt::format("the reference's standard errors are {}x{}, the reference {}x{}", reference_se.width(),
+                                            reference_se.height(), reference.width(), reference.height()));
     const bool noisy = reference_se.pixel_count() == reference.pixel_count();
     double sum_sq = 0, noise = 0;
     long n = 0;
@@ -96,7 +104,7 @@ double rmse_against_reference(const Image& image, const Image& reference, const 
             if (noisy) noise += double(reference_se[i][c]) * reference_se[i][c];
             ++n;
         }
-    return n ? std::sqrt(std::max(0.0, (sum_sq - noise) / double(n))) : 0.0;
+    return n ? std::sqrt(std::max(0.0, (sum_sq - noise) / double(n))) : std::numeric_limits<double>::quiet_NaN();
 }
 
 }  // namespace pathlab

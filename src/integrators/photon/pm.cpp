@@ -268,7 +268,8 @@ ColourOf<T> PhotonMapper<T>::beam_estimate(const Vec3f& o, const Vec3f& d, float
     MergeSum<T> sum;
     volume_balls_.for_each_along(o, d, tmax, [&](uint32_t i, float s) {
         const Photon<T>& ph = volume_[i];
-        if (ph.medium != medium || t + int(ph.vertex) - 1 > max_bounces_) return;
+        // (a ball of radius 0: a photon whose neighbours all lie on it, no disc to spread it on)
+        if (ph.medium != medium || t + int(ph.vertex) - 1 > max_bounces_ || !(volume_balls_.radius2(i) > 0)) return;
         const Colour Ts = faults_.beam_without_transmittance ? Colour(1.0f) : Tr.at(s);
         // The photon's disc across the ray: 1 / (pi r_p^2).
         sum.add(Ts * phase_eval(phase, -d, ph.wi) * ph.power / (pi * volume_balls_.radius2(i)), ph.dispersed);

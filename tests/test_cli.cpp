@@ -270,6 +270,34 @@ std::string write_scene(const std::string& file, const std::string& integrator =
     return file;
 }
 
+// Scene files of one name in folders of their own (Bitterli's layout: DIR/scene.xml): {dir} is
+// the folder, and the default names take it when they would collide (they were refused).
+TEST_F(Cli, ScenesOfOneNameInTheirOwnFoldersGetTheFolderInTheirNames) {
+    fs::create_directories(path("kitchen")), fs::create_directories(path("bathroom"));
+    const std::string a = write_scene(path("kitchen/scene.xml")), b = write_scene(path("bathroom/scene.xml"));
+    CliResult r = run({"-s", a + "," + b, "--spp", "1", "--resolution", "8x4", "-q", "-o", path("{dir}-{scene}.pfm")});
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(fs::exists(path("kitchen-scene.pfm")));
+    EXPECT_TRUE(fs::exists(path("bathroom-scene.pfm")));
+    // The default pattern, run from the test's folder.
+    const fs::path before = fs::current_path();
+    fs::current_path(path(""));
+    r = run({"-s", a + "," + b, "--spp", "1", "--resolution", "8x4", "-q"});
+    fs::current_path(before);
+    ASSERT_EQ(r.code, 0) << r.err;
+    int kitchen = 0, bathroom = 0;
+    for (const auto& e : fs::directory_iterator(path("out"))) {
+        kitchen += contains(e.path().filename().string(), "kitchen-scene-direct-mis.");
+        bathroom += contains(e.path().filename().string(), "bathroom-scene-direct-mis.");
+    }
+    EXPECT_EQ(kitchen, 2);  // .exr and .png
+    EXPECT_EQ(bathroom, 2);
+    // One scene alone keeps the names it always had.
+    r = run({"-s", a, "--spp", "1", "--resolution", "8x4", "-q", "-o", path("{scene}.pfm")});
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(fs::exists(path("scene.pfm")));
+}
+
 TEST_F(Cli, SceneFileSettingsApplyUnlessTheCommandLineGivesThem) {
     const std::string scene = write_scene(path("ball.xml"));
     CliResult r = run({"--scene", scene, "-q", "-o", path("{scene}-{algorithm}.pfm"), "--stats", path("a.json")});

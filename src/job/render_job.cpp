@@ -1,6 +1,8 @@
 #include "bsdfs/spectral_bsdf.hpp"
 #include "job/render_job.hpp"
 
+#include <filesystem>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -183,10 +185,15 @@ RenderStats RenderJob::run_into(Film& film) { return render_into(scene(), integr
 
 std::string RenderJob::expand(const std::string& pattern) const {
     try {
+        // {dir}: the scene file's folder (scenes laid out as DIR/scene.xml, Bitterli's way), or the
+        // built-in scene's name.
+        const std::string dir = choice_.file.empty()
+                                    ? choice_.name
+                                    : std::filesystem::absolute(choice_.file).lexically_normal().parent_path().filename().string();
         return fmt::format(fmt::runtime(pattern), fmt::arg("scene", choice_.name), fmt::arg("index", choice_.index),
-                           fmt::arg("algorithm", info_->name));
+                           fmt::arg("algorithm", info_->name), fmt::arg("dir", dir));
     } catch (const fmt::format_error& e) {
-        throw UsageError(fmt::format("invalid output pattern '{}': {} (placeholders: {{scene}}, {{index}}, {{algorithm}})",
+        throw UsageError(fmt::format("invalid output pattern '{}': {} (placeholders: {{scene}}, {{dir}}, {{index}}, {{algorithm}})",
                                      pattern, e.what()));
     }
 }

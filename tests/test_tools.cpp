@@ -369,6 +369,24 @@ TEST_F(Tools, ReferenceThenCheckReportsOkMissingAndBlackByDesign) {
     EXPECT_TRUE(std::regex_search(r.out, std::regex("6 env-diffuse +ERROR +6-env-diffuse.exr +.*6-env-diffuse.exr: cannot read"))) << r.out;
 }
 
+// Two renders of different scenes (their EXRs carry the scene's name and hash): compare warns,
+// and with --strict refuses (exit 2); renders of one scene, and images without the metadata, pass quietly.
+TEST_F(Tools, CompareWarnsOfRendersOfDifferentScenes) {
+    for (const char* s : {"2", "3"})
+        ASSERT_EQ(run({"-s", s, "--resolution", "8x8", "--spp", "1", "-q", "-o", path(std::string("r") + s + ".exr")}).code, 0);
+    ASSERT_EQ(run({"-s", "2", "--resolution", "8x8", "--spp", "1", "--seed", "9", "-q", "-o", path("r2b.exr")}).code, 0);
+    CliResult r = run({"compare", path("r2.exr"), path("r3.exr")});
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(contains(r.err, "warning: " + path("r2.exr") + " is a render of ceiling-diffuse (")) << r.err;
+    EXPECT_TRUE(contains(r.err, "images of different scenes")) << r.err;
+    r = run({"compare", path("r2.exr"), path("r3.exr"), "--strict"});
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_TRUE(contains(r.err, "images of different scenes (--strict)")) << r.err;
+    r = run({"compare", path("r2.exr"), path("r2b.exr"), "--strict"});
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_FALSE(contains(r.err, "warning")) << r.err;
+}
+
 TEST_F(Tools, CheckUsageErrors) {
     CliResult r = run({"check", "-a", "1", "--references", path("nowhere")});
     EXPECT_EQ(r.code, 2);

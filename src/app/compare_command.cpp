@@ -14,9 +14,19 @@
 namespace pathlab {
 namespace {
 
-Image read_input(const std::string& path) {
+// The image, and for a render's .exr the scene it is of ("name (hash)"; empty when unknown).
+Image read_input(const std::string& path, std::string& scene) {
     try {
-        return read_image(path);
+        if (image_format_for(path) != ImageFormat::Exr) return read_image(path);
+        ExrExtras extras;
+        Image img = read_exr(path, extras);
+        std::string name, hash;
+        for (const auto& [k, v] : extras.attributes) {
+            if (k == "pathlab:scene") name = v;
+            if (k == "pathlab:sceneHash") hash = v;
+        }
+        if (!hash.empty()) scene = fmt::format("{} ({})", name, hash);
+        return img;
     } catch (const ImageIoError& e) {
         throw UsageError(e.what());  // names the file
     }
@@ -53,6 +63,7 @@ CLI::App* add_compare_command(CLI::App& app, CompareOptions& o) {
     cmd->add_option("--diff", o.diff_path, "Write a false-colour PNG of the signed luminance difference A - B (blue: A darker, red: A brighter)");
     cmd->add_option("--diff-scale", o.diff_scale, "Difference shown at full colour in --diff (default: the 99th percentile of |difference|)");
     cmd->add_flag("--json", o.json, "Print the results as JSON");
+    cmd->add_flag("--strict", o.strict, "Refuse (exit 2) two renders of different scenes, by their EXRs' scene hashes (default: a warning)");
     return cmd;
 }
 
@@ -71,7 +82,15 @@ int run_compare_command(const CompareOptions& o) {
             throw UsageError(e.what());
         }
     }
-    const Image a = read_input(o.a), b = read_input(o.b);
+    std::string scene_a, scene_b;
+    const Image a = read_input(o.a, scene_a), b = read_input(o.b, scene_b);
+    // Renders of different scenes (both EXRs say which, by the scene's hash): a warning, or with
+    // --strict a refusal. The numbers would say nothing of either render.
+    if (!scene_a.empty() && !scene_b.empty() && scene_a != scene_b) {
+        const std::string why = fmt::format("{} is a render of {}, {} of {}: images of different scenes", o.a, scene_a, o.b, scene_b);
+        if (o.strict) throw UsageError(why + " (--strict)");
+        fmt::print(stderr, "pathlab: warning: {}\n", why);
+    }
     ImageDifference d;
     try {
         d = compare_images(a, b);

@@ -23,6 +23,7 @@ struct CompareOptions {
     std::string diff_path;
     double diff_scale = 0;  // 0: automatic
     bool json = false;
+    bool strict = false;  // refuse renders of different scenes (by their EXR metadata) instead of warning
 };
 CLI::App* add_compare_command(CLI::App& app, CompareOptions& o);
 // 0 agreement (or no threshold), 1 threshold exceeded.

@@ -10,6 +10,7 @@
 
 #include "cli_runner.hpp"
 #include "image/image_io.hpp"
+#include "integrators/integrators.hpp"
 
 namespace pathlab::test {
 namespace {
@@ -296,6 +297,13 @@ TEST_F(Cli, ScenesOfOneNameInTheirOwnFoldersGetTheFolderInTheirNames) {
     r = run({"-s", a, "--spp", "1", "--resolution", "8x4", "-q", "-o", path("{scene}.pfm")});
     EXPECT_EQ(r.code, 0) << r.err;
     EXPECT_TRUE(fs::exists(path("scene.pfm")));
+}
+
+// -a all renders every estimator, one image each.
+TEST_F(Cli, AlgorithmAllRendersEveryEstimator) {
+    const CliResult r = run({"-s", "2", "-a", "all", "--spp", "1", "--resolution", "4x4", "-q", "-o", path("all/{algorithm}.pfm")});
+    ASSERT_EQ(r.code, 0) << r.err;
+    for (const IntegratorInfo& info : integrators()) EXPECT_TRUE(fs::exists(path("all/" + info.name + ".pfm"))) << info.name;
 }
 
 TEST_F(Cli, SceneFileSettingsApplyUnlessTheCommandLineGivesThem) {

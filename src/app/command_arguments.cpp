@@ -116,6 +116,10 @@ PixelRect parse_crop_option(const std::string& text) {
 
 std::vector<const IntegratorInfo*> parse_algorithm_list(const std::string& spec) {
     std::vector<const IntegratorInfo*> infos;
+    if (spec == "all") {  // every estimator, in `pathlab algorithms`' order
+        for (const IntegratorInfo& info : integrators()) infos.push_back(&info);
+        return infos;
+    }
     for (const std::string& name : split_comma_list(spec)) {
         const IntegratorInfo* e = &integrator_or_usage_error(name);
         if (std::find(infos.begin(), infos.end(), e) != infos.end())

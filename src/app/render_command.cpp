@@ -72,7 +72,7 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
     add_scene_arguments(app, o.scenes);
     app.add_option_function<std::string>(
         "-a,--algorithm", [&o](const std::string& v) { o.algorithm = v, o.algorithm_given = true; },
-        "Estimator name or course alias (see `pathlab algorithms`), or a comma-separated list; default: the scene file's "
+        "Estimator name or course alias (see `pathlab algorithms`), a comma-separated list, or all; default: the scene file's "
         "integrator, else pt-mis");
     app.add_option_function<int>("--spp", [&o](const int& v) { o.spp = v, o.spp_given = true; },
                                  fmt::format("Samples per pixel (default {}, or unlimited with --time)", kDefaultSpp));

@@ -15,11 +15,11 @@ uint64_t available_memory() {
     return 0;
 }
 
-void check_memory(uint64_t bytes, const std::string& what, const std::string& advice) {
+void check_memory(double bytes, const std::function<std::string()>& what, const std::function<std::string(uint64_t)>& advice) {
     const uint64_t available = available_memory();
-    if (available > 0 && bytes > available)
-        throw NotEnoughMemory(fmt::format("{} would need {:.1f} GiB of memory, but only {:.1f} GiB is available{}", what, gib(bytes),
-                                          gib(available), advice));
+    if (available == 0 || bytes <= double(available)) return;
+    throw NotEnoughMemory(fmt::format("{} would need {:.1f} GiB of memory, but only {:.1f} GiB is available{}", what(),
+                                      bytes / double(uint64_t(1) << 30), gib(available), advice ? advice(available) : ""));
 }
 
 }  // namespace pathlab

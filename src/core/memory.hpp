@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <stdexcept>
 #include <string>
 
@@ -22,7 +23,9 @@ struct NotEnoughMemory : std::runtime_error {
 };
 
 // Throws NotEnoughMemory("<what> would need X GiB of memory, but only Y GiB is available<advice>")
-// when `bytes` is more than the machine can give (nothing when that is unknown).
-void check_memory(uint64_t bytes, const std::string& what, const std::string& advice = "");
+// when `bytes` is more than the machine can give (nothing when that is unknown); `what` and
+// `advice` (given the bytes available, e.g. how much of the request fits) are made only then.
+void check_memory(double bytes, const std::function<std::string()>& what,
+                  const std::function<std::string(uint64_t available)>& advice = {});
 
 }  // namespace pathlab

@@ -106,38 +106,32 @@ MeshDesc cylinder_mesh(int segments) {
 
 namespace {
 
-// Two inputs on which tinyobjloader 2.0.0rc10 has undefined behaviour (found by fuzz_obj):
-// a skin-weight line ("vw", a tinyobjloader extension) converts its joint index from float
-// to int unchecked (inf, 1e10), and a number's exponent of exactly 2147483648 or 2147483649
-// overflows an int. pathlab does not use skin weights: those lines become comments. No mesh
-// needs an exponent of 10 digits: such a number is refused.
-void avoid_tinyobj_undefined_behaviour(std::string& text, const std::string& path) {
+// What tinyobjloader 2.0.0rc10 gets wrong, taken care of line by line before it parses the text:
+// - undefined behaviour (found by fuzz_obj): a skin-weight line ("vw", a tinyobjloader
+//   extension) converts its joint index from float to int unchecked (inf, 1e10), and a number's
+//   exponent of exactly 2147483648 or 2147483649 overflows an int. pathlab does not use skin
+//   weights: those lines become comments. No mesh needs an exponent of 10 digits: such a number
+//   is refused;
+// - numbers read as other numbers, silently: "nan" and "inf" as 0 in a vertex, and a face index
+//   past 32 bits wrapped (4294967299 is vertex 3). Refused with the line.
+void prepare_obj_text(std::string& text, const std::string& path) {
     const auto digit = [](char c) { return c >= '0' && c <= '9'; };
-    for (size_t i = 0; i < text.size(); ++i) {
-        if (i == 0 || text[i - 1] == '\n' || text[i - 1] == '\r') {  // a line starts (tinyobjloader's line ends)
-            size_t j = i;
-            while (j < text.size() && (text[j] == ' ' || text[j] == '\t')) ++j;
-            if (j + 2 < text.size() && text[j] == 'v' && text[j + 1] == 'w' && (text[j + 2] == ' ' || text[j + 2] == '\t')) text[j] = '#';
-        }
-        if ((text[i] == 'e' || text[i] == 'E') && i > 0 && (digit(text[i - 1]) || text[i - 1] == '.')) {
-            size_t j = i + 1;
+    size_t line = 1;
+    for (size_t i = 0; i < text.size();) {
+        const size_t end = std::min(text.find_first_of("\r\n", i), text.size());
+        size_t first = i;
+        while (first < end && (text[first] == ' ' || text[first] == '\t')) ++first;
+        if (first + 2 < text.size() && text[first] == 'v' && text[first + 1] == 'w' && (text[first + 2] == ' ' || text[first + 2] == '\t'))
+            text[first] = '#';
+        for (size_t e = i; e < end; ++e) {
+            if (!((text[e] == 'e' || text[e] == 'E') && e > 0 && (digit(text[e - 1]) || text[e - 1] == '.'))) continue;
+            size_t j = e + 1;
             if (j < text.size() && (text[j] == '+' || text[j] == '-')) ++j;
             while (j < text.size() && text[j] == '0') ++j;
             size_t digits = 0;
             while (j + digits < text.size() && digit(text[j + digits])) ++digits;
             if (digits >= 10) throw MeshLoadError(fmt::format("cannot read mesh '{}': a number with an exponent of {} digits", path, digits));
         }
-    }
-}
-
-// Two inputs tinyobjloader reads as other numbers, silently: "nan" and "inf" as 0 in a vertex,
-// and a face index past 32 bits wrapped (4294967299 is vertex 3). Refused with the line.
-void refuse_obj_numbers_read_wrongly(const std::string& text, const std::string& path) {
-    size_t line = 1;
-    for (size_t i = 0; i < text.size();) {
-        const size_t end = std::min(text.find_first_of("\r\n", i), text.size());
-        size_t first = i;
-        while (first < end && (text[first] == ' ' || text[first] == '\t')) ++first;
         const char c0 = first < end ? text[first] : '#';
         std::vector<std::string_view> tokens;  // only for the lines below (a few per mesh line)
         if (c0 == 'v' || c0 == 'f' || c0 == 'l' || c0 == 'p')
@@ -164,7 +158,7 @@ void refuse_obj_numbers_read_wrongly(const std::string& text, const std::string&
                     size_t digits = 0;
                     uint64_t value = 0;
                     for (size_t c = a; c < b; ++c)
-                        if (tokens[t][c] >= '0' && tokens[t][c] <= '9' && ++digits <= 12) value = value * 10 + uint64_t(tokens[t][c] - '0');
+                        if (digit(tokens[t][c]) && ++digits <= 12) value = value * 10 + uint64_t(tokens[t][c] - '0');
                     if (digits > 10 || value > uint64_t(INT32_MAX)) throw fail(fmt::format("index '{}' is out of range", tokens[t].substr(a, b - a)));
                     a = b + 1;
                 }
@@ -195,8 +189,7 @@ MeshDesc load_obj_mesh(const std::string& path) {
     if (!in) throw MeshLoadError(fmt::format("cannot read mesh '{}': cannot open the file", path));
     std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     if (in.bad()) throw MeshLoadError(fmt::format("cannot read mesh '{}': read error", path));
-    avoid_tinyobj_undefined_behaviour(text, path);
-    refuse_obj_numbers_read_wrongly(text, path);
+    prepare_obj_text(text, path);
     tinyobj::ObjReader reader;
     if (!reader.ParseFromString(text, "", config)) {
         std::string why = reader.Error();

@@ -33,8 +33,8 @@ nlohmann::json read_manifest(const fs::path& path) {
         if (!j["scenes"].is_array()) throw fail("its \"scenes\" is not an array");
         for (const nlohmann::json& e : j["scenes"]) {
             if (!e.is_object()) throw fail("an entry of \"scenes\" is not an object");
-            const std::string file = e.contains("file") && e["file"].is_string() ? e["file"].get<std::string>() : "?";
             if (!e.contains("file") || !e["file"].is_string()) throw fail("an entry of \"scenes\" has no \"file\" name");
+            const std::string file = e["file"].get<std::string>();
             if (e.contains("index") && !e["index"].is_number_integer()) throw fail(fmt::format("the entry of '{}': its index is not a whole number", file));
             try {
                 (void)reference_record_from_json(e);

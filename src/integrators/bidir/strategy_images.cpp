@@ -1,6 +1,5 @@
 #include "integrators/bidir/strategy_images.hpp"
 
-#include <algorithm>
 #include <filesystem>
 
 #include <fmt/format.h>
@@ -14,15 +13,18 @@ void StrategyImages::begin_pass(int width, int height, int chunks) {
     const size_t pixels = size_t(width) * size_t(height), n = size_t(count(max_length_));
     if (width != width_ || height != height_ || weighted_.empty()) {
         // Two films and two pass images per strategy.
-        const uint64_t per_strategy = uint64_t(pixels) * (2 * sizeof(PixelSums) + 2 * sizeof(Vec3d));
-        const uint64_t available = available_memory();
-        if (available > 0 && double(n) * double(per_strategy) > double(available)) {
-            int fits = 0;
-            while (double(count(fits + 1)) * double(per_strategy) <= double(available)) ++fits;
-            check_memory(uint64_t(std::min(double(n) * double(per_strategy), 1.8e19)),
-                         fmt::format("--strategies images of paths up to {} bounces ({} strategies, {} images at {}x{})", max_length_, n, 2 * n, width, height),
-                         fmt::format(": lower --strategies-depth (at most {} fits)", fits));
-        }
+        const double per_strategy = double(pixels) * double(2 * sizeof(PixelSums) + 2 * sizeof(Vec3d));
+        check_memory(
+            double(n) * per_strategy,
+            [&] {
+                return fmt::format("--strategies images of paths up to {} bounces ({} strategies, {} images at {}x{})", max_length_, n, 2 * n,
+                                   width, height);
+            },
+            [&](uint64_t available) {
+                int fits = 0;
+                while (double(count(fits + 1)) * per_strategy <= double(available)) ++fits;
+                return fmt::format(": lower --strategies-depth (at most {} fits)", fits);
+            });
         width_ = width, height_ = height;
         weighted_.assign(n, Film(width, height));
         unweighted_.assign(n, Film(width, height));

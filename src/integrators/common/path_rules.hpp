@@ -37,6 +37,12 @@ inline IntegratorOptions limited_to_length(IntegratorOptions o) {
     return o;
 }
 
+// Whether paths of this many bounces count in the image: all, or one length only (--only-length),
+// without the emitters seen directly when they are hidden.
+inline bool length_counts(const IntegratorOptions& o, int length) {
+    return (o.only_length < 0 || o.only_length == length) && !(o.hide_emitters && length == 0);
+}
+
 class PathRules {
 public:
     explicit PathRules(const IntegratorOptions& o)

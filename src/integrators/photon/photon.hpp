@@ -75,11 +75,13 @@ void check_photon_memory(const std::string& who, size_t paths, uint64_t bytes_pe
             if ((path[v].kind == VertexKind::Surface || path[v].kind == VertexKind::Medium) && path[v].connectible()) ++photons;
     }
     const double per_path = double(photons) / kPilot;
-    const double bytes = double(paths) * per_path * double(bytes_per_photon);
-    const uint64_t available = available_memory();
-    if (available == 0 || bytes <= double(available)) return;
-    check_memory(uint64_t(std::min(bytes, 1.8e19)), fmt::format("{}'s {} light paths (about {:.1f} photons each, {} bytes per photon)", who, paths, per_path, bytes_per_photon),
-                 fmt::format(": lower {} (about {} light paths fit)", option, uint64_t(double(available) / (std::max(per_path, 1e-3) * double(bytes_per_photon)))));
+    check_memory(
+        double(paths) * per_path * double(bytes_per_photon),
+        [&] { return fmt::format("{}'s {} light paths (about {:.1f} photons each, {} bytes per photon)", who, paths, per_path, bytes_per_photon); },
+        [&](uint64_t available) {
+            return fmt::format(": lower {} (about {} light paths fit)", option,
+                               uint64_t(double(available) / (std::max(per_path, 1e-3) * double(bytes_per_photon))));
+        });
 }
 
 }  // namespace pathlab

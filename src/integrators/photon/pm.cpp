@@ -202,9 +202,7 @@ template <class T>
 ColourOf<T> PhotonMapper<T>::radiance(const Scene& scene, const Ray& camera_ray, Sampler& sampler, WavelengthsOf<T>& wl) const {
     using Colour = ColourOf<T>;
     if (scene.has_media()) return radiance_in_media(scene, camera_ray, sampler, wl);
-    const auto counts = [&](int length) {
-        return (options_.only_length < 0 || options_.only_length == length) && !(options_.hide_emitters && length == 0);
-    };
+    const auto counts = [this](int length) { return length_counts(options_, length); };
     Colour L(0.0f);
     const auto x = trace_to_visible_point<T>(scene, camera_ray, sampler, max_bounces_, kMaxDiracChain, counts, L, wl);
     if (!x) return L;
@@ -280,9 +278,7 @@ ColourOf<T> PhotonMapper<T>::beam_estimate(const Vec3f& o, const Vec3f& d, float
 template <class T>
 ColourOf<T> PhotonMapper<T>::radiance_in_media(const Scene& scene, const Ray& camera_ray, Sampler& sampler, WavelengthsOf<T>& wl) const {
     using Colour = ColourOf<T>;
-    const auto counts = [&](int length) {
-        return (options_.only_length < 0 || options_.only_length == length) && !(options_.hide_emitters && length == 0);
-    };
+    const auto counts = [this](int length) { return length_counts(options_, length); };
     const bool photons = options_.only_length < 0;  // the estimates take paths of every length
     MediumState<T> st{sampler, wl};
     Colour L(0.0f);

@@ -47,6 +47,7 @@
 
 #include "integrators/bidir/bdpt.hpp"
 #include "integrators/common/media_lighting.hpp"
+#include "integrators/common/path_rules.hpp"
 #include "integrators/integrator.hpp"
 #include "integrators/photon/photon.hpp"
 #include "integrators/photon/photon_grid.hpp"
@@ -102,9 +103,7 @@ private:
     ColourOf<T> beam(const Vec3f& o, const Vec3f& d, float tmax, int32_t medium, const TransmittanceTrack<ColourOf<T>>& Tr,
                      const PhaseFunction& phase, int t, float r, size_t paths, const WavelengthsOf<T>& wl) const;
     // Whether paths of this many bounces count (all, or one length only).
-    bool counts(int length) const {
-        return (options_.only_length < 0 || options_.only_length == length) && !(options_.hide_emitters && length == 0);
-    }
+    bool counts(int length) const { return length_counts(options_, length); }
 
     IntegratorOptions options_;
     SppmFaults faults_;

@@ -14,7 +14,7 @@ void BallTree::build(Positions centres, const std::vector<float>& radii) {
     for (size_t i = 0; i < n; ++i) centre_[i] = centres[i], radius2_[i] = radii[i] * radii[i], order_[i] = uint32_t(i);
     nodes_.clear();
     if (n == 0) return;
-    nodes_.reserve(2 * (n / kLeafSize + 1));
+    nodes_.reserve(n);  // median splits leave at least 2 balls in a leaf: at most n / 2 leaves, n nodes
     build_node(0, uint32_t(n));
 }
 

@@ -23,6 +23,7 @@
 #include "judge/image_statistics.hpp"
 #include "render_helpers.hpp"
 #include "scene_helpers.hpp"
+#include "spectral_helpers.hpp"
 #include "scenefile/scene_file.hpp"
 
 namespace pathlab::test {
@@ -301,6 +302,49 @@ TEST(BidirMedia, AConnectionWithoutItsTransmittanceIsDetected) {
     Bdpt<RgbTransport> faulty(depth_options(), faults);
     const RenderResult b = render_integrator(media_scenes()[0].d, faulty, kSize, kSize, 1024, 21);
     EXPECT_FALSE(agreement(b, reference(0)).agree);
+}
+
+TEST(BidirMedia, MediaBehindScatteringBoundariesAreSealedFromTheOthers) {
+    // Scene 3 of media_scenes: smoke inside an index-matched box (medium 0), ink in a glass ball (1).
+    const auto scene = Scene::build(media_scenes()[2].d);
+    EXPECT_TRUE(scene->media_separated(1, 0));   // ink | smoke: the glass between them
+    EXPECT_TRUE(scene->media_separated(-1, 1));  // outside | ink
+    EXPECT_FALSE(scene->media_separated(0, -1)); // smoke | outside: through the index-matched box
+    EXPECT_FALSE(scene->media_separated(1, 1));
+    EXPECT_FALSE(scene->media_separated(-1, -1));
+}
+
+// Connections inside a dense homogeneous medium are made with probability T / (1/64) when their
+// transmittance T is below 1/64 in every channel (Bdpt::connect): the image is that of making
+// them all. Paired renders (the same seeds make the same subpaths; only the roulette differs) of
+// the marble block, whose 16 image means differ by d_k: a t-test of mean(d) = 0 (15 degrees of
+// freedom, |t| < 4.07: false alarm 1e-3). Not dividing the survivors by their probability
+// darkens the block (detected: t = -5.1 with these seeds).
+TEST(BidirMedia, ConnectionRouletteChangesTheNoiseNotTheImage) {
+    const SceneDescription d = load_scene_file(source_path("scenes/marble-block.xml"));
+    BdptFaults every_connection, undivided;
+    every_connection.no_connection_roulette = true;
+    undivided.connection_roulette_undivided = true;
+    Bdpt<RgbTransport> oracle(IntegratorOptions{}, every_connection), roulette(IntegratorOptions{}, BdptFaults{}),
+        faulty(IntegratorOptions{}, undivided);
+    const auto brightness = [](const RenderResult& r) {
+        const ImageMean m = image_mean(r);
+        return m.mean.x + m.mean.y + m.mean.z;
+    };
+    const auto t_statistic = [&](Integrator& candidate) {
+        std::vector<double> diffs;
+        for (uint64_t seed = 1; seed <= 16; ++seed)
+            diffs.push_back(brightness(render_integrator(d, candidate, kSize, kSize, 128, seed)) -
+                            brightness(render_integrator(d, oracle, kSize, kSize, 128, seed)));
+        double mean = 0, var = 0;
+        for (double x : diffs) mean += x / double(diffs.size());
+        for (double x : diffs) var += (x - mean) * (x - mean) / double(diffs.size() - 1);
+        return mean / std::sqrt(var / double(diffs.size()));
+    };
+    const double t = t_statistic(roulette);
+    EXPECT_LT(std::abs(t), 4.07) << "roulette against every connection made: t = " << t;
+    const double t_faulty = t_statistic(faulty);
+    EXPECT_LT(t_faulty, -4.07) << "survivors not divided by their probability: t = " << t_faulty;
 }
 
 TEST(BidirMedia, OneAndTwoThreadsGiveTheSameBytes) {

@@ -54,11 +54,16 @@ bool has_extinction(const Medium& medium) {
 
 float mis_extinction(const Medium& m, const Vec3f& p) { return mean(MediumRgb{m}.extinction(p)); }
 
-float mis_transmittance(const Medium& m, const Vec3f& o, const Vec3f& d, float tmax) {
+namespace {
+
+// exp(-optical depth of channel(sigma_t)) along o + t d, t in [0, tmax]: exact where the
+// extinction is constant, else the midpoint rule over the majorant grid's cells.
+template <class Channel>
+float midpoint_transmittance(const Medium& m, const Vec3f& o, const Vec3f& d, float tmax, Channel channel) {
     const MediumRgb view{m};
     Rgb sigma_t;
     if (view.constant_extinction(sigma_t)) {
-        const float s = mean(sigma_t);
+        const float s = channel(sigma_t);
         return s > 0 ? std::exp(-s * tmax) : 1.0f;
     }
     float scale, depth = 0;
@@ -67,9 +72,19 @@ float mis_transmittance(const Medium& m, const Vec3f& o, const Vec3f& d, float t
     while (pieces.next(seg)) {
         if (!(seg.sigma_maj > 0)) continue;  // nothing there
         if (!std::isfinite(seg.t1)) return 0.0f;
-        depth += mean(view.extinction(o + d * (0.5f * (seg.t0 + seg.t1)))) * (seg.t1 - seg.t0);
+        depth += channel(view.extinction(o + d * (0.5f * (seg.t0 + seg.t1)))) * (seg.t1 - seg.t0);
     }
     return std::exp(-depth);
+}
+
+}  // namespace
+
+float mis_transmittance(const Medium& m, const Vec3f& o, const Vec3f& d, float tmax) {
+    return midpoint_transmittance(m, o, d, tmax, [](const Rgb& s) { return mean(s); });
+}
+
+float clearest_transmittance(const Medium& m, const Vec3f& o, const Vec3f& d, float tmax) {
+    return midpoint_transmittance(m, o, d, tmax, [](const Rgb& s) { return std::min({s.x, s.y, s.z}); });
 }
 
 }  // namespace pathlab

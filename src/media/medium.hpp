@@ -79,5 +79,8 @@ float free_flight_pdf(const HomogeneousMedium& m, float t, int hero);
 //                       a medium), else the midpoint rule over the majorant grid's cells
 float mis_extinction(const Medium& m, const Vec3f& p);
 float mis_transmittance(const Medium& m, const Vec3f& o, const Vec3f& d, float tmax);
+// The same for the least extinction of the channels (the clearest channel's transmittance):
+// how much light a connection can carry at most, before its transmittance is estimated.
+float clearest_transmittance(const Medium& m, const Vec3f& o, const Vec3f& d, float tmax);
 
 }  // namespace pathlab

@@ -163,6 +163,11 @@ std::unique_ptr<Scene> Scene::build(const SceneDescription& desc) {
     s->accel_.commit();
     s->has_media_ = desc.camera_medium >= 0;
     for (const GeometryRecord& rec : s->geometry_) s->has_media_ = s->has_media_ || rec.media;
+    s->sealed_.assign(desc.media.size(), 1);
+    for (const GeometryRecord& rec : s->geometry_)
+        if (rec.media && rec.media->index_matched)
+            for (const int32_t m : {rec.media->interior, rec.media->exterior})
+                if (m >= 0) s->sealed_[size_t(m)] = 0;
     if (lo.x <= hi.x) {
         s->center_ = (lo + hi) * 0.5f;
         s->radius_ = std::max(1e-3f, 0.5f * length(hi - lo));

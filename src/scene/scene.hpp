@@ -56,6 +56,13 @@ public:
     int32_t camera_medium() const { return desc_.camera_medium; }
     // True when some shape changes the medium or the camera sits in one.
     bool has_media() const { return has_media_; }
+    // True when no straight segment joins a point in medium a to a point in medium b: they
+    // differ and one of them is sealed (every boundary it has is a scattering surface, none
+    // index-matched), so the segment meets a surface that blocks it. A shortcut for
+    // connections out of a dielectric-bounded medium, which would each cost a shadow ray.
+    bool media_separated(int32_t a, int32_t b) const {
+        return a != b && ((a >= 0 && sealed_[size_t(a)]) || (b >= 0 && sealed_[size_t(b)]));
+    }
     // The medium at point p (-1: none), found by following the segment from the camera to p
     // through every boundary it crosses, as the camera's paths track media.
     int32_t medium_at(const Vec3f& p) const;
@@ -135,6 +142,7 @@ private:
     LightDistribution light_distribution_;
     int environment_ = -1;
     bool has_media_ = false;
+    std::vector<char> sealed_;          // by medium: no index-matched boundary (media_separated)
     std::vector<int32_t> light_media_;  // by light, when the scene has media
     Vec3f center_{0.0f};
     float radius_ = 1;

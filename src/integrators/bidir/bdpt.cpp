@@ -33,6 +33,18 @@ float cos_at(const PathVertexBase& v, const Vec3f& w) {
     return v.kind == VertexKind::Surface ? std::abs(dot(v.sp.frame.n, w)) : (v.has_normal() ? std::abs(dot(v.n, w)) : 1.0f);
 }
 
+// Connections inside one medium whose transmittance is below this in every channel are made
+// with probability T / kConnectionRouletteT (Bdpt::connect).
+constexpr float kConnectionRouletteT = 1.0f / 64;
+
+// The probability of making the connection from o along the unit direction d, length dist,
+// inside medium m: 1 unless its clearest channel's transmittance (exact in homogeneous media,
+// the midpoint rule over the majorant cells in grids) is below kConnectionRouletteT.
+float connection_survival(const Medium& m, const Vec3f& o, const Vec3f& d, float dist) {
+    const float T = clearest_transmittance(m, o, d, dist);
+    return T < kConnectionRouletteT ? std::max(T / kConnectionRouletteT, 1e-30f) : 1.0f;
+}
+
 // The random numbers of one sample come from separate streams (Bdpt::sample_stream): the
 // camera subpath (the stream a pixel integrator would use), the light subpath, and the
 // connections of each camera vertex t (next-event estimation draws there). So a subpath's
@@ -346,7 +358,9 @@ StrategyResult<T> Bdpt<T>::connect(const RenderContext& ctx, SubpathView light, 
     st.stream_id = kMediumStream + uint64_t(s);
     const auto transmittance = [&](const PathVertexBase& from, const PathVertexBase& to, const Vec3f& w) {
         if (!media) return scene.occluded(from.segment_to(to)) ? Colour(0.0f) : Colour(1.0f);
-        const Colour Tr = shadow_transmittance(scene, from.segment_to(to), from.medium_towards(w), st, &known.T);
+        const int32_t medium = from.medium_towards(w);
+        if (scene.media_separated(medium, to.medium_towards(-w))) return Colour(0.0f);  // no ray needed
+        const Colour Tr = shadow_transmittance(scene, from.segment_to(to), medium, st, &known.T);
         if (faults_.drop_distance_pdf) known.T = 1;
         return faults_.drop_connection_transmittance && !is_black(Tr) ? Colour(1.0f) : Tr;
     };
@@ -393,6 +407,7 @@ StrategyResult<T> Bdpt<T>::connect(const RenderContext& ctx, SubpathView light, 
         sampled.n = (flags & kLightSurface) ? ls->normal : Vec3f(0.0f);
         sampled.emitter_n = ls->normal;
         sampled.light = choice.index;
+        sampled.medium = scene.light_medium(choice.index);
         sampled.beta = light_colour(scene, choice.index, ls->Le, wl) / (choice.pmf * ls->pdfW);
         sampled.pdf_fwd = pdf_light_origin(scene, sampled, pt);
         r.L = pt.beta * bsdf_towards(scene, pt, ls->wi, known.pt_to_qs, wl) * sampled.beta * cos_at(pt, ls->wi);
@@ -406,9 +421,24 @@ StrategyResult<T> Bdpt<T>::connect(const RenderContext& ctx, SubpathView light, 
         const Vec3f d = qs.p - pt.p;
         const float dist2 = dot(d, d);
         if (!(dist2 > 0)) return r;
-        const Vec3f w = d / std::sqrt(dist2);  // from pt towards qs
+        const float dist = std::sqrt(dist2);
+        const Vec3f w = d / dist;  // from pt towards qs
+        float survival = 1;
+        if (media) {
+            const int32_t medium = pt.medium_towards(w);
+            if (scene.media_separated(medium, qs.medium_towards(-w))) return r;  // blocked: no BSDFs, no ray
+            // Roulette on connections that the medium all but extinguishes (transmittance below
+            // kConnectionRouletteT in every channel): made with probability T / that, and
+            // divided by it (unbiased; a made one weighs about as one of transmittance
+            // kConnectionRouletteT). In a dense medium most of a long subpath's O(n m) connections
+            // are of this kind; the rest cost their BSDFs and a shadow ray as before.
+            if (medium >= 0 && medium == qs.medium_towards(-w) && !faults_.no_connection_roulette) {
+                survival = connection_survival(scene.medium(medium), pt.p, w, dist);
+                if (survival < 1 && !(st.rng().next1d() < survival)) return r;
+            }
+        }
         const float G = cos_at(pt, w) * cos_at(qs, w) / dist2;
-        r.L = qs.beta * bsdf_towards(scene, qs, -w, known.qs_to_pt, wl) * bsdf_towards(scene, pt, w, known.pt_to_qs, wl) * pt.beta * G;
+        r.L = qs.beta * bsdf_towards(scene, qs, -w, known.qs_to_pt, wl) * bsdf_towards(scene, pt, w, known.pt_to_qs, wl) * pt.beta * (faults_.connection_roulette_undivided ? G : G / survival);
         if (is_black(r.L)) return StrategyResult<T>{};
         const Colour Tr = transmittance(pt, qs, w);
         if (is_black(Tr)) return StrategyResult<T>{};

@@ -62,9 +62,13 @@ struct BdptFaults {
     bool specular_pdf_rev_missing = false;  // a Dirac vertex's reverse density left unset (0)
     bool drop_connection_transmittance = false;  // media: a connection's transmittance left out
     bool drop_distance_pdf = false;              // media: densities without distance sampling's factor
+    bool connection_roulette_undivided = false;  // media: a connection that survives roulette not divided by its probability
     // Not a fault: every weight by the ratio walk (the oracle), for the test that compares whole
     // renders with the running quantities' weights.
     bool ratio_walk = false;
+    // Not a fault: every connection in a dense homogeneous medium made (no roulette), for the
+    // test that the roulette changes the noise and not the image.
+    bool no_connection_roulette = false;
     bool any() const { return drop_nee_strategy || specular_pdf_rev_missing || ratio_walk; }  // (the media faults act where they are)
 };
 

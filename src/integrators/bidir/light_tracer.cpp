@@ -47,6 +47,7 @@ void LightTracer<T>::trace(const RenderContext& ctx, Sampler& sampler, SplatList
     int32_t medium = start->medium;
     // Whether the segment to the camera is free, and its transmittance through media.
     const auto to_camera = [&](const Ray& segment, int32_t from_medium) {
+        if (scene.media_separated(from_medium, scene.camera_medium())) return Colour(0.0f);  // blocked: no ray needed
         return shadow_transmittance(scene, segment, from_medium, st);
     };
 

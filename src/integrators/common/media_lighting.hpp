@@ -58,6 +58,7 @@ ColourOf<T> estimate_light(const Scene& scene, const ScatterVertex& v, Sampler& 
             shadow = Ray{v.p, to - v.p, 1.0f - 1e-4f};
         }
     }
+    if (scene.media_separated(medium, scene.light_medium(choice.index))) return Colour(0.0f);  // blocked: no ray needed
     const Colour Tr = shadow_transmittance(scene, shadow, medium, st);
     if (is_black(Tr)) return Colour(0.0f);
     const float pdf_light = choice.pmf * ls->pdfW;

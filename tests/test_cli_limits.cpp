@@ -79,6 +79,22 @@ TEST_F(CliLimits, OutputsNeverOverwriteInputsOrEachOther) {
     r = run({"-s", "0", "--resolution", "4x4", "--spp", "1", "-q", "-o", path("a.exr"), "-o", path("a.exr")});
     EXPECT_EQ(r.code, 2);
     EXPECT_FALSE(fs::exists(path("a.exr")));
+    // -o onto an image the scene reads (a bitmap texture beside it), and --ic-records onto it.
+    ASSERT_EQ(run({"-s", "0", "--resolution", "4x4", "--spp", "1", "-q", "-o", path("wood.pfm")}).code, 0);
+    const std::string wood = read(path("wood.pfm"));
+    const std::string textured = path("textured.xml");
+    std::ofstream(textured) << "<scene version=\"3.0.0\"><shape type=\"rectangle\"><bsdf type=\"diffuse\"><texture type=\"bitmap\" "
+                               "name=\"reflectance\"><string name=\"filename\" value=\"wood.pfm\"/></texture></bsdf></shape>"
+                               "<emitter type=\"constant\"/></scene>\n";
+    for (const std::vector<std::string>& onto : {std::vector<std::string>{"-o", path("wood.pfm")},
+                                                 std::vector<std::string>{"-a", "ic", "-o", path("b.pfm"), "--ic-records", path("wood.pfm")}}) {
+        std::vector<std::string> args{"-s", textured, "--resolution", "4x4", "--spp", "1", "-q"};
+        args.insert(args.end(), onto.begin(), onto.end());
+        r = run(args);
+        EXPECT_EQ(r.code, 2) << r.err;
+        EXPECT_TRUE(contains(r.err, "is a file textured.xml reads")) << r.err;
+        EXPECT_EQ(read(path("wood.pfm")), wood);
+    }
     // check --json onto a reference, before it is read.
     fs::create_directories(path("refs"));
     ASSERT_EQ(run({"-s", "0", "--resolution", "8x8", "--spp", "1", "-q", "-o", path("refs/0.pfm")}).code, 0);

@@ -83,7 +83,7 @@ int run_reference_command(const ReferenceOptions& o) {
     std::vector<std::string> dirs, stems;
     OutputPaths paths;
     for (const SceneChoice& s : scenes)
-        if (!s.file.empty()) paths.input(s.file, "the scene file");
+        paths.scene_inputs(s);
     for (const IntegratorInfo* info : algorithms)
         for (const SceneChoice& s : scenes) {
             request.algorithm = info->name;

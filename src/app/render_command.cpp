@@ -238,7 +238,7 @@ std::vector<RenderJob> make_jobs(const RenderCommandOptions& o, bool check_paths
     // Check every output before the first render starts: writable, not an input, not another output.
     OutputPaths paths;
     for (const RenderJob& job : jobs)
-        if (!job.scene_choice().file.empty()) paths.input(job.scene_choice().file, "the scene file");
+        paths.scene_inputs(job.scene_choice());
     for (RenderJob& job : jobs) {
         resumes.push_back(o.resume.empty() ? "" : job.expand(o.resume));
         checkpoints.push_back(!o.checkpoint.empty() ? job.expand(o.checkpoint) : resumes.back());

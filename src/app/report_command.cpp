@@ -133,7 +133,7 @@ int run_report_command(const ReportOptions& o) {
                                              page.choice.name, tried));
             page.reference = found->path;
         }
-        if (!page.choice.file.empty()) paths.input(page.choice.file, "the scene file");
+        paths.scene_inputs(page.choice);
         if (!page.reference.empty()) {
             paths.input(page.reference, "--reference");
             paths.input(stderr_path_for(page.reference), "the reference's standard errors");

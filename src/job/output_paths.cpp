@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "image/image_io.hpp"
+#include "job/scene_choice.hpp"
 #include "job/usage_error.hpp"
 
 namespace pathlab {
@@ -16,6 +17,12 @@ std::string OutputPaths::key(const std::string& path) {
 }
 
 void OutputPaths::input(const std::string& path, const std::string& what) { inputs_.push_back({path, key(path), what}); }
+
+void OutputPaths::scene_inputs(const SceneChoice& scene) {
+    if (!scene.file.empty()) input(scene.file, "the scene file");
+    for (const std::string& f : scene.files)
+        if (f != scene.file) input(f, fmt::format("a file {} reads,", std::filesystem::path(scene.file).filename().string()));
+}
 
 void OutputPaths::output(const std::string& path, const std::string& what, bool image) {
     const std::string k = key(path);

@@ -10,10 +10,15 @@
 
 namespace pathlab {
 
+struct SceneChoice;
+
 class OutputPaths {
 public:
     // A file the command reads; `what` names it in messages ("the scene file").
     void input(const std::string& path, const std::string& what);
+    // A scene's files: the scene file and every file it reads (includes, meshes, textures,
+    // environment maps, light profiles, spectra, grids), which no output may replace.
+    void scene_inputs(const SceneChoice& scene);
     // A file the command will write. Image outputs must have a known extension. Throws
     // UsageError naming both paths when it is an input or another output, or cannot be written.
     void output(const std::string& path, const std::string& what, bool image);

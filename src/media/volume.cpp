@@ -35,7 +35,7 @@ Volume Volume::of_grid(VoxelGrid g, const Transform& unit_to_world) {
 
 Volume read_constvolume(Properties& p) { return Volume::constant_value(p.get_rgb("value")); }
 
-Volume read_gridvolume(Properties& p, const std::string& base_dir, bool allow_files) {
+Volume read_gridvolume(Properties& p, const std::string& base_dir, bool allow_files, std::vector<std::string>* files_read) {
     if (!p.has("filename")) p.fail("<volume type=\"gridvolume\"> needs <string name=\"filename\" value=\"...\"/>");
     if (!allow_files) p.fail("this loader does not read files (gridvolume is disabled)");
     std::filesystem::path file(p.get_string("filename"));
@@ -62,6 +62,7 @@ Volume read_gridvolume(Properties& p, const std::string& base_dir, bool allow_fi
         p.fail("filename", e.what());
     }
     grid.nearest = filter == "nearest";
+    if (files_read) files_read->push_back(path);
     return Volume::of_grid(std::move(grid), unit_to_world);
 }
 

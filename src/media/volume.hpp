@@ -60,6 +60,7 @@ inline const PluginInfo& gridvolume_plugin() {
 // (the scene file's directory); allow_files = false refuses to read files (the fuzzer). Throws
 // PropertyError (a grid file's problems name the file).
 Volume read_constvolume(Properties& p);
-Volume read_gridvolume(Properties& p, const std::string& base_dir, bool allow_files);
+// `files_read`, if given, gets the grid file's path (SceneChoice::files: the scene hash, outputs that may not overwrite it).
+Volume read_gridvolume(Properties& p, const std::string& base_dir, bool allow_files, std::vector<std::string>* files_read = nullptr);
 
 }  // namespace pathlab

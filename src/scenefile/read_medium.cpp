@@ -45,7 +45,7 @@ Volume read_volume(XmlSource& xml, const pugi::xml_node& n, const SceneBuilder& 
     if (type == gridvolume_plugin().type) {
         Properties p = xml.properties(n, gridvolume_plugin());
         return reading([&] {
-            const Volume v = read_gridvolume(p, b.shapes.base_dir, b.shapes.allow_files);
+            const Volume v = read_gridvolume(p, b.shapes.base_dir, b.shapes.allow_files, b.shapes.files_read);
             p.check_all_used();
             return v;
         });

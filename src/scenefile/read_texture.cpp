@@ -18,6 +18,7 @@ std::shared_ptr<const Texture> read_texture(XmlSource& xml, const pugi::xml_node
     Properties p = xml.properties(n, plugin->info());
     TextureContext ctx{b.shapes.base_dir, b.shapes.allow_files};
     if (ctx.allow_files) ctx.search_dirs = xml.search_dirs();
+    ctx.files_read = b.shapes.files_read;
     return reading([&] {
         auto t = std::make_shared<const Texture>(plugin->read(p, ctx));
         p.check_all_used();

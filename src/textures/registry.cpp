@@ -43,7 +43,9 @@ Texture read_bitmap(Properties& p, const TextureContext& ctx) {
     const std::string path =
         find_in_dirs(p.get_string("filename"), ctx.search_dirs.empty() ? std::vector<std::string>{ctx.base_dir} : ctx.search_dirs);
     try {
-        return Texture(load_bitmap_texture(path, raw, f, w, to_uv));
+        Texture t(load_bitmap_texture(path, raw, f, w, to_uv));
+        if (ctx.files_read) ctx.files_read->push_back(path);
+        return t;
     } catch (const ImageIoError& e) {
         p.fail("filename", fmt::format("cannot read the texture: {}", e.what()));
     }

@@ -18,6 +18,7 @@ struct TextureContext {
     // Where relative file names are searched, in order (the scene file's folder and its <path>
     // folders); base_dir when empty.
     std::vector<std::string> search_dirs = {};
+    std::vector<std::string>* files_read = nullptr;  // if given, gets each image file's path
 };
 
 struct TexturePlugin {

@@ -285,6 +285,11 @@ TEST_F(Distributed, CheckpointOfAnotherRenderIsRefusedSayingWhatDiffers) {
                   .code,
               0);
     const std::string before = file_bytes(path("c.ckpt"));
+    // `info` says which render a checkpoint holds, as it says it of an EXR.
+    const CliResult info = run({"info", path("c.ckpt")});
+    EXPECT_EQ(info.code, 0) << info.err;
+    for (const char* line : {"16x12 pathlab checkpoint", "pathlab:integrator: pt-mis", "pathlab:seed: 5", "pathlab:spp: 2", "pathlab:passes: 0-1"})
+        EXPECT_TRUE(contains(info.out, line)) << line << " in\n" << info.out;
     const CliResult other_scene =
         run({"--scene", "4", "--resolution", "16x12", "--seed", "5", "-q", "--spp", "4", "--resume", path("c.ckpt"), "-o", path("b.exr")});
     EXPECT_EQ(other_scene.code, 2);
@@ -341,6 +346,7 @@ TEST_F(Distributed, TruncatedOrCorruptedCheckpointIsRefusedAndKept) {
         EXPECT_TRUE(contains(r.err, d.message)) << d.what << ": " << r.err;
         EXPECT_TRUE(file_bytes(path("bad.ckpt")) == d.bytes) << d.what << ": never overwritten";
         EXPECT_FALSE(fs::exists(path("b.exr")));
+        EXPECT_EQ(run({"info", path("bad.ckpt")}).code, 2) << d.what;
     }
     EXPECT_THROW(read_checkpoint(path("missing.ckpt")), CheckpointError);
 

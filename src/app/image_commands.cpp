@@ -1,5 +1,8 @@
 // `pathlab convert IN OUT` and `pathlab info IMG...`: image tools in the manner of pbrt's imgtool.
+#include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <optional>
 #include <filesystem>
 
 #include <nlohmann/json.hpp>
@@ -9,7 +12,9 @@
 #include "app/tool_commands.hpp"
 #include "image/image_header.hpp"
 #include "image/image_io.hpp"
+#include "job/checkpoint.hpp"
 #include "job/output_paths.hpp"
+#include "job/render_identity.hpp"
 #include "job/usage_error.hpp"
 
 namespace pathlab {
@@ -66,16 +71,51 @@ int run_convert_command(const ConvertOptions& o) {
 
 CLI::App* add_info_command(CLI::App& app, InfoOptions& o) {
     CLI::App* cmd = app.add_subcommand(
-        "info", "Size, channels, metadata (every header attribute: spp, seed, ... when written), per-channel mean/min/max, NaN/Inf counts");
-    cmd->add_option("IMG", o.images, "Images (.exr, .hdr, .pfm, .png)")->required();
+        "info", "Size, channels, metadata (every header attribute: spp, seed, ... when written), per-channel mean/min/max, NaN/Inf counts; of a checkpoint, the render it holds");
+    cmd->add_option("IMG", o.images, "Images (.exr, .hdr, .pfm, .png), or checkpoints (--checkpoint: the render they are of, their image so far)")->required();
     cmd->add_flag("--json", o.json, "Print the results as JSON");
     return cmd;
 }
 
+namespace {
+
+// Whether the file begins as a checkpoint does (job/checkpoint.hpp).
+bool is_checkpoint_file(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    char magic[sizeof kCheckpointMagic] = {};
+    return in.read(magic, sizeof magic) && std::equal(std::begin(magic), std::end(magic), std::begin(kCheckpointMagic));
+}
+
+// A checkpoint described as info describes an image: its render's identity as the metadata
+// (the fields an EXR of that render carries, pathlab:scene ...), the passes it holds, the
+// time spent and the version that wrote it; the image is the film's mean so far.
+ImageHeader checkpoint_header(const CheckpointInfo& info) {
+    ImageHeader h;
+    h.format = "pathlab checkpoint";
+    h.channels = {"R (mean so far)", "G (mean so far)", "B (mean so far)"};
+    for (const auto& [key, value] : info.identity.fields) h.attributes.emplace_back(metadata_key(key), value);
+    h.attributes.emplace_back("pathlab:spp", std::to_string(info.passes.count()));
+    h.attributes.emplace_back("pathlab:passes", info.passes.to_string());
+    h.attributes.emplace_back("pathlab:seconds", fmt::format("{:.3f}", info.seconds));
+    h.attributes.emplace_back("pathlab:version", info.writer);
+    return h;
+}
+
+}  // namespace
+
 int run_info_command(const InfoOptions& o) {
     nlohmann::json all = nlohmann::json::array();
     for (const std::string& path : o.images) {
-        const bool png = [&] {
+        // A checkpoint (--checkpoint): what render it is of, and its image so far.
+        std::optional<Checkpoint> checkpoint;
+        if (is_checkpoint_file(path)) {
+            try {
+                checkpoint = read_checkpoint(path);
+            } catch (const CheckpointError& e) {
+                throw UsageError(e.what());
+            }
+        }
+        const bool png = !checkpoint && [&] {
             try {
                 return is_png(path);
             } catch (const ImageIoError& e) {
@@ -85,17 +125,22 @@ int run_info_command(const InfoOptions& o) {
         // Pixels first: the reader validates the whole file before its header is looked at.
         Image img;
         Image8 img8;
-        try {
-            if (png) img8 = read_png8(path);
-            else img = read_image(path);
-        } catch (const ImageIoError& e) {
-            throw UsageError(e.what());
-        }
         ImageHeader header;
-        try {
-            header = read_image_header(path);
-        } catch (const ImageIoError& e) {
-            throw UsageError(e.what());
+        if (checkpoint) {
+            img = checkpoint->film.mean();
+            header = checkpoint_header(checkpoint->info);
+        } else {
+            try {
+                if (png) img8 = read_png8(path);
+                else img = read_image(path);
+            } catch (const ImageIoError& e) {
+                throw UsageError(e.what());
+            }
+            try {
+                header = read_image_header(path);
+            } catch (const ImageIoError& e) {
+                throw UsageError(e.what());
+            }
         }
         header.width = png ? img8.width : img.width();
         header.height = png ? img8.height : img.height();

@@ -252,6 +252,30 @@ TEST(Transmittance, RatioAndDeltaTrackingAgreeInAGrid) {
     }
 }
 
+// A connection's transmittance and its MIS transmittance in one walk give what the two
+// functions give apart, bit for bit (the same random numbers; the same midpoint sums), in a
+// grid and in a homogeneous medium, from inside, from outside and through a majorant factor.
+TEST(Transmittance, WithMisEqualsTheTwoFunctionsBitForBit) {
+    const Medium grid = test_grid_medium(0.4f), fog = HomogeneousMedium{Rgb(0.5f, 1.0f, 2.0f), Rgb(0.3f), IsotropicPhase{}};
+    Sampler s(31, 0, 0);
+    int differing = 0, compared = 0;
+    for (const Medium* m : {&grid, &fog})
+        for (int i = 0; i < 2000; ++i) {
+            const Vec3f o(s.next1d() * 3 - 1.5f, s.next1d() * 3 - 1.5f, s.next1d() * 2 - 1);
+            const Vec3f d = normalize(Vec3f(s.next1d() - 0.5f, s.next1d() - 0.5f, s.next1d() - 0.5f));
+            const float tmax = s.next1d() * 3, factor = i % 3 == 0 ? 1.7f : 1.0f;
+            Sampler a(5, 1, uint64_t(i)), b(5, 1, uint64_t(i));
+            float mis = -1;
+            const Rgb together = estimate_transmittance_with_mis(*m, MediumRgb{*m}, o, d, tmax, a, factor, mis);
+            const Rgb apart = estimate_transmittance(*m, o, d, tmax, b, factor);
+            const float expected = mis_transmittance(*m, o, d, tmax);
+            ++compared;
+            if (std::memcmp(&together, &apart, sizeof(Rgb)) != 0 || (!is_black(together) && std::memcmp(&mis, &expected, sizeof mis) != 0))
+                ++differing;
+        }
+    EXPECT_EQ(differing, 0) << "of " << compared;
+}
+
 TEST(Transmittance, MajorantsBoundEveryLookup) {
     const HeterogeneousMedium g = test_grid_medium();
     const Medium m = g;

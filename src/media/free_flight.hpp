@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "media/majorant_grid.hpp"
@@ -120,10 +121,11 @@ FreeFlight sample_free_flight(const View& m, const Vec3f& o, const Vec3f& d, flo
 
 // Ratio tracking along o + t d, t in [0, tmax]: the running estimate after every tentative
 // collision goes to step(t, T); returns the estimate of T(0, tmax). A Russian roulette on a small
-// transmittance (unbiased, and thick media end early) may end it, with T = 0.
-template <class View, class Step>
+// transmittance (unbiased, and thick media end early) may end it, with T = 0. Each piece of
+// constant majorant goes to piece(segment) before its collisions are tracked.
+template <class View, class Step, class Piece>
 typename View::Colour ratio_tracking(const View& m, const Vec3f& o, const Vec3f& d, float tmax, Sampler& rng, float majorant_factor,
-                                     Step&& step) {
+                                     Step&& step, Piece&& piece) {
     using Colour = typename View::Colour;
     using namespace free_flight_detail;
     float scale;
@@ -131,6 +133,7 @@ typename View::Colour ratio_tracking(const View& m, const Vec3f& o, const Vec3f&
     MajorantSegment seg;
     Colour T(1.0f);
     while (pieces.next(seg)) {
+        piece(std::as_const(seg));
         const float sigma_maj = seg.sigma_maj * scale;
         if (!(sigma_maj > 0)) continue;
         for (float t = seg.t0;;) {
@@ -149,6 +152,11 @@ typename View::Colour ratio_tracking(const View& m, const Vec3f& o, const Vec3f&
         }
     }
     return T;
+}
+template <class View, class Step>
+typename View::Colour ratio_tracking(const View& m, const Vec3f& o, const Vec3f& d, float tmax, Sampler& rng, float majorant_factor,
+                                     Step&& step) {
+    return ratio_tracking(m, o, d, tmax, rng, majorant_factor, step, [](const MajorantSegment&) {});
 }
 
 // An unbiased estimate of the transmittance along o + t d, t in [0, tmax] (closed form where

@@ -83,4 +83,27 @@ float mis_transmittance(const Medium& m, const Vec3f& o, const Vec3f& d, float t
 // how much light a connection can carry at most, before its transmittance is estimated.
 float clearest_transmittance(const Medium& m, const Vec3f& o, const Vec3f& d, float tmax);
 
+// estimate_transmittance(view, ...) and, in `mis`, mis_transmittance(medium, o, d, tmax), both
+// bit for bit, in one walk over the majorant cells in grid media (a connection of the
+// bidirectional methods needs both; the midpoint rule reads the cells ratio tracking visits).
+// `view` is `medium` seen at the path's wavelengths. When ratio tracking's roulette ends the walk
+// (T = 0), `mis` is what the cells before gave: nothing uses it then.
+template <class View>
+typename View::Colour estimate_transmittance_with_mis(const Medium& medium, const View& view, const Vec3f& o, const Vec3f& d, float tmax,
+                                                      Sampler& rng, float majorant_factor, float& mis) {
+    using Colour = typename View::Colour;
+    Colour sigma_t;
+    if (view.constant_extinction(sigma_t)) {
+        mis = mis_transmittance(medium, o, d, tmax);
+        return estimate_transmittance(view, o, d, tmax, rng, majorant_factor);
+    }
+    float depth = 0;
+    const Colour T = ratio_tracking(view, o, d, tmax, rng, majorant_factor, [](float, const Colour&) {}, [&](const MajorantSegment& seg) {
+        if (!(seg.sigma_maj > 0)) return;  // nothing there (as mis_transmittance)
+        depth += std::isfinite(seg.t1) ? mis_extinction(medium, o + d * (0.5f * (seg.t0 + seg.t1))) * (seg.t1 - seg.t0) : kInf;
+    });
+    mis = std::exp(-depth);
+    return T;
+}
+
 }  // namespace pathlab

@@ -124,9 +124,14 @@ ColourOf<T> shadow_transmittance(const Scene& scene, Ray shadow, int32_t medium,
             const float len = length(shadow.d);
             const float t = hit ? isect.t : shadow.tmax;
             const float tmax = segment || hit ? t * len : kInf;
-            Tr *= estimate_transmittance(medium_view(scene.medium(medium), st.wl), shadow.o, shadow.d / len, tmax, st.rng(),
-                                        st.majorant_factor);
-            if (mis_T) *mis_T *= mis_transmittance(scene.medium(medium), shadow.o, shadow.d / len, tmax);
+            const Medium& m = scene.medium(medium);
+            if (mis_T) {
+                float mis;
+                Tr *= estimate_transmittance_with_mis(m, medium_view(m, st.wl), shadow.o, shadow.d / len, tmax, st.rng(), st.majorant_factor, mis);
+                *mis_T *= mis;
+            } else {
+                Tr *= estimate_transmittance(medium_view(m, st.wl), shadow.o, shadow.d / len, tmax, st.rng(), st.majorant_factor);
+            }
             if (is_black(Tr)) return Tr;
         }
         if (!hit) return Tr;

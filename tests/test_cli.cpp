@@ -336,9 +336,18 @@ TEST_F(Cli, SceneFileErrorsGiveFileLineColumnAndExitCode2) {
     r = run({"--scene", write_scene(path("ok.xml")), "-D", "novalue", "-o", path("x.exr")});
     EXPECT_EQ(r.code, 2);
     EXPECT_TRUE(contains(r.err, "expected name=value")) << r.err;
+    // An integrator pathlab does not have: an error that says where and that -a replaces it; with
+    // -a the scene renders, with a note.
     r = run({"--scene", write_scene(path("odd.xml"), "stokes"), "-o", path("x.exr")});
     EXPECT_EQ(r.code, 2);
+    EXPECT_TRUE(contains(r.err, path("odd.xml") + ":")) << r.err;
     EXPECT_TRUE(contains(r.err, "unsupported integrator type 'stokes'")) << r.err;
+    EXPECT_TRUE(contains(r.err, "or choose one of pathlab's with -a NAME")) << r.err;
+    EXPECT_FALSE(fs::exists(path("x.exr")));
+    r = run({"--scene", path("odd.xml"), "-a", "pt-mis", "--spp", "1", "--resolution", "4x4", "-o", path("x.exr")});
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(contains(r.err, "note: the scene's integrator is not one of pathlab's; -a pt-mis renders the scene instead")) << r.err;
+    EXPECT_TRUE(fs::exists(path("x.exr")));
 }
 
 }  // namespace

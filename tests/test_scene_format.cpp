@@ -217,7 +217,6 @@ TEST(SceneFileStructure, RefusalsNameTheMissingFeature) {
     };
     const std::vector<Case> cases = {
         {"<shape type=\"cube\"><bsdf type=\"principled\"/></shape>", "metallic, specular, roughness"},
-        {"<integrator type=\"volpath_simple\"/>", "unsupported integrator type 'volpath_simple'"},
         {"<sensor type=\"perspective\"><film type=\"hdrfilm\"><rfilter type=\"sinc\"/></film></sensor>",
          "unsupported rfilter type 'sinc'; supported: box, tent, gaussian, mitchell, catmullrom, lanczos"},
         {"<sensor type=\"perspective\"><film type=\"hdrfilm\"><string name=\"pixel_format\" value=\"xyz\"/></film></sensor>",

@@ -87,6 +87,12 @@ void apply_environment_caps(RenderSettings& s, const SceneDescription& d) {
 
 RenderJob::RenderJob(SceneChoice scene, const JobRequest& r) : choice_(std::move(scene)) {
     const SceneDescription& d = choice_.description;
+    if (!d.unknown_integrator.empty()) {
+        if (!r.algorithm)
+            throw UsageError(d.unknown_integrator + "; or choose one of pathlab's with -a NAME (e.g. -a pt-mis), which replaces it");
+        choice_.description.notes.push_back(d.unknown_integrator.substr(0, d.unknown_integrator.find(": error: ")) +
+                                            fmt::format(": note: the scene's integrator is not one of pathlab's; -a {} renders the scene instead", *r.algorithm));
+    }
     info_ = &integrator_or_usage_error(r.algorithm ? *r.algorithm : d.algorithm.value_or("pt-mis"));
     options_.max_depth = r.max_depth ? *r.max_depth : d.max_depth.value_or(-1);
     options_.rr_depth = r.rr_depth ? *r.rr_depth : d.rr_depth.value_or(3);

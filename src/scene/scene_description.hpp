@@ -45,6 +45,9 @@ struct SceneDescription {
     std::vector<std::shared_ptr<const EmissionSpectrum>> light_spectra, mesh_emission_spectra, sphere_emission_spectra;
     // Render settings a scene file may suggest; command-line options override them.
     std::optional<std::string> algorithm;
+    // A scene file's integrator that pathlab does not have ("file:line:column: error: ..."): a
+    // render of the scene needs -a, which replaces it (render_job.cpp).
+    std::string unknown_integrator;
     std::optional<int> spp, max_depth, rr_depth;  // depths in pathlab's bounces
     std::optional<int64_t> photons;               // sppm, pm: light paths (per iteration for sppm)
     std::optional<float> photon_radius;           // sppm: the first iteration's radius

@@ -31,8 +31,15 @@ void read_plain_integrator(XmlSource& xml, const pugi::xml_node& n, SceneBuilder
     xml.check_attributes(n, {"type", "id", "name"});
     const std::string type = xml.attr(n, "type");
     const IntegratorInfo* info = find_integrator(type);
-    if (!info)
-        xml.fail(n, fmt::format("unsupported integrator type '{}'; supported: {}, and the wrappers moment and aov", type, integrator_names()));
+    if (!info) {
+        // Not an error yet: -a may choose the estimator instead (the element is then skipped).
+        const SourceLocation w = xml.where(n);
+        b.desc.unknown_integrator =
+            SceneFileError(xml.file(), w.line, w.column,
+                           fmt::format("unsupported integrator type '{}'; supported: {}, and the wrappers moment and aov", type, integrator_names()))
+                .what();
+        return;
+    }
     b.desc.algorithm = info->name;
     if (!xml.plugin_children(n).empty()) xml.fail(xml.plugin_children(n).front(), "an <integrator> has no nested plugins");
     const PluginInfo plugin = info->plugin();

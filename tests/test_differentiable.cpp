@@ -13,6 +13,8 @@
 // against its standard error (plus the truncation estimate), |z| < 3.89: a false alarm rate of
 // 1e-4 per parameter. It must also fail with each fault switch of DiffFaults.
 #include <gtest/gtest.h>
+
+#include <map>
 #include <tbb/task_arena.h>
 
 #include <unistd.h>
@@ -419,6 +421,40 @@ TEST(DiffCli, ParamsNamesAreAcceptedByOptimize) {
     EXPECT_EQ(bad.code, 2);
     EXPECT_TRUE(test::contains(bad.err, "unknown parameter 'red.albedo'")) << bad.err;
     EXPECT_TRUE(test::contains(bad.err, "green.reflectance.value")) << bad.err;
+    fs::remove_all(dir);
+}
+
+// -D sets a scene file's $parameters for params, gradient and optimize as for a render (a name
+// the scene does not use is refused), and gradient gives the same bytes with 1 and 2 --threads.
+TEST(DiffCli, DefinesAndThreadsAsForARender) {
+    namespace fs = std::filesystem;
+    const fs::path dir = fs::temp_directory_path() / ("pathlab-diff-d-" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    const std::string scene = (dir / "wall.xml").string();
+    std::ofstream(scene) << "<scene version=\"3.0.0\"><default name=\"refl\" value=\"0.5\"/>"
+                            "<bsdf type=\"diffuse\" id=\"wall\"><rgb name=\"reflectance\" value=\"$refl\"/></bsdf>"
+                            "<shape type=\"rectangle\"><ref id=\"wall\"/></shape><emitter type=\"constant\"/></scene>\n";
+    const test::CliResult params = test::run({"params", scene, "-D", "refl=0.25", "--json"});
+    ASSERT_EQ(params.code, 0) << params.err;
+    EXPECT_TRUE(test::contains(params.out, "0.25")) << params.out;
+    const auto gradient_files = [&](const std::string& threads) {
+        const std::string out = (dir / ("g" + threads)).string();
+        const test::CliResult r = test::run({"gradient", "--scene", std::string(PATHLAB_SOURCE_DIR) + "/scenes/2-ceiling-diffuse.xml",
+                                             "--params", "red.reflectance.value", "--spp", "2", "--resolution", "16x12", "--threads", threads,
+                                             "--out", out});
+        EXPECT_FALSE(test::contains(r.out, "[0, 0, 0]")) << r.out;
+        EXPECT_EQ(r.code, 0) << r.err;
+        std::map<std::string, std::string> files;
+        for (const auto& e : fs::directory_iterator(out)) {
+            std::ifstream in(e.path(), std::ios::binary);
+            files[e.path().filename().string()] = std::string(std::istreambuf_iterator<char>(in), {});
+        }
+        return files;
+    };
+    const auto one = gradient_files("1"), two = gradient_files("2");
+    EXPECT_FALSE(one.empty());
+    EXPECT_TRUE(one == two) << "the gradient's files differ between 1 and 2 threads";
+    EXPECT_EQ(test::run({"gradient", "--scene", scene, "-D", "nothere=1", "--params", "wall.reflectance.value"}).code, 2);
     fs::remove_all(dir);
 }
 

@@ -35,7 +35,7 @@ std::vector<Photon<RgbTransport>> random_photons(Pcg32& rng, size_t n) {
         Vec3f p(rng.next_float(), rng.next_float(), rng.next_float());
         if (i % 3 == 0) p = Vec3f(0.3f) + (p - Vec3f(0.5f)) * 0.02f;  // a dense cluster
         if (i % 97 == 0 && i > 0) p = photons[i - 1].p;               // duplicates
-        photons.push_back({p * 4.0f - Vec3f(1.0f), Vec3f(0, 0, 1), Rgb(1.0f), 2});
+        photons.push_back({p * 4.0f - Vec3f(1.0f), Vec3f(0, 0, 1), Rgb(1.0f), 2, 0, -1});
     }
     return photons;
 }
@@ -67,7 +67,7 @@ TEST(PhotonSearch, GridAndKdTreeFindExactlyThePhotonsWithinTheRadius) {
 }
 
 TEST(PhotonSearch, ThePhotonAtExactlyTheRadiusCountsAndNothingIsFoundInNothing) {
-    const std::vector<Photon<RgbTransport>> photons = {{Vec3f(0.5f), Vec3f(0, 0, 1), Rgb(1.0f), 2}, {Vec3f(0.5f, 0.5f, 1.5f), Vec3f(0, 0, 1), Rgb(1.0f), 2}};
+    const std::vector<Photon<RgbTransport>> photons = {{Vec3f(0.5f), Vec3f(0, 0, 1), Rgb(1.0f), 2, 0, -1}, {Vec3f(0.5f, 0.5f, 1.5f), Vec3f(0, 0, 1), Rgb(1.0f), 2, 0, -1}};
     PhotonGrid grid;
     PhotonKdTree tree;
     grid.build(photons, 0.25f);

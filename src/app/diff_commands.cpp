@@ -6,6 +6,9 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <optional>
+
+#include <tbb/global_control.h>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -26,8 +29,8 @@
 namespace pathlab {
 namespace {
 
-SceneChoice one_scene(const std::string& spec) {
-    std::vector<SceneChoice> scenes = resolve_scenes(spec);
+SceneChoice one_scene(const std::string& spec, const std::vector<std::string>& defines) {
+    std::vector<SceneChoice> scenes = resolve_scenes(spec, parse_defines(defines));
     if (scenes.size() != 1) throw UsageError(fmt::format("give one scene, not '{}'", spec));
     return std::move(scenes.front());
 }
@@ -166,6 +169,13 @@ void add_common_options(CLI::App* cmd, DiffCommonOptions& o) {
     cmd->add_option("--max-depth", o.max_depth, "Longest path in bounces (-1: unlimited)")->capture_default_str();
     cmd->add_option("--rr-depth", o.rr_depth, "Bounces before Russian roulette (-1: never)")->capture_default_str();
     cmd->add_option("--resolution", o.resolution, "WIDTHxHEIGHT of the renders");
+    cmd->add_option("-D,--define", o.defines, "name=value for $name in the scene file (repeatable; overrides <default>)");
+    add_threads_option(*cmd, o.threads);
+}
+
+// --threads: at most that many worker threads while `limit` lives.
+void limit_threads(std::optional<tbb::global_control>& limit, int threads) {
+    if (threads != 0) limit.emplace(tbb::global_control::max_allowed_parallelism, thread_count_or_cap(threads));
 }
 
 Image read_target(const std::string& path) {
@@ -219,11 +229,12 @@ CLI::App* add_params_command(CLI::App& app, ParamsOptions& o) {
     CLI::App* cmd = app.add_subcommand("params", "List a scene's differentiable parameters: name, kind, value, size (docs/differentiable.md)");
     cmd->add_option("SCENE", o.scene, "A built-in course scene (index or name) or a scene file")->required();
     cmd->add_flag("--json", o.json, "Print them as JSON");
+    cmd->add_option("-D,--define", o.defines, "name=value for $name in the scene file (repeatable; overrides <default>)");
     return cmd;
 }
 
 int run_params_command(const ParamsOptions& o) {
-    const SceneChoice scene = one_scene(o.scene);
+    const SceneChoice scene = one_scene(o.scene, o.defines);
     const std::vector<SceneParameter> params = scene_parameters(scene.description);
     if (o.json) {
         nlohmann::json j = nlohmann::json::array();
@@ -259,7 +270,9 @@ CLI::App* add_gradient_command(CLI::App& app, GradientOptions& o) {
 }
 
 int run_gradient_command(const GradientOptions& o) {
-    SceneChoice scene = one_scene(o.common.scene);
+    std::optional<tbb::global_control> threads;
+    limit_threads(threads, o.common.threads);
+    SceneChoice scene = one_scene(o.common.scene, o.common.defines);
     std::vector<ForwardItem> items;
     const ParameterSet set = choose_parameters(scene.description, o.common, &items);
     int w = 64, h = 64;
@@ -329,7 +342,9 @@ CLI::App* add_optimize_command(CLI::App& app, OptimizeOptions& o) {
 }
 
 int run_optimize_command(const OptimizeOptions& o) {
-    SceneChoice scene = one_scene(o.common.scene);
+    std::optional<tbb::global_control> threads;
+    limit_threads(threads, o.common.threads);
+    SceneChoice scene = one_scene(o.common.scene, o.common.defines);
     const ParameterSet set = choose_parameters(scene.description, o.common);
     const Image target = read_target(o.target);
     int w = target.width(), h = target.height();

@@ -12,6 +12,7 @@ namespace pathlab {
 
 struct ParamsOptions {
     std::string scene;
+    std::vector<std::string> defines;  // -D name=value
     bool json = false;
 };
 CLI::App* add_params_command(CLI::App& app, ParamsOptions& o);
@@ -27,6 +28,8 @@ struct DiffCommonOptions {
     int max_depth = -1;
     int rr_depth = 3;
     std::string resolution;           // default: the target's size (optimize) or 64x64 (gradient)
+    std::vector<std::string> defines;  // -D name=value
+    int threads = 0;                   // 0: all cores
 };
 
 struct GradientOptions {

@@ -356,11 +356,13 @@ StrategyResult<T> Bdpt<T>::connect(const RenderContext& ctx, SubpathView light, 
     // estimate (ratio tracking, from a stream of strategy (s, t)'s own), and its MIS transmittance.
     MediumState<T> st{sampler, wl};
     st.stream_id = kMediumStream + uint64_t(s);
+    // Checked before a connection's BSDFs: a segment out of a sealed medium is blocked without a ray.
+    const auto separated = [&](const PathVertexBase& from, const PathVertexBase& to, const Vec3f& w) {
+        return media && scene.media_separated(from.medium_towards(w), to.medium_towards(-w));
+    };
     const auto transmittance = [&](const PathVertexBase& from, const PathVertexBase& to, const Vec3f& w) {
         if (!media) return scene.occluded(from.segment_to(to)) ? Colour(0.0f) : Colour(1.0f);
-        const int32_t medium = from.medium_towards(w);
-        if (scene.media_separated(medium, to.medium_towards(-w))) return Colour(0.0f);  // no ray needed
-        const Colour Tr = shadow_transmittance(scene, from.segment_to(to), medium, st, &known.T);
+        const Colour Tr = shadow_transmittance(scene, from.segment_to(to), from.medium_towards(w), st, &known.T);
         if (faults_.drop_distance_pdf) known.T = 1;
         return faults_.drop_connection_transmittance && !is_black(Tr) ? Colour(1.0f) : Tr;
     };
@@ -383,6 +385,7 @@ StrategyResult<T> Bdpt<T>::connect(const RenderContext& ctx, SubpathView light, 
         sampled.p = ctx.camera.position();
         sampled.medium = scene.camera_medium();
         sampled.beta = Colour(k->We / k->pdfW);
+        if (separated(qs, sampled, k->wi)) return r;
         r.L = qs.beta * bsdf_towards(scene, qs, k->wi, known.qs_to_pt, wl) * sampled.beta * cos_at(qs, k->wi);
         if (is_black(r.L)) return StrategyResult<T>{};
         const Colour Tr = transmittance(qs, sampled, k->wi);
@@ -410,6 +413,7 @@ StrategyResult<T> Bdpt<T>::connect(const RenderContext& ctx, SubpathView light, 
         sampled.medium = scene.light_medium(choice.index);
         sampled.beta = light_colour(scene, choice.index, ls->Le, wl) / (choice.pmf * ls->pdfW);
         sampled.pdf_fwd = pdf_light_origin(scene, sampled, pt);
+        if (separated(pt, sampled, ls->wi)) return r;
         r.L = pt.beta * bsdf_towards(scene, pt, ls->wi, known.pt_to_qs, wl) * sampled.beta * cos_at(pt, ls->wi);
         if (is_black(r.L)) return StrategyResult<T>{};
         const Colour Tr = transmittance(pt, sampled, ls->wi);
@@ -423,15 +427,15 @@ StrategyResult<T> Bdpt<T>::connect(const RenderContext& ctx, SubpathView light, 
         if (!(dist2 > 0)) return r;
         const float dist = std::sqrt(dist2);
         const Vec3f w = d / dist;  // from pt towards qs
+        if (separated(pt, qs, w)) return r;
         float survival = 1;
         if (media) {
-            const int32_t medium = pt.medium_towards(w);
-            if (scene.media_separated(medium, qs.medium_towards(-w))) return r;  // blocked: no BSDFs, no ray
             // Roulette on connections that the medium all but extinguishes (transmittance below
             // kConnectionRouletteT in every channel): made with probability T / that, and
             // divided by it (unbiased; a made one weighs about as one of transmittance
             // kConnectionRouletteT). In a dense medium most of a long subpath's O(n m) connections
             // are of this kind; the rest cost their BSDFs and a shadow ray as before.
+            const int32_t medium = pt.medium_towards(w);
             if (medium >= 0 && medium == qs.medium_towards(-w) && !faults_.no_connection_roulette) {
                 survival = connection_survival(scene.medium(medium), pt.p, w, dist);
                 if (survival < 1 && !(st.rng().next1d() < survival)) return r;

@@ -56,6 +56,10 @@ void add_threads_option(CLI::App& app, int& threads) {
     app.add_option("--threads", threads, fmt::format("Worker threads (default: all cores; at most {} x the cores)", kMaxThreadsPerCore));
 }
 
+void limit_threads(std::optional<tbb::global_control>& limit, int threads) {
+    if (threads != 0) limit.emplace(tbb::global_control::max_allowed_parallelism, thread_count_or_cap(threads));
+}
+
 size_t thread_count_or_cap(int requested) {
     if (requested <= 0) throw UsageError(fmt::format("--threads must be positive, got {}", requested));
     const size_t cores = std::max(1u, std::thread::hardware_concurrency());

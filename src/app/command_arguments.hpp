@@ -3,6 +3,10 @@
 // (exit code 2) with a message that lists what is valid.
 #pragma once
 
+#include <optional>
+
+#include <tbb/global_control.h>
+
 #include <CLI/CLI.hpp>
 
 #include <cstddef>
@@ -30,6 +34,8 @@ uint64_t parse_seed_option(const std::string& text);
 // kMaxThreadsPerCore x the cores, with a message, before it limits the thread pool.
 void add_threads_option(CLI::App& app, int& threads);
 size_t thread_count_or_cap(int requested);
+// --threads applied: `limit` holds the pool to that many threads while it lives (0: no limit).
+void limit_threads(std::optional<tbb::global_control>& limit, int threads);
 
 // The scenes of every scene command, the same way everywhere: `pathlab SCENE... [options]`
 // (Mitsuba's and pbrt's habit), or -s/--scene; each a built-in scene (index, name, acronym), a

@@ -173,11 +173,6 @@ void add_common_options(CLI::App* cmd, DiffCommonOptions& o) {
     add_threads_option(*cmd, o.threads);
 }
 
-// --threads: at most that many worker threads while `limit` lives.
-void limit_threads(std::optional<tbb::global_control>& limit, int threads) {
-    if (threads != 0) limit.emplace(tbb::global_control::max_allowed_parallelism, thread_count_or_cap(threads));
-}
-
 Image read_target(const std::string& path) {
     try {
         return read_image(path);

@@ -110,7 +110,7 @@ int run_reference_command(const ReferenceOptions& o) {
         }
 
     std::optional<tbb::global_control> thread_limit;
-    if (o.threads != 0) thread_limit.emplace(tbb::global_control::max_allowed_parallelism, thread_count_or_cap(o.threads));
+    limit_threads(thread_limit, o.threads);
     const bool show_progress = !o.quiet && isatty(STDERR_FILENO);
 
     InterruptGuard interrupt;

@@ -389,7 +389,7 @@ int run_render_command(const RenderCommandOptions& o, RankGroup* ranks) {
     const bool several_algorithms = o.algorithm_given && parse_algorithm_list(o.algorithm).size() > 1;
 
     std::optional<tbb::global_control> thread_limit;
-    if (o.threads != 0) thread_limit.emplace(tbb::global_control::max_allowed_parallelism, thread_count_or_cap(o.threads));
+    limit_threads(thread_limit, o.threads);
     const int threads = int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
 
     const bool show_progress = root && !o.quiet && isatty(STDERR_FILENO);

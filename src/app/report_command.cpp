@@ -193,7 +193,7 @@ int run_report_command(const ReportOptions& o) {
     }
 
     std::optional<tbb::global_control> thread_limit;
-    if (o.threads != 0) thread_limit.emplace(tbb::global_control::max_allowed_parallelism, thread_count_or_cap(o.threads));
+    limit_threads(thread_limit, o.threads);
     const bool show_progress = !o.quiet && isatty(STDERR_FILENO);
     const std::string budget = o.time_limit > 0 ? fmt::format("equal time: {} s per algorithm", o.time_limit)
                                                 : fmt::format("equal samples: {} spp per algorithm", o.spp);

@@ -89,9 +89,11 @@ RenderJob::RenderJob(SceneChoice scene, const JobRequest& r) : choice_(std::move
     const SceneDescription& d = choice_.description;
     if (!d.unknown_integrator.empty()) {
         if (!r.algorithm)
-            throw UsageError(d.unknown_integrator + "; or choose one of pathlab's with -a NAME (e.g. -a pt-mis), which replaces it");
-        choice_.description.notes.push_back(d.unknown_integrator.substr(0, d.unknown_integrator.find(": error: ")) +
-                                            fmt::format(": note: the scene's integrator is not one of pathlab's; -a {} renders the scene instead", *r.algorithm));
+            throw UsageError(fmt::format("{}: error: unsupported integrator type '{}'; supported: {}, and the wrappers moment and aov; or "
+                                         "choose one of pathlab's with -a NAME (e.g. -a pt-mis), which replaces it",
+                                         d.unknown_integrator_at, d.unknown_integrator, integrator_names()));
+        choice_.description.notes.push_back(fmt::format(
+            "{}: note: the scene's integrator is not one of pathlab's; -a {} renders the scene instead", d.unknown_integrator_at, *r.algorithm));
     }
     info_ = &integrator_or_usage_error(r.algorithm ? *r.algorithm : d.algorithm.value_or("pt-mis"));
     options_.max_depth = r.max_depth ? *r.max_depth : d.max_depth.value_or(-1);

@@ -45,9 +45,9 @@ struct SceneDescription {
     std::vector<std::shared_ptr<const EmissionSpectrum>> light_spectra, mesh_emission_spectra, sphere_emission_spectra;
     // Render settings a scene file may suggest; command-line options override them.
     std::optional<std::string> algorithm;
-    // A scene file's integrator that pathlab does not have ("file:line:column: error: ..."): a
-    // render of the scene needs -a, which replaces it (render_job.cpp).
-    std::string unknown_integrator;
+    // A scene file's integrator that pathlab does not have: its type, and where the file gives it
+    // ("file:line:column"). A render of the scene needs -a, which replaces it (render_job.cpp).
+    std::string unknown_integrator, unknown_integrator_at;
     std::optional<int> spp, max_depth, rr_depth;  // depths in pathlab's bounces
     std::optional<int64_t> photons;               // sppm, pm: light paths (per iteration for sppm)
     std::optional<float> photon_radius;           // sppm: the first iteration's radius

@@ -34,10 +34,8 @@ void read_plain_integrator(XmlSource& xml, const pugi::xml_node& n, SceneBuilder
     if (!info) {
         // Not an error yet: -a may choose the estimator instead (the element is then skipped).
         const SourceLocation w = xml.where(n);
-        b.desc.unknown_integrator =
-            SceneFileError(xml.file(), w.line, w.column,
-                           fmt::format("unsupported integrator type '{}'; supported: {}, and the wrappers moment and aov", type, integrator_names()))
-                .what();
+        b.desc.unknown_integrator = type;
+        b.desc.unknown_integrator_at = fmt::format("{}:{}:{}", xml.file(), w.line, w.column);
         return;
     }
     b.desc.algorithm = info->name;

@@ -173,8 +173,14 @@ TEST(EnvMapLookup, FollowsMitsubasLatLongConvention) {
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) t[size_t(y * w + x)] = Rgb(float(x), float(y), 1);
     const EnvMap map(w, h, t);
-    // Between texel centres the lookup interpolates: at the centre of a texel it is the texel.
-    EXPECT_EQ(map.lookup({(2 + 0.5f) / w, (1 + 0.5f) / h}), Rgb(2, 1, 1));
+    // Between texels the lookup interpolates; texel (x, y) sits at u = (x + 1/2) / W (the centre of
+    // its column) and v = y / (H - 1) (the first row at the zenith, the last at the nadir), as in
+    // Mitsuba 3's envmap.cpp.
+    EXPECT_EQ(map.lookup({(2 + 0.5f) / w, 1.0f / (h - 1)}), Rgb(2, 1, 1));
+    EXPECT_EQ(map.lookup({(5 + 0.5f) / w, 0.0f}), Rgb(5, 0, 1));
+    EXPECT_EQ(map.lookup({(5 + 0.5f) / w, 1.0f}), Rgb(5, float(h - 1), 1));
+    EXPECT_NEAR(map.lookup({(2 + 0.5f) / w, 0.5f}).y, 0.5f * (h - 1), 1e-6f);
+    EXPECT_NEAR(map.lookup({(2 + 0.5f) / w, 0.25f}).y, 0.25f * (h - 1), 1e-6f);  // texel-centred rows would give 0.5
     const auto at = [&](Vec3f d) { return map.direction_to_uv(normalize(d)); };
     EXPECT_NEAR(at({0, 1, 0}).y, 0.0f, 1e-6f);
     EXPECT_NEAR(at({0, -1, 0}).y, 1.0f, 1e-6f);

@@ -87,8 +87,9 @@ TEST(MaterialRendering, PathTracersAgreeOnEveryNewMaterial) {
 // white linear plastic (its albedo is exactly 1, plastic.hpp) as floor and sphere, white rough
 // plastic, a material="none" mirror and smooth glass, for all three path tracers.
 TEST(MaterialRendering, WhitePlasticAndPerfectConductorVanishInAWhiteFurnace) {
-    SceneDescription d = material_scene({make_plastic(Rgb(1.0f)), make_mirror(), make_dielectric(1.5f, 1.0f),
-                                         make_rough_plastic(ggx(0.3f), Rgb(1.0f))});
+    // (Not roughplastic: Mitsuba 3's model, which it follows, loses the energy of the coating's
+    // facet inter-reflections; RoughPlastic.CoatingTablesAreTheRoughDielectricsAlbedos tests it.)
+    SceneDescription d = material_scene({make_plastic(Rgb(1.0f)), make_mirror(), make_dielectric(1.5f, 1.0f)});
     d.materials[1] = make_plastic(Rgb(1.0f), Rgb(1.0f), 1.6f, 1.0f);  // the floor, two-sided
     d.meshes.erase(d.meshes.begin());                                  // no area light
     d.lights = {EnvironmentLight{Rgb(0.5f)}};

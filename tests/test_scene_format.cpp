@@ -674,6 +674,40 @@ TEST(SceneFileSensors, WindowsClippingLensAndOrthographicRays) {
     }
 }
 
+// Without fov, Mitsuba 3 takes a 50 mm lens on a 36 x 24 mm film and spans the film's diagonal
+// (sensor.cpp, parse_fov): on a square film the horizontal field of view is 34.0 degrees, not the
+// 39.6 that 36 mm across would give. focal_length does the same for other lenses; fov_axis is
+// ignored with it (a note); a scene without a sensor gets the same camera.
+TEST(SceneFileSensors, DefaultFieldOfViewIsMitsubasFiftyMillimetreLensOnTheDiagonal) {
+    const auto camera_of = [](const std::string& sensor, int w, int h) {
+        return load_scene_text(fmt::format(R"(<scene version="3.0.0"><sensor type="perspective">{}
+            <film type="hdrfilm"><integer name="width" value="{}"/><integer name="height" value="{}"/></film></sensor><shape type="sphere"/></scene>)",
+                                           sensor, w, h),
+                               "s.xml", ".")
+            .camera;
+    };
+    const auto diagonal_tan = [](double mm) { return std::sqrt(36.0 * 36 + 24 * 24) / (2 * mm); };  // tan(half the diagonal fov)
+    for (const auto& [sensor, mm] : {std::pair("", 50.0), std::pair(R"(<string name="focal_length" value="25mm"/>)", 25.0),
+                                     std::pair(R"(<string name="focal_length" value="85"/>)", 85.0)})
+        for (const auto& [w, h] : {std::pair(48, 48), std::pair(96, 48), std::pair(30, 60)}) {
+            const Camera cam = camera_of(sensor, w, h);
+            EXPECT_EQ(cam.fov_axis, FovAxis::Diagonal);
+            EXPECT_NEAR(cam.fov_degrees, 2 * std::atan(diagonal_tan(mm)) * 180 / M_PI, 1e-4);
+            // The ray through the middle of the right edge: tan(half the fov along x) = the diagonal's tan * w / sqrt(w^2 + h^2).
+            const Vec3f d = PerspectiveCamera(cam, w, h).generate(float(w), 0.5f * float(h)).d;
+            const double tan_x = std::abs(double(dot(d, cam.right))) / double(dot(d, cam.forward));
+            EXPECT_NEAR(tan_x, diagonal_tan(mm) * w / std::hypot(double(w), double(h)), 1e-5) << sensor << " " << w << "x" << h;
+        }
+    // On a square film: 34.0 degrees across, where 36 mm across (the old rule) gave 39.6.
+    EXPECT_NEAR(2 * std::atan(diagonal_tan(50) / std::sqrt(2.0)) * 180 / M_PI, 34.02, 0.01);
+    // Without a sensor: the same lens.
+    const SceneDescription bare = load_scene_text(R"(<scene version="3.0.0"><shape type="sphere"/></scene>)", "s.xml", ".");
+    EXPECT_EQ(bare.camera.fov_axis, FovAxis::Diagonal);
+    EXPECT_NEAR(bare.camera.fov_degrees, 2 * std::atan(diagonal_tan(50)) * 180 / M_PI, 1e-4);
+    // fov keeps its axis (x by default).
+    EXPECT_EQ(camera_of(R"(<float name="fov" value="30"/>)", 48, 48).fov_axis, FovAxis::X);
+}
+
 TEST(SceneFileSensors, LightTracerAgreesWithPathTracingInACropWindow) {
     // The window's image plane area is in the light tracer's importance: with a wrong area its
     // pixels would be off by the window's fraction of the film (here 1/4).

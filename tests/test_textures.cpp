@@ -337,6 +337,23 @@ TEST_F(TextureFiles, TexturesAreBoundToBsdfParameters) {
     EXPECT_TRUE(bm.materials[0].two_sided);
 }
 
+// Mitsuba 3's rawconstant (the identity normal map of its render tests) and bitmap's storage
+// format (accepted: pathlab stores floats).
+TEST_F(TextureFiles, RawConstantAndBitmapFormat) {
+    write_png8(pattern8(2, 2), path("t.png"));
+    const SceneDescription n = load(
+        R"(<bsdf type="normalmap"><texture type="rawconstant" name="normalmap"><vector name="value" value="0.5, 0.5, 1"/></texture>
+             <bsdf type="diffuse"/></bsdf>)");
+    ASSERT_TRUE(n.materials[0].textures);
+    EXPECT_EQ(n.materials[0].textures->perturbation, FramePerturbation::NormalMap);
+    const SceneDescription f = load(R"(<bsdf type="diffuse"><texture type="bitmap" name="reflectance"><string name="filename" value="t.png"/>
+             <string name="format" value="variant"/></texture></bsdf>)");
+    const SceneDescription plain = load(R"(<bsdf type="diffuse"><texture type="bitmap" name="reflectance"><string name="filename" value="t.png"/>
+             </texture></bsdf>)");
+    EXPECT_EQ(std::get<PhongMaterial>(f.materials[0].model_at({0.3f, 0.7f})).diffuse,
+              std::get<PhongMaterial>(plain.materials[0].model_at({0.3f, 0.7f})).diffuse);
+}
+
 TEST_F(TextureFiles, RefusalsSayWhatIsWrongAndWhere) {
     write_png8(pattern8(2, 2), path("t.png"));
     Image negative(2, 2, Rgb(0.5f));
@@ -356,7 +373,7 @@ TEST_F(TextureFiles, RefusalsSayWhatIsWrongAndWhere) {
         {"<bsdf type=\"diffuse\">" + checker_as("colour") + "</bsdf>", "", "parameter 'colour' of <bsdf type=\"diffuse\"> cannot be a texture"},
         {"<bsdf type=\"diffuse\"><texture type=\"checkerboard\"/></bsdf>", "", "needs the name of the parameter it gives (reflectance)"},
         {"<bsdf type=\"diffuse\"><texture type=\"noise\" name=\"reflectance\"/></bsdf>", "",
-         "unsupported texture type 'noise'; supported: bitmap, checkerboard"},
+         "unsupported texture type 'noise'; supported: bitmap, checkerboard, rawconstant"},
         {"<bsdf type=\"diffuse\"><texture type=\"bitmap\" name=\"reflectance\"/></bsdf>", "", "needs <string name=\"filename\""},
         {"<bsdf type=\"diffuse\"><texture type=\"bitmap\" name=\"reflectance\"><string name=\"filename\" value=\"t.png\"/>"
          "<string name=\"filter_type\" value=\"trilinear\"/></texture></bsdf>",
@@ -365,8 +382,13 @@ TEST_F(TextureFiles, RefusalsSayWhatIsWrongAndWhere) {
          "<string name=\"wrap_mode\" value=\"border\"/></texture></bsdf>",
          "", "unsupported wrap_mode 'border'; supported: repeat, mirror, clamp"},
         {"<bsdf type=\"diffuse\"><texture type=\"bitmap\" name=\"reflectance\"><string name=\"filename\" value=\"t.png\"/>"
+         "<string name=\"format\" value=\"half\"/></texture></bsdf>",
+         "", "unsupported format 'half'; supported: auto, variant, fixed"},
+        {"<bsdf type=\"normalmap\"><texture type=\"rawconstant\" name=\"normalmap\"/><bsdf type=\"diffuse\"/></bsdf>", "",
+         "needs <vector name=\"value\""},
+        {"<bsdf type=\"diffuse\"><texture type=\"bitmap\" name=\"reflectance\"><string name=\"filename\" value=\"t.png\"/>"
          "<float name=\"gamma\" value=\"2\"/></texture></bsdf>",
-         "", "unsupported parameter 'gamma' for <texture type=\"bitmap\">; supported: filename, filter_type, wrap_mode, raw, to_uv"},
+         "", "unsupported parameter 'gamma' for <texture type=\"bitmap\">; supported: filename, filter_type, wrap_mode, raw, format, to_uv"},
         {"<bsdf type=\"diffuse\"><texture type=\"bitmap\" name=\"reflectance\"><string name=\"filename\" value=\"neg.exr\"/></texture></bsdf>",
          "", "the texture for 'reflectance' has negative values (down to -1); it must not be negative"},
         {"<bsdf type=\"diffuse\">" + bitmap + "<rgb name=\"reflectance\" value=\"0.5\"/></bsdf>", "", "parameter 'reflectance' is given twice"},

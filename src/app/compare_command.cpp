@@ -10,6 +10,7 @@
 #include "judge/false_colour.hpp"
 #include "judge/image_compare.hpp"
 #include "judge/image_compare_json.hpp"
+#include "judge/pixel_z_test.hpp"
 
 namespace pathlab {
 namespace {
@@ -64,8 +65,56 @@ CLI::App* add_compare_command(CLI::App& app, CompareOptions& o) {
     cmd->add_option("--diff-scale", o.diff_scale, "Difference shown at full colour in --diff (default: the 99th percentile of |difference|)");
     cmd->add_flag("--json", o.json, "Print the results as JSON");
     cmd->add_flag("--strict", o.strict, "Refuse (exit 2) two renders of different scenes, by their EXRs' scene hashes (default: a warning)");
+    cmd->add_option("--z-test", o.z_test_variance,
+                    "Judge A as Mitsuba 3's render tests do, given this image of B's per-sample variance: a z-test per pixel and "
+                    "channel in XYZ at a Sidak-corrected --alpha, passing when 99.75% of them pass (exit code 1 if not); needs --spp");
+    cmd->add_option("--spp", o.z_test_spp, "--z-test: A's samples per pixel")->check(CLI::PositiveNumber);
+    cmd->add_option("--alpha", o.z_test_alpha, "--z-test: the false-alarm rate of the whole image")
+        ->check(CLI::Range(1e-12, 0.5))
+        ->capture_default_str();
     return cmd;
 }
+
+namespace {
+
+int run_z_test(const CompareOptions& o, const Image& a, const Image& b) {
+    if (o.z_test_spp == 0) throw UsageError("--z-test needs --spp, the samples per pixel of A");
+    std::string unused;
+    const Image var = read_input(o.z_test_variance, unused);
+    PixelZTestOptions zo;
+    zo.spp = o.z_test_spp, zo.alpha = o.z_test_alpha;
+    PixelZTest t;
+    try {
+        t = pixel_z_test(a, b, var, zo);
+    } catch (const std::invalid_argument&) {
+        throw UsageError(fmt::format("{} is {}x{}, {} {}x{} and {} {}x{}: the images and the variance must have one size", o.a,
+                                     a.width(), a.height(), o.b, b.width(), b.height(), o.z_test_variance, var.width(),
+                                     var.height()));
+    }
+    if (o.json) {
+        nlohmann::json j = {{"a", o.a},
+                            {"b", o.b},
+                            {"variance", o.z_test_variance},
+                            {"spp", o.z_test_spp},
+                            {"alpha", o.z_test_alpha},
+                            {"alpha_per_test", t.alpha_per_test},
+                            {"tested", t.tested},
+                            {"passed", t.passed},
+                            {"pass_fraction", t.pass_fraction()},
+                            {"min_p_value", t.min_p_value},
+                            {"mean_relative_diff", t.mean_relative_diff},
+                            {"pass", t.pass}};
+        fmt::print("{}\n", j.dump(2));
+    } else {
+        fmt::print("{}: {:.2f}% of {} pixel-channels pass the z-test at {:.3g} (Sidak, alpha {:g} over the image; 99.75% needed); "
+                   "mean of A - B in XYZ {:+.2f}% of B; min p-value {:.3g}\n",
+                   t.pass ? "PASS" : "FAIL", 100 * t.pass_fraction(), t.tested, t.alpha_per_test, o.z_test_alpha,
+                   100 * t.mean_relative_diff, t.min_p_value);
+    }
+    return t.pass ? 0 : 1;
+}
+
+}  // namespace
 
 int run_compare_command(const CompareOptions& o) {
     double unused = 0;
@@ -91,6 +140,8 @@ int run_compare_command(const CompareOptions& o) {
         if (o.strict) throw UsageError(why + " (--strict)");
         fmt::print(stderr, "pathlab: warning: {}\n", why);
     }
+    if (!o.z_test_variance.empty()) return run_z_test(o, a, b);
+    if (o.z_test_spp != 0) throw UsageError("--spp is for --z-test");
     ImageDifference d;
     try {
         d = compare_images(a, b);

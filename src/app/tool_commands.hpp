@@ -24,6 +24,10 @@ struct CompareOptions {
     double diff_scale = 0;  // 0: automatic
     bool json = false;
     bool strict = false;  // refuse renders of different scenes (by their EXR metadata) instead of warning
+    // Mitsuba 3's render test (judge/pixel_z_test.hpp): B's per-sample variance image and A's samples per pixel.
+    std::string z_test_variance;
+    uint64_t z_test_spp = 0;
+    double z_test_alpha = 0.01;
 };
 CLI::App* add_compare_command(CLI::App& app, CompareOptions& o);
 // 0 agreement (or no threshold), 1 threshold exceeded.

@@ -9,8 +9,12 @@
 //
 // (Walter et al. 2007, "Microfacet models for refraction through rough surfaces"; Heitz 2014,
 // "Understanding the masking-shadowing function".) D is normalised so that the projected
-// microfacet area is 1: integral of D(h) hz dh = 1. Shadowing-masking is Smith's
-// height-correlated form G2 = 1 / (1 + Lambda(wi) + Lambda(wo)); G1 = 1 / (1 + Lambda(w)).
+// microfacet area is 1: integral of D(h) hz dh = 1. Masking is Smith's G1 = 1 / (1 + Lambda(w));
+// shadowing-masking is its separable form G2 = G1(wi) G1(wo), as Mitsuba 3 (microfacet.h, G)
+// and Mitsuba 0.6 use it, so that scenes render as their authors saw them there. (The
+// height-correlated form 1 / (1 + Lambda(wi) + Lambda(wo)) of Heitz 2014, which pbrt-v4 uses,
+// is larger where both directions are grazing: the roughest sphere of Mitsuba's roughplastic
+// render test had a ring of failing pixels at its rim with it.)
 //
 // Sampling: the distribution of normals visible from wi (wi.z > 0; callers flip to the upper
 // hemisphere), density D_wi(h) = G1(wi) max(0, wi.h) D(h) / wi.z for both distributions.
@@ -74,8 +78,8 @@ struct MicrofacetDistribution {
     }
 
     float G1(const Vec3f& w) const { return 1.0f / (1.0f + lambda(w)); }
-    // Height-correlated masking-shadowing of wi and wo (both must see the facet h: callers check).
-    float G2(const Vec3f& wi, const Vec3f& wo) const { return 1.0f / (1.0f + lambda(wi) + lambda(wo)); }
+    // Separable masking-shadowing of wi and wo (both must see the facet h: callers check).
+    float G2(const Vec3f& wi, const Vec3f& wo) const { return G1(wi) * G1(wo); }
 
     // A microfacet normal for directions seen from wi (wi.z > 0); see the header comment.
     Vec3f sample(const Vec3f& wi, const Vec2f& u) const {

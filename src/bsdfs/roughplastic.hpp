@@ -1,14 +1,20 @@
-// roughplastic: a diffuse base under a rough dielectric coating. The coating reflects like a
-// rough dielectric interface (microfacet reflection, microfacet.hpp); what it does not reflect
-// reaches the diffuse base, as in plastic.hpp, and leaves through the coating again:
+// roughplastic: a diffuse base under a rough dielectric coating, as Mitsuba 3 defines it
+// (src/bsdfs/roughplastic.cpp there). The coating reflects like a rough dielectric interface
+// (microfacet reflection, microfacet.hpp); what it transmits reaches the diffuse base, as in
+// plastic.hpp, and leaves through the coating again:
 //   f(wi, wo) = R_s F(wi.h) D(h) G2(wi, wo) / (4 cos_i cos_o)
 //             + rho' T(cos_i) T(cos_o) / (pi eta^2)
-// T(mu) = 1 - E(mu) is the coating's transmittance, E(mu) the directional albedo of its
-// reflection lobe (with R_s = 1), tabulated once per material by quadrature (as Mitsuba 3
-// does). rho' = rho / (1 - Fdr) (or rho / (1 - rho Fdr) when nonlinear) with the coating's
-// internal diffuse reflectance taken as Fdr = 1 - (2 / eta^2) integral_0^1 T(mu) mu dmu, the
-// value that reciprocity gives the rough interface from inside; so a white base (rho = 1,
-// R_s = 1, linear) reflects E(cos_i) + T(cos_i) = 1 at every angle. Reciprocal.
+// T(mu) is the coating's transmittance for light arriving at cosine mu: the albedo of the rough
+// dielectric's (single-scattering) refraction lobe, integral (1 - F(wi.m)) G1(wt) over the
+// visible normals m (wt the refracted direction). rho' = rho / (1 - Fint) (or rho / (1 - rho
+// Fint) when nonlinear), with Fint = 2 integral_0^1 R_in(mu) mu dmu the coating's reflectance for
+// diffuse light from inside, R_in(mu) the albedo of its reflection lobe at relative index
+// 1 / eta (total internal reflection included). Both are tabulated once per material by
+// quadrature over the visible normals, as Mitsuba 3 does. The single-scattering lobes lose the
+// energy of the facets' inter-reflections, so a white base reflects less than it receives
+// (0.55 at normal incidence with GGX alpha 0.5: docs/materials.md). This is Mitsuba's model;
+// pathlab's before 2026-12-05 took T = 1 - E and Fint from reciprocity, a lossless model 6-20%
+// brighter than Mitsuba's render tests. Reciprocal.
 //
 // XML (Mitsuba 3 names; Mitsuba 0.6 camelCase spellings accepted):
 //   distribution          string           ggx or beckmann                          default beckmann
@@ -21,15 +27,16 @@
 //   sample_visible        boolean          accepted; visible normals are always sampled
 // One-sided unless wrapped in twosided.
 //
-// Sampling: the coating's lobe with probability P_s (as plastic.hpp, with E(cos_i) in place
-// of the smooth Fresnel term), else the cosine-weighted hemisphere; pdf() is the mixture of
-// both densities and f the whole BSDF, so every sample is an ordinary (non-delta) one.
+// Sampling: the coating's lobe with probability P_s (as plastic.hpp, with 1 - T(cos_i) in
+// place of the smooth Fresnel term), else the cosine-weighted hemisphere; pdf() is the mixture
+// of both densities and f the whole BSDF, so every sample is an ordinary (non-delta) one.
 #pragma once
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <optional>
+#include <utility>
 
 #include "core/sampling.hpp"
 #include "bsdfs/bsdf_sample.hpp"
@@ -48,14 +55,17 @@ struct RoughPlasticMaterial {
     RoughPlasticMaterial() = default;
     RoughPlasticMaterial(const MicrofacetDistribution& d, const CoatedDiffuse& c) : distribution(d), coat(c) {
         for (int k = 0; k < kTableSize; ++k)
-            transmittance[size_t(k)] = float(1 - coating_albedo(std::max(1e-4, double(k) / (kTableSize - 1))));
-        // Fdr = 1 - (2 / eta^2) integral of T(mu) mu dmu (trapezoidal on the table's nodes).
-        double integral = 0;
-        for (int k = 0; k + 1 < kTableSize; ++k) {
-            const double m0 = double(k) / (kTableSize - 1), m1 = double(k + 1) / (kTableSize - 1);
-            integral += 0.5 * (transmittance[size_t(k)] * m0 + transmittance[size_t(k + 1)] * m1) * (m1 - m0);
-        }
-        coat.fdr = float(1 - 2 * integral / (double(coat.eta) * coat.eta));
+            transmittance[size_t(k)] = float(coating_albedo(std::max(1e-4, double(k) / (kTableSize - 1)), coat.eta, false, 64));
+        // Fint = 2 integral R_in(mu) mu dmu = integral R_in(sqrt(s)) ds: the midpoint rule in s = mu^2,
+        // on either side of the smooth interface's critical angle (s_c = 1 - 1 / eta^2), where a
+        // nearly smooth coating's R_in jumps to 1.
+        constexpr int kNodes = 24;
+        const double sc = coat.eta > 1 ? 1 - 1 / (double(coat.eta) * coat.eta) : 0.0;
+        double sum = 0;
+        for (const auto& [s0, s1] : {std::pair(0.0, sc), std::pair(sc, 1.0)})
+            for (int k = 0; k < kNodes && s1 > s0; ++k)
+                sum += (s1 - s0) / kNodes * coating_albedo(std::sqrt(s0 + (s1 - s0) * (k + 0.5) / kNodes), 1 / coat.eta, true, 96);
+        coat.fdr = float(sum);
         coat.update();
     }
 
@@ -115,29 +125,29 @@ struct RoughPlasticMaterial {
     void texels_changed() { coat.update(); }
 
 private:
-    // E(mu): albedo of the coating's reflection (R_s = 1) for light arriving at cosine mu, by
-    // the midpoint rule over microfacet normals with theta_h = atan(a tan(pi t / 2)), t
-    // uniform, which puts the nodes where D has its mass.
-    double coating_albedo(double mu, int n = 64) const {
+    // The coating's albedo for light arriving at cosine mu from the side where the relative
+    // index is eta (eta_t / eta_i): of its reflection lobe (reflect) or its refraction lobe.
+    // The midpoint rule on n x n points of the visible normals' sample space (each point a
+    // visible normal m, of density D_wi), so that the integrand is F G1(wo) or (1 - F) G1(wt).
+    double coating_albedo(double mu, float eta, bool reflect_lobe, int n) const {
         const Vec3f wi(float(std::sqrt(1 - mu * mu)), 0.0f, float(mu));
-        const double a = std::sqrt(double(distribution.alpha_u) * distribution.alpha_v);
         double sum = 0;
-        for (int i = 0; i < n; ++i) {
-            const double x = std::tan(M_PI / 2 * (i + 0.5) / n), theta = std::atan(a * x);
-            const double dtheta = a * (M_PI / 2) * (1 + x * x) / (1 + a * a * x * x);
-            const double st = std::sin(theta), ct = std::cos(theta);
+        for (int i = 0; i < n; ++i)
             for (int j = 0; j < n; ++j) {
-                const double phi = 2 * M_PI * (j + 0.5) / n;
-                const Vec3f h(float(st * std::cos(phi)), float(st * std::sin(phi)), float(ct));
-                const float c = dot(wi, h);
-                if (c <= 0) continue;
-                const Vec3f wo = reflect(wi, h);
-                if (wo.z <= 0) continue;
-                // f cos_o d omega_o = F D G2 / (4 mu wo.z) wo.z 4 (wo.h) d omega_h
-                sum += double(coat.fresnel(c)) * distribution.D(h) * distribution.G2(wi, wo) * c / mu * st * dtheta;
+                const Vec3f m = distribution.sample(wi, Vec2f(float((i + 0.5) / n), float((j + 0.5) / n)));
+                const float c = dot(wi, m);
+                if (!(c > 0)) continue;
+                float cos_t = 0;
+                const float F = fresnel_dielectric(c, eta, &cos_t);
+                if (reflect_lobe) {
+                    const Vec3f wo = reflect(wi, m);
+                    if (wo.z > 0) sum += double(F) * distribution.G1(wo);
+                } else if (F < 1) {
+                    const Vec3f wt = (c / eta - cos_t) * m - wi / eta;  // refracted, below the surface
+                    if (wt.z < 0) sum += double(1 - F) * distribution.G1(wt);
+                }
             }
-        }
-        return sum * (2 * M_PI / n) / n;
+        return sum / (double(n) * n);
     }
 };
 

@@ -229,11 +229,13 @@ private:
 
 // The scene-file sensors (the reader, read_sensor.cpp, turns to_world into the camera).
 inline std::vector<ParamInfo> projective_sensor_params() {
-    return {{"fov", ParamType::Float, "39.3077", "field of view in degrees"},
+    return {{"fov", ParamType::Float, "", "field of view in degrees (default: from focal_length)"},
             {"fov_axis", ParamType::String, "x",
              "the axis fov spans: x, y, diagonal, smaller, larger, or pathlab's each (both axes span fov, as the course's camera)",
              "fovAxis"},
-            {"focal_length", ParamType::String, "", "instead of fov: a 35 mm film's focal length (\"50mm\" or 50), fov = 2 atan(36 / (2 f)) along x",
+            {"focal_length", ParamType::String, "50mm",
+             "instead of fov: a 35 mm film's (36 x 24 mm) focal length (\"50mm\" or 50); the field of view along the film's "
+             "diagonal is 2 atan(sqrt(36^2 + 24^2) / (2 f)), as Mitsuba 3 and 0.6 (46.8 degrees for 50 mm: 34.0 along x on a square film)",
              "focalLength"},
             {"to_world", ParamType::Transform, "", "placement (usually a lookat); Mitsuba's camera looks along +z, +y up, +x left", "toWorld"},
             {"near_clip", ParamType::Float, "",

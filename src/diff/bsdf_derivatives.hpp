@@ -12,7 +12,7 @@
 //   Phong:           df/drho_d = 1/pi,  df/drho_s = (n + 2) c^n / (2 pi),
 //                    df/dn = rho_s c^n (1 + (n + 2) ln c) / (2 pi)     (c = cos alpha > 0)
 //   roughconductor:  df/dR = F D G2 / (4 cos_i cos_o),  df/dalpha = R F (D' G2 + D G2') / (4 cos_i cos_o),
-//                    G2' = -G2^2 (Lambda'(wi) + Lambda'(wo)), with for GGX
+//                    G2 = G1(wi) G1(wo), G2' = -G2 (G1(wi) Lambda'(wi) + G1(wo) Lambda'(wo)), with for GGX
 //                    D' = D (-2/alpha + 4 s / (alpha^3 t)), t = s / alpha^2 + hz^2, s = hx^2 + hy^2,
 //                    Lambda' = a2 / (2 alpha sqrt(1 + a2)), a2 = alpha^2 tan^2;
 //                    for Beckmann D' = D (2 s / (alpha^3 hz^2) - 2/alpha), Lambda' = exp(-c^2) / (2 sqrt(pi) c alpha), c = 1/sqrt(a2)
@@ -79,17 +79,6 @@ float coating_fdr(const CoatedDiffuse& c, Compute&& compute) {
     return compute();
 }
 
-// The rough coating's Fdr as RoughPlasticMaterial's constructor computes it from its table.
-inline float rough_coating_fdr(const RoughPlasticMaterial& r) {
-    const int n = RoughPlasticMaterial::kTableSize;
-    double integral = 0;
-    for (int k = 0; k + 1 < n; ++k) {
-        const double m0 = double(k) / (n - 1), m1 = double(k + 1) / (n - 1);
-        integral += 0.5 * (r.transmittance[size_t(k)] * m0 + r.transmittance[size_t(k + 1)] * m1) * (m1 - m0);
-    }
-    return float(1 - 2 * integral / (double(r.coat.eta) * r.coat.eta));
-}
-
 }  // namespace bsdf_derivative_detail
 
 // Calls add(offset, df/dtheta) for every bound scalar parameter of `m` whose derivative at
@@ -132,7 +121,8 @@ void bsdf_jacobian(const Material& m, const MaterialBinding& b, const Vec3f& wi,
             for (int c = 0; c < 3; ++c) add(b.specular + c, channel(c, (&base.x)[c]));
         }
         if (b.alpha >= 0) {
-            const float dG = -G * G * (dlambda_dalpha(r->distribution, wi) + dlambda_dalpha(r->distribution, wo));
+            const float dG = -G * (r->distribution.G1(wi) * dlambda_dalpha(r->distribution, wi) +
+                                   r->distribution.G1(wo) * dlambda_dalpha(r->distribution, wo));
             add(b.alpha, r->specular_reflectance * F * (dD_dalpha(r->distribution, h) * G + D * dG));
         }
         return;
@@ -153,7 +143,7 @@ void bsdf_jacobian(const Material& m, const MaterialBinding& b, const Vec3f& wi,
     }
     if (const auto* r = std::get_if<RoughPlasticMaterial>(&m.model)) {
         if (delta || b.diffuse < 0) return;
-        const Rgb d = coated_base_derivative(r->coat, coating_fdr(r->coat, [&] { return rough_coating_fdr(*r); })) *
+        const Rgb d = coated_base_derivative(r->coat, coating_fdr(r->coat, [&] { return r->coat.fdr; })) *
                       (r->T(wi.z) * r->T(wo.z) * kInvPi / (r->coat.eta * r->coat.eta));
         for (int ch = 0; ch < 3; ++ch) add(b.diffuse + ch, channel(ch, (&d.x)[ch]));
     }

@@ -28,22 +28,29 @@ EnvMap::EnvMap(int width, int height, std::vector<Rgb> texels, const Frame& to_w
         y = std::clamp(y, 0, height_ - 1);
         return lum[size_t(y) * size_t(width_) + size_t(x)];
     };
+    // The lookup's luminance at image coordinates (s, t) (lookup() below: s = u W - 1/2, t = v (H - 1)).
+    const auto bilinear = [&](float s, float t) {
+        const int x0 = int(std::floor(s)), y0 = std::min(int(std::floor(t)), height_ - 1);
+        const float wx = s - float(x0), wy = t - float(y0);
+        return (L(x0, y0) * (1 - wx) + L(x0 + 1, y0) * wx) * (1 - wy) + (L(x0, y0 + 1) * (1 - wx) + L(x0 + 1, y0 + 1) * wx) * wy;
+    };
     std::vector<float> f(texels_.size());
     double mean = 0;
     for (int y = 0; y < height_; ++y) {
         const float sin_max = row_max_sin_theta(y, height_);
         // The texel's solid angle, for the mean radiance.
         const double omega = 2 * M_PI / width_ * (std::cos(M_PI * y / height_) - std::cos(M_PI * (y + 1) / height_));
+        // The cell's rows: from t0 to t1, with the image rows between (at most one: t1 - t0 < 1).
+        const float t0 = float(double(y) * (height_ - 1) / height_), t1 = float(double(y + 1) * (height_ - 1) / height_);
+        float ts[3] = {t0, t1, t0};
+        const int between = int(std::floor(t0)) + 1;
+        if (float(between) < t1) ts[2] = float(between);
         for (int x = 0; x < width_; ++x) {
-            // The bilinear function's maximum over the cell: the texel itself, the midpoints of
-            // its edges (averages of two texels) and its corners (averages of four).
-            const float c = L(x, y), l = L(x - 1, y), r = L(x + 1, y), up = L(x, y - 1), dn = L(x, y + 1);
-            float m = c;
-            for (const float e : {l, r, up, dn}) m = std::max(m, 0.5f * (c + e));
-            m = std::max(m, 0.25f * (c + l + up + L(x - 1, y - 1)));
-            m = std::max(m, 0.25f * (c + r + up + L(x + 1, y - 1)));
-            m = std::max(m, 0.25f * (c + l + dn + L(x - 1, y + 1)));
-            m = std::max(m, 0.25f * (c + r + dn + L(x + 1, y + 1)));
+            // The bilinear function's maximum over the cell is at a corner of one of its patches:
+            // columns x - 1/2, x, x + 1/2 (the cell's edges and the texel's centre) by the rows above.
+            float m = 0;
+            for (const float t : ts)
+                for (const float dx : {-0.5f, 0.0f, 0.5f}) m = std::max(m, bilinear(float(x) + dx, t));
             f[size_t(y) * size_t(width_) + size_t(x)] = m * sin_max;
             mean += double(pathlab::mean(texel(x, y))) * omega;
         }
@@ -53,14 +60,17 @@ EnvMap::EnvMap(int width, int height, std::vector<Rgb> texels, const Frame& to_w
 }
 
 Rgb EnvMap::lookup(Vec2f uv) const {
-    const float s = uv.x * float(width_) - 0.5f, t = uv.y * float(height_) - 0.5f;
-    const float fs = std::floor(s), ft = std::floor(t);
-    const float wx = s - fs, wy = t - ft;
+    // Texel-centred in u (column x at u = (x + 1/2) / W), corner-aligned in v (row y at
+    // v = y / (H - 1): the first row at the zenith, the last at the nadir), as Mitsuba 3's
+    // envmap.cpp (eval_spectrum) looks it up.
+    const float s = uv.x * float(width_) - 0.5f, t = std::clamp(uv.y, 0.0f, 1.0f) * float(height_ - 1);
+    const float fs = std::floor(s);
+    const int y0 = std::min(int(t), std::max(height_ - 2, 0)), y1 = std::min(y0 + 1, height_ - 1);
+    const float wx = s - fs, wy = t - float(y0);
     // u in [0, 1): fs in [-1, W - 1]; other u wrap by a modulo.
     int x0 = int(fs);
     if (x0 < 0 || x0 >= width_) x0 = ((x0 % width_) + width_) % width_;
     const int x1 = x0 + 1 == width_ ? 0 : x0 + 1;
-    const int y0 = std::clamp(int(ft), 0, height_ - 1), y1 = std::clamp(int(ft) + 1, 0, height_ - 1);
     return (texel(x0, y0) * (1 - wx) + texel(x1, y0) * wx) * (1 - wy) + (texel(x0, y1) * (1 - wx) + texel(x1, y1) * wx) * wy;
 }
 

@@ -6,20 +6,21 @@
 // Mapping, Mitsuba 3's convention, in the emitter's frame (to_world turns it): a direction d has
 // theta = acos(d.y) and phi = atan2(d.x, -d.z) in [0, 2 pi), and lies at u = phi / (2 pi),
 // v = theta / pi of the image: the top row looks up (+y), the left edge towards -z, a quarter of
-// the way across towards +x, the middle towards +z. Texel (x, y) of a W x H image covers
-// [x/W, (x+1)/W) x [y/H, (y+1)/H) and its value sits at the texel's centre (Mitsuba 3 puts the
-// rows at theta = y pi / (H - 1) instead: the same orientation, up to half a texel vertically).
+// the way across towards +x, the middle towards +z. Texel (x, y) of a W x H image sits at
+// u = (x + 1/2) / W (texel-centred) and v = y / (H - 1) (the first row at the zenith, the last at
+// the nadir), as Mitsuba 3 looks it up (envmap.cpp, eval_spectrum); for sampling, its cell is
+// [x/W, (x+1)/W) x [y/H, (y+1)/H).
 //
-// Lookup: bilinear between the four nearest texel centres, wrapping around in u, the first and
-// last rows held towards the poles.
+// Lookup: bilinear between the four nearest texels, wrapping around in u.
 //
 // Sampling (incident and emitted directions alike): a piecewise-constant 2D distribution over
 // the texels' cells of [0, 1)^2 (core/distribution.hpp), with the value of texel (x, y)
 //     f = (the largest luminance the bilinear lookup takes in the texel's cell)
 //       x (the largest sin(theta) over the texel's row),
 // i.e. the cell maxima of the integrand luminance(L) sin(theta): the bilinear function is
-// largest at the corners of its four quarter-patches inside the cell, so the maximum is that of
-// 9 values (the texel, the 4 edge midpoints, the 4 corners). Every direction where the lookup
+// largest at a corner of one of its patches inside the cell, so the maximum is that of at most
+// 9 values (the cell's edges and the texel's centre in u, by the cell's edges and the image row
+// between them in v). Every direction where the lookup
 // is non-zero has a non-zero density, and a sample's luminance weight L / pdfW never exceeds
 // 2 pi^2 mean(f). A point (u, v) of the distribution is the direction above; its density per
 // unit solid angle is pdf_uv / (2 pi^2 sin(theta)) (dphi dtheta = 2 pi^2 du dv, dw = sin(theta)

@@ -33,7 +33,10 @@ Volume Volume::of_grid(VoxelGrid g, const Transform& unit_to_world) {
     return v;
 }
 
-Volume read_constvolume(Properties& p) { return Volume::constant_value(p.get_rgb("value")); }
+Volume read_constvolume(Properties& p) {
+    p.get_transform("to_world");  // a constant is the same everywhere
+    return Volume::constant_value(p.get_rgb("value"));
+}
 
 Volume read_gridvolume(Properties& p, const std::string& base_dir, bool allow_files, std::vector<std::string>* files_read) {
     if (!p.has("filename")) p.fail("<volume type=\"gridvolume\"> needs <string name=\"filename\" value=\"...\"/>");
@@ -45,6 +48,9 @@ Volume read_gridvolume(Properties& p, const std::string& base_dir, bool allow_fi
     if (filter != "trilinear" && filter != "nearest")
         p.fail("filter_type", fmt::format("unsupported filter_type '{}'; supported: trilinear, nearest", filter));
     const std::string grid_name = p.has("grid") ? p.get_string("grid") : "";
+    if (p.get_bool("use_grid_bbox"))
+        p.fail("use_grid_bbox", "use_grid_bbox = true is not supported: pathlab places the grid's unit cube with to_world (give the "
+                                "file's bounding box as a scale and translate there)");
     const Transform to_world = p.get_transform("to_world").value_or(Transform{});
     const bool vdb = path.size() >= 4 && path.compare(path.size() - 4, 4, ".vdb") == 0;
     if (!vdb && p.has("grid")) p.fail("grid", "only .vdb files have named grids");

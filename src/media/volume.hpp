@@ -42,7 +42,8 @@ struct Volume {
 
 inline const PluginInfo& constvolume_plugin() {
     static const PluginInfo info{"volume", "constvolume", "the same value everywhere",
-                                 {{"value", ParamType::Rgb, "1", "the value (a float or an RGB triple)"}}};
+                                 {{"value", ParamType::Rgb, "1", "the value (a float or an RGB triple)"},
+                                  {"to_world", ParamType::Transform, "", "accepted (Mitsuba's volumes all take one): a constant is the same wherever it is placed"}}};
     return info;
 }
 inline const PluginInfo& gridvolume_plugin() {
@@ -51,7 +52,9 @@ inline const PluginInfo& gridvolume_plugin() {
         {{"filename", ParamType::String, "", "the .vol or .vdb file, relative to the scene file"},
          {"to_world", ParamType::Transform, "", "places the grid's unit cube [0, 1]^3 (a .vdb grid: its own world space) in the scene"},
          {"filter_type", ParamType::String, "trilinear", "trilinear or nearest"},
-         {"grid", ParamType::String, "", "a .vdb file's grid by name (default: 'density', or the file's only grid)"}},
+         {"grid", ParamType::String, "", "a .vdb file's grid by name (default: 'density', or the file's only grid)"},
+         {"use_grid_bbox", ParamType::Boolean, "false",
+          "Mitsuba 3's choice of the .vol file's own bounding box instead of the unit cube: false only (true is refused: give the box as to_world)"}},
         "The grid is 0 outside its box. A .vol file's own bounding box is ignored, as Mitsuba 3 does. Values must be finite and "
         "not negative."};
     return info;

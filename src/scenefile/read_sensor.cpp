@@ -148,20 +148,22 @@ void read_sampler(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b) {
     if (!xml.plugin_children(n).empty()) xml.fail(xml.plugin_children(n).front(), "a <sampler> has no nested plugins");
 }
 
-// fov from focal_length ("50mm" or 50): a 35 mm film, 36 mm wide.
-float fov_of_focal_length(Properties& p) {
+// The field of view along the film's diagonal from focal_length ("50mm" or 50, the default when
+// neither fov nor focal_length is given): the diagonal of a 35 mm film, 36 x 24 mm, whatever the
+// film's own aspect (Mitsuba 3's parse_fov in src/render/sensor.cpp, as Mitsuba 0.6 did).
+float diagonal_fov_of_focal_length(Properties& p) {
     std::string text = p.get_string("focal_length");
     if (text.size() > 2 && text.substr(text.size() - 2) == "mm") text.resize(text.size() - 2);
     const auto f = parse_float_text(text);
     if (!f || !(*f > 0)) p.fail("focal_length", fmt::format("focal_length must be a positive length like \"50mm\", got '{}'", p.get_string("focal_length")));
-    return float(2 * std::atan(36.0 / (2 * *f)) * 180 / 3.14159265358979323846);
+    return float(2 * std::atan(std::sqrt(36.0 * 36 + 24 * 24) / (2 * *f)) * 180 / 3.14159265358979323846);
 }
 
 }  // namespace
 
 void use_default_sensor(SceneBuilder& b) {
     Properties camera(perspective_plugin(), {}), film(hdrfilm_plugin(), {});
-    b.desc.camera = Camera::look_along({0, 0, 0}, {0, 0, 1}, {0, 1, 0}, camera.get_float("fov"), read_fov_axis(camera));
+    b.desc.camera = Camera::look_along({0, 0, 0}, {0, 0, 1}, {0, 1, 0}, diagonal_fov_of_focal_length(camera), FovAxis::Diagonal);
     b.desc.width = film.get_int("width");
     b.desc.height = film.get_int("height");
 }
@@ -190,9 +192,14 @@ void read_sensor(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b) {
             }
         } else {
             if (p.has("focal_length") && p.has("fov")) p.fail("focal_length", "give fov or focal_length, not both");
-            const float fov = p.has("focal_length") ? fov_of_focal_length(p) : p.get_float("fov");
+            const bool given_fov = p.has("fov");
+            if (!given_fov && p.has("fov_axis")) {
+                read_fov_axis(p);  // checked, then ignored as Mitsuba does
+                xml.note(n, "fov_axis is ignored without fov: focal_length's field of view spans the film's diagonal");
+            }
+            const float fov = given_fov ? p.get_float("fov") : diagonal_fov_of_focal_length(p);
             if (!(fov > 0 && fov < 180)) p.fail(fmt::format("fov must be between 0 and 180 degrees, got {}", fov));
-            const FovAxis axis = read_fov_axis(p);
+            const FovAxis axis = given_fov ? read_fov_axis(p) : FovAxis::Diagonal;
             c = camera_from(xml, p.get_transform("to_world"), block, fov, axis);
             c.principal_x = p.get_float("principal_point_offset_x");
             c.principal_y = p.get_float("principal_point_offset_y");

@@ -24,6 +24,8 @@ const PluginInfo& bitmap_plugin() {
          {"filter_type", ParamType::String, "bilinear", "bilinear (the four nearest texels) or nearest"},
          {"wrap_mode", ParamType::String, "repeat", "uv outside [0, 1]: repeat, mirror or clamp"},
          {"raw", ParamType::Boolean, "false", "keep 8-bit values as stored instead of decoding sRGB (normal and bump maps)"},
+         {"format", ParamType::String, "auto",
+          "Mitsuba 3's storage precision (auto, variant, fixed): accepted; pathlab keeps the decoded values as 32-bit floats"},
          kToUv}};
     return info;
 }
@@ -38,6 +40,9 @@ Texture read_bitmap(Properties& p, const TextureContext& ctx) {
     else if (wrap == "clamp") w = WrapMode::Clamp;
     else if (wrap != "repeat") p.fail("wrap_mode", fmt::format("unsupported wrap_mode '{}'; supported: repeat, mirror, clamp", wrap));
     const bool raw = p.get_bool("raw");
+    const std::string format = p.get_string("format");
+    if (format != "auto" && format != "variant" && format != "fixed")
+        p.fail("format", fmt::format("unsupported format '{}'; supported: auto, variant, fixed", format));
     const UvTransform to_uv = read_to_uv(p);
     if (!ctx.allow_files) p.fail("this loader does not read files (bitmap textures are disabled)");
     const std::string path =
@@ -66,12 +71,26 @@ Texture read_checkerboard(Properties& p, const TextureContext&) {
     return Texture(c);
 }
 
+// Mitsuba 3's rawconstant: one value everywhere, used as given (no colour conversion), e.g. the
+// identity normal map (0.5, 0.5, 1).
+const PluginInfo& rawconstant_plugin() {
+    static const PluginInfo info{"texture", "rawconstant", "one value everywhere, as given (no colour conversion): e.g. a normal map's (0.5, 0.5, 1)",
+                                 {{"value", ParamType::Point, "", "the value (a <vector> or <point>; required)"}}};
+    return info;
+}
+Texture read_rawconstant(Properties& p, const TextureContext&) {
+    if (!p.has("value")) p.fail("<texture type=\"rawconstant\"> needs <vector name=\"value\" value=\"x, y, z\"/>");
+    const Vec3f v = p.get_point("value");
+    return Texture(ConstantTexture{Rgb(v.x, v.y, v.z)});
+}
+
 }  // namespace
 
 const std::vector<TexturePlugin>& texture_plugins() {
     static const std::vector<TexturePlugin> table = {
         {bitmap_plugin, read_bitmap},
         {checkerboard_plugin, read_checkerboard},
+        {rawconstant_plugin, read_rawconstant},
     };
     return table;
 }

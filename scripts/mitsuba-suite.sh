@@ -1,0 +1,69 @@
+#!/bin/bash
+# Mitsuba 3's render-test suite, judged as its src/render/tests/test_renders.py judges it, with
+# pathlab as the renderer. DIR is a checkout of github.com/mitsuba-renderer/mitsuba-data (its
+# tests/scenes and common folders; nothing of it is part of pathlab).
+#
+# For every DIR/tests/scenes/*/NAME_INTEGRATOR.xml with a reference refs/NAME_ref_rgb.exr and
+# its per-sample variance refs/NAME_ref_rgb_var.exr: render with -D integrator=INTEGRATOR at
+# spp = 2e6 / pixels, seed 0, and judge with `pathlab compare --z-test` (a z-test per pixel and
+# channel in XYZ, Sidak-corrected alpha 0.01, pass when 99.75% of the pixel-channels pass).
+# One line per scene, then a summary; the renders are kept in OUT (default: a temporary folder).
+#
+# Usage: scripts/mitsuba-suite.sh DIR [OUT] [-- extra pathlab options, e.g. --threads 2]
+set -u
+if [ $# -lt 1 ] || [ ! -d "$1/tests/scenes" ]; then
+    echo "usage: $0 MITSUBA_DATA_DIR [OUT] [-- pathlab options]  (MITSUBA_DATA_DIR/tests/scenes must exist)" >&2
+    exit 2
+fi
+data=$(cd "$1" && pwd)
+shift
+out=""
+if [ $# -gt 0 ] && [ "$1" != "--" ]; then out=$1; shift; fi
+[ $# -gt 0 ] && [ "$1" = "--" ] && shift
+here=$(cd "$(dirname "$0")/.." && pwd)
+pathlab=${PATHLAB:-$here/build/pathlab}
+[ -x "$pathlab" ] || { echo "$0: $pathlab is not built (make, or set PATHLAB)" >&2; exit 2; }
+[ -n "$out" ] || out=$(mktemp -d)
+mkdir -p "$out"
+
+pass=0 fail=0 broken=0 skipped=0
+printf '%-58s %-14s %s\n' "scene" "result" "detail"
+for scene in "$data"/tests/scenes/*/*.xml; do
+    folder=$(dirname "$scene")
+    name=$(basename "$scene" .xml)
+    integrator=${name##*_}
+    base=${name%_*}
+    ref=$folder/refs/${base}_ref_rgb.exr
+    var=$folder/refs/${base}_ref_rgb_var.exr
+    label=$(basename "$folder")/$name
+    if [ ! -f "$ref" ] || [ ! -f "$var" ]; then
+        printf '%-58s %-14s %s\n' "$label" "SKIP" "no refs/${base}_ref_rgb.exr with its _var"
+        skipped=$((skipped + 1))
+        continue
+    fi
+    size=$("$pathlab" info "$ref" | head -1 | sed -n 's/.*: \([0-9]*\)x\([0-9]*\) .*/\1 \2/p')
+    read -r w h <<<"$size"
+    spp=$((2000000 / (w * h)))
+    img=$out/$(basename "$folder")-$name.exr
+    start=$(date +%s.%N)
+    if ! err=$("$pathlab" "$scene" -D "integrator=$integrator" --spp "$spp" --seed 0 -q -o "$img" "$@" 2>&1 >/dev/null); then
+        printf '%-58s %-14s %s\n' "$label" "CANNOT RENDER" "$(printf '%s' "$err" | grep -m1 -i 'error' | sed "s|$data/||g")"
+        broken=$((broken + 1))
+        continue
+    fi
+    seconds=$(echo "$(date +%s.%N) - $start" | bc)
+    verdict=$("$pathlab" compare "$img" "$ref" --z-test "$var" --spp "$spp" 2>&1)
+    status=$?
+    detail=$(printf '%s' "$verdict" | sed -n 's/^\(PASS\|FAIL\): \([0-9.]*%\) of .*; mean of A - B in XYZ \([-+0-9.]*%\) of B.*/\2 pass, mean \3/p')
+    [ -n "$detail" ] || detail=$(printf '%s' "$verdict" | head -1)
+    detail="$detail, $spp spp, $(printf '%.1f' "$seconds") s"
+    if [ $status -eq 0 ]; then
+        printf '%-58s %-14s %s\n' "$label" "PASS" "$detail"
+        pass=$((pass + 1))
+    else
+        printf '%-58s %-14s %s\n' "$label" "FAIL" "$detail"
+        fail=$((fail + 1))
+    fi
+done
+echo "summary: $pass pass, $fail fail, $broken cannot render, $skipped skipped (renders in $out)"
+[ $fail -eq 0 ] && [ $broken -eq 0 ]

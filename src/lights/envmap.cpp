@@ -16,23 +16,31 @@ float row_max_sin_theta(int y, int height) {
     return float(std::max(std::sin(t0 * M_PI), std::sin(t1 * M_PI)));
 }
 
+// The bilinear lookup at image coordinates (s, t) = (u W - 1/2, v (H - 1)) of values fetch(x, y):
+// texel-centred in u, wrapping around; corner-aligned in v (row y at v = y / (H - 1)), as
+// Mitsuba 3's envmap.cpp (eval_spectrum) looks it up. Shared by the lookup (colours) and the
+// sampling bound (luminances).
+template <typename Fetch>
+auto bilinear_at(float s, float t, int width, int height, Fetch&& fetch) {
+    const float fs = std::floor(s);
+    const int y0 = std::min(int(t), std::max(height - 2, 0)), y1 = std::min(y0 + 1, height - 1);
+    const float wx = s - fs, wy = t - float(y0);
+    // u in [0, 1): fs in [-1, W - 1]; other u wrap by a modulo.
+    int x0 = int(fs);
+    if (x0 < 0 || x0 >= width) x0 = ((x0 % width) + width) % width;
+    const int x1 = x0 + 1 == width ? 0 : x0 + 1;
+    return (fetch(x0, y0) * (1 - wx) + fetch(x1, y0) * wx) * (1 - wy) + (fetch(x0, y1) * (1 - wx) + fetch(x1, y1) * wx) * wy;
+}
+
 }  // namespace
 
 EnvMap::EnvMap(int width, int height, std::vector<Rgb> texels, const Frame& to_world)
     : width_(width), height_(height), texels_(std::move(texels)), frame_(to_world) {
-    // Luminance with the lookup's boundary rules: u wraps, v is held at the first and last rows.
     std::vector<float> lum(texels_.size());
     for (size_t i = 0; i < texels_.size(); ++i) lum[i] = luminance(texels_[i]);
-    const auto L = [&](int x, int y) {
-        x = (x % width_ + width_) % width_;
-        y = std::clamp(y, 0, height_ - 1);
-        return lum[size_t(y) * size_t(width_) + size_t(x)];
-    };
-    // The lookup's luminance at image coordinates (s, t) (lookup() below: s = u W - 1/2, t = v (H - 1)).
+    // The lookup's luminance at image coordinates (s, t) (t within [0, H - 1]).
     const auto bilinear = [&](float s, float t) {
-        const int x0 = int(std::floor(s)), y0 = std::min(int(std::floor(t)), height_ - 1);
-        const float wx = s - float(x0), wy = t - float(y0);
-        return (L(x0, y0) * (1 - wx) + L(x0 + 1, y0) * wx) * (1 - wy) + (L(x0, y0 + 1) * (1 - wx) + L(x0 + 1, y0 + 1) * wx) * wy;
+        return bilinear_at(s, t, width_, height_, [&](int x, int y) { return lum[size_t(y) * size_t(width_) + size_t(x)]; });
     };
     std::vector<float> f(texels_.size());
     double mean = 0;
@@ -60,18 +68,8 @@ EnvMap::EnvMap(int width, int height, std::vector<Rgb> texels, const Frame& to_w
 }
 
 Rgb EnvMap::lookup(Vec2f uv) const {
-    // Texel-centred in u (column x at u = (x + 1/2) / W), corner-aligned in v (row y at
-    // v = y / (H - 1): the first row at the zenith, the last at the nadir), as Mitsuba 3's
-    // envmap.cpp (eval_spectrum) looks it up.
-    const float s = uv.x * float(width_) - 0.5f, t = std::clamp(uv.y, 0.0f, 1.0f) * float(height_ - 1);
-    const float fs = std::floor(s);
-    const int y0 = std::min(int(t), std::max(height_ - 2, 0)), y1 = std::min(y0 + 1, height_ - 1);
-    const float wx = s - fs, wy = t - float(y0);
-    // u in [0, 1): fs in [-1, W - 1]; other u wrap by a modulo.
-    int x0 = int(fs);
-    if (x0 < 0 || x0 >= width_) x0 = ((x0 % width_) + width_) % width_;
-    const int x1 = x0 + 1 == width_ ? 0 : x0 + 1;
-    return (texel(x0, y0) * (1 - wx) + texel(x1, y0) * wx) * (1 - wy) + (texel(x0, y1) * (1 - wx) + texel(x1, y1) * wx) * wy;
+    return bilinear_at(uv.x * float(width_) - 0.5f, std::clamp(uv.y, 0.0f, 1.0f) * float(height_ - 1), width_, height_,
+                       [&](int x, int y) { return texel(x, y); });
 }
 
 Vec3f EnvMap::uv_to_direction(Vec2f uv) {

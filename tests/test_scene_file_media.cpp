@@ -160,9 +160,10 @@ TEST_F(SceneFileMedia, MistakesAreNamedWithTheirLine) {
     has(error(R"(<medium type="heterogeneous"><volume type="gridvolume" name="sigma_t"/></medium>)"), "needs <string name=\"filename\"");
     has(error(R"(<medium type="heterogeneous"><volume type="gridvolume" name="sigma_t"><string name="filename" value="g.vol"/>
                  <boolean name="use_grid_bbox" value="true"/></volume></medium>)"), "use_grid_bbox = true is not supported");
-    // Mitsuba's volumes all take a to_world; a constant's changes nothing (accepted, no error).
-    EXPECT_NO_THROW(load(R"(<medium type="heterogeneous"><volume type="constvolume" name="sigma_t"><rgb name="value" value="0.5"/>
-                 <transform name="to_world"><translate x="1"/></transform></volume></medium><shape type="sphere"/>)"));
+    // A constvolume's to_world bounds the medium in Mitsuba 3: refused, not ignored.
+    has(error(R"(<medium type="heterogeneous"><volume type="constvolume" name="sigma_t"><rgb name="value" value="0.5"/>
+                 <transform name="to_world"><translate x="1"/></transform></volume></medium><shape type="sphere"/>)"),
+        "a constvolume's to_world (which bounds the medium to the placed unit cube in Mitsuba 3) is not supported");
     has(error(R"(<medium type="heterogeneous"><rgb name="sigma_t" value="1"/>
                  <volume type="constvolume" name="sigma_t"/></medium>)"), "sigma_t is given twice");
     has(error(R"(<shape type="cube"><bsdf type="null"/><emitter type="area"/></shape>)"), "cannot emit");

@@ -43,7 +43,8 @@ struct Volume {
 inline const PluginInfo& constvolume_plugin() {
     static const PluginInfo info{"volume", "constvolume", "the same value everywhere",
                                  {{"value", ParamType::Rgb, "1", "the value (a float or an RGB triple)"},
-                                  {"to_world", ParamType::Transform, "", "accepted (Mitsuba's volumes all take one): a constant is the same wherever it is placed"}}};
+                                  {"to_world", ParamType::Transform, "",
+                                   "refused: in Mitsuba 3 it bounds a heterogeneous medium to the placed unit cube, which pathlab does not do"}}};
     return info;
 }
 inline const PluginInfo& gridvolume_plugin() {

@@ -16,7 +16,7 @@ public:
         if (!scene.intersect(ray, hit)) return scene.escaped_radiance();
         const Rgb Le = emitted_radiance(scene, hit, -ray.d);
         const ShadingPoint sp = make_shading_point(scene, hit, ray.d);
-        const LightChoice choice = scene.choose_light(sampler.next1d());
+        const LightChoice choice = scene.choose_light(sp.p, sp.frame.n, sampler.next1d());
         const auto ls = sample_light(scene.lights()[size_t(choice.index)], sp.p, sampler.next2d());
         if (sp.material->is_black() || !ls || dot(ls->wi, sp.ng) <= 0) return Le;
         const Ray shadow = std::isinf(ls->distance) ? spawn_ray(sp.p, sp.ng, ls->wi)

@@ -137,7 +137,7 @@ public:
     }
     // Light sampling's density of the light end (x_k).
     float light_origin(const FullPath& f) const {
-        const float pmf = scene_->light_pmf(f.light_index);
+        const float pmf = scene_->emitter_pmf(f.light_index);
         if (kind_ == LightKind::Point) return pmf;
         if (kind_ == LightKind::Environment) return pmf / (4 * kPi);
         return pmf / std::get<TriangleLight>(scene_->lights()[size_t(f.light_index)]).area;

@@ -69,7 +69,7 @@ public:
             pdf = (1 - pd) * power_cosine_pdf(dot(PhongMaterial::mirror(sp.wi), wo), m.exponent);
         }
         if (wo.z <= 0 || !(pdf > 0)) return L;
-        const EmitterHit e = trace_to_emitter(scene, sp.spawn(wo), sp.p);
+        const EmitterHit e = trace_to_emitter(scene, sp.spawn(wo), sp.p, sp.frame.n);
         return L + m.eval(sp.wi, wo) * e.Le * (wo.z / pdf);
     }
 };

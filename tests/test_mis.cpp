@@ -11,8 +11,10 @@ namespace {
 // From shading points seen by the camera, sample lights; for each sampled direction compute
 // the light-sampling density twice (as light sampling reports it, and as the BSDF-sampled
 // half finds it by tracing the direction) and check the two weights sum to 1.
-void check_weights(int scene_index) {
-    const auto scene = Scene::build(make_builtin_scene(scene_index));
+void check_weights(int scene_index, LightSamplerKind lights = LightSamplerKind::Power) {
+    SceneDescription d = make_builtin_scene(scene_index);
+    d.light_sampler = lights;
+    const auto scene = Scene::build(d);
     const PerspectiveCamera cam(scene->camera(), 64, 64);
     Sampler rng(21, 0, 0);
     int checked = 0;
@@ -23,11 +25,11 @@ void check_weights(int scene_index) {
         if (!scene->intersect(ray, hit)) continue;
         const ShadingPoint sp = make_shading_point(*scene, hit, ray.d);
         if (sp.material->is_black()) continue;
-        const LightChoice choice = scene->choose_light(rng.next1d());
+        const LightChoice choice = scene->choose_light(sp.p, sp.frame.n, rng.next1d());
         const auto ls = sample_light(scene->lights()[size_t(choice.index)], sp.p, rng.next2d());
         if (!ls || ls->delta || dot(ls->wi, sp.ng) <= 0) continue;
         const Ray probe = sp.spawn(sp.frame.to_local(ls->wi));
-        const EmitterHit found = trace_to_emitter(*scene, probe, sp.p);
+        const EmitterHit found = trace_to_emitter(*scene, probe, sp.p, sp.frame.n);
         if (is_black(found.Le)) continue;  // occluded: this direction finds another surface
         const float p_light = choice.pmf * ls->pdfW;
         ASSERT_NEAR(found.pdf_light, p_light, 1e-3f * p_light) << "scene " << scene_index << " sample " << i;
@@ -42,6 +44,11 @@ void check_weights(int scene_index) {
 TEST(Mis, WeightsOfBothStrategiesSumToOneWithTheCeilingLight) { check_weights(3); }
 TEST(Mis, WeightsOfBothStrategiesSumToOneWithTheLightBox) { check_weights(5); }
 TEST(Mis, WeightsOfBothStrategiesSumToOneWithTheEnvironment) { check_weights(7); }
+// The same with the light BVH, whose probabilities depend on the shading point and its normal.
+TEST(Mis, WeightsSumToOneWithTheLightBvh) {
+    check_weights(3, LightSamplerKind::Bvh);
+    check_weights(5, LightSamplerKind::Bvh);
+}
 
 }  // namespace
 }  // namespace pathlab::test

@@ -98,6 +98,10 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
                                  "Longest path in bounces (-1: unlimited; default: the scene file's, else -1)");
     app.add_option_function<int>("--rr-depth", [&o](const int& v) { o.rr_depth = v, o.rr_depth_given = true; },
                                  "Bounces before Russian roulette starts (default: the scene file's, else 3)");
+    app.add_option("--light-sampler", o.light_sampler,
+                   "How next-event estimation chooses a light: uniform, power (default: in proportion to power) or bvh (a "
+                   "light tree, by each light's bound at the shading point: for many lights); for the integrators that "
+                   "sample lights at their shading points (pathlab algorithms)");
     app.add_option("--mis", o.mis, "bdpt, vcm, bpm: the MIS heuristic, balance or power")->capture_default_str();
     app.add_option("--strategies", o.strategies_dir,
                    "bdpt: also write one image per strategy (s, t), weighted and unweighted, and montages, into this directory "
@@ -167,6 +171,11 @@ std::vector<RenderJob> make_jobs(const RenderCommandOptions& o, bool check_paths
     if (o.mis != "balance" && o.mis != "power")
         throw UsageError(fmt::format("unknown MIS heuristic '{}'. Valid heuristics: balance, power", o.mis));
     request.mis_power = o.mis == "power";
+    if (o.light_sampler) {
+        request.light_sampler = parse_light_sampler(*o.light_sampler);
+        if (!request.light_sampler)
+            throw UsageError(fmt::format("unknown light sampler '{}'. Valid light samplers: {}", *o.light_sampler, kLightSamplerNames));
+    }
     request.strategies_depth = o.strategies_depth;
     request.photons = o.photons;
     request.photon_radius = o.photon_radius;

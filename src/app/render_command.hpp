@@ -33,6 +33,7 @@ struct RenderCommandOptions {
     bool quiet = false;
     bool spectral = false;
     std::string mis = "balance";
+    std::optional<std::string> light_sampler;
     std::string strategies_dir;
     int strategies_depth = 4;
     std::optional<int64_t> photons;

@@ -67,7 +67,7 @@ public:
             const VertexBsdf* v = vb ? &*vb : nullptr;
 
             // Next-event estimation, as estimate_light_sample(mis = true).
-            const LightChoice choice = scene_.choose_light(sampler.next1d());
+            const LightChoice choice = scene_.choose_light(sp.p, sp.frame.n, sampler.next1d());
             const Vec2f u = sampler.next2d();
             if (choice.index >= 0) {
                 const Light& light = scene_.lights()[size_t(choice.index)];
@@ -95,7 +95,7 @@ public:
             const auto s = sp.material->sample(sp, sp.wi, sampler.next2d());
             EmitterHit found;
             if (s) {
-                found = trace_to_emitter(scene_, sp.spawn(s->wo), sp.p);
+                found = trace_to_emitter(scene_, sp.spawn(s->wo), sp.p, sp.frame.n);
                 if (!is_black(found.Le)) {
                     const float weight = s->delta ? 1.0f : balance_heuristic(s->pdfW, found.pdf_light);
                     const float k = std::abs(s->wo.z) * weight / s->pdfW;

@@ -87,6 +87,8 @@ struct IntegratorOptions {
     // Spectral mode (docs/spectral.md): paths carry 4 sampled wavelengths instead of RGB, the
     // integrator's SpectralTransport instantiation (common/transport.hpp; make_for_transport).
     bool spectral = false;
+    // How next-event estimation chooses a light (--light-sampler); the scene is built with it.
+    LightSamplerKind light_sampler = LightSamplerKind::Power;
 };
 
 // What every pass of one render sees; fixed for the whole render.
@@ -184,9 +186,18 @@ struct IntegratorInfo {
     // Renders participating media (a scene whose shapes or camera refer to a <medium>); the
     // others refuse such a scene (RenderJob), rather than render it as if the media were not there.
     bool media = false;
+    // Chooses a light at each shading point for next-event estimation, so --light-sampler applies
+    // (light paths start on a light chosen by power, whatever it says).
+    bool samples_lights = false;
 
     PluginInfo plugin() const;
 };
+
+// `info` with samples_lights set (for the integrators declared as one aggregate).
+inline IntegratorInfo sampling_lights(IntegratorInfo info) {
+    info.samples_lights = true;
+    return info;
+}
 
 // IntegratorInfo::make of an integrator written once (a class template over the transport, whose
 // constructor takes the options first): its instantiation for the transport the options ask for.
@@ -204,5 +215,7 @@ std::string integrator_names();
 std::string spectral_integrator_names();
 // ... and those that render participating media.
 std::string media_integrator_names();
+// ... and those that choose lights for next-event estimation (--light-sampler).
+std::string light_sampling_integrator_names();
 
 }  // namespace pathlab

@@ -53,4 +53,6 @@ std::string spectral_integrator_names() { return names_of_integrators_with(&Inte
 
 std::string media_integrator_names() { return names_of_integrators_with(&IntegratorInfo::media); }
 
+std::string light_sampling_integrator_names() { return names_of_integrators_with(&IntegratorInfo::samples_lights); }
+
 }  // namespace pathlab

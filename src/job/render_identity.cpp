@@ -65,7 +65,8 @@ std::string options_text(const IntegratorOptions& o) {
                        o.max_depth, o.rr_depth, o.only_length, o.mis_power ? "power" : "balance", o.photons, hex_float(o.photon_radius),
                        hex_float(o.photon_alpha), int(o.vcm_merging), int(o.vcm_connections), o.ic_rays, hex_float(o.ic_error),
                        int(o.ic_gradients)) +
-           (o.spectral ? " mode=spectral" : "") + (o.volume_beam ? "" : " volume=points");  // the text of the defaults as it always was
+           (o.spectral ? " mode=spectral" : "") + (o.volume_beam ? "" : " volume=points") +
+           (o.light_sampler == LightSamplerKind::Power ? "" : fmt::format(" lights={}", light_sampler_name(o.light_sampler)));  // the text of the defaults as it always was
 }
 
 std::string metadata_key(const std::string& field) {

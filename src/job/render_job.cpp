@@ -120,6 +120,11 @@ RenderJob::RenderJob(SceneChoice scene, const JobRequest& r) : choice_(std::move
     options_.pbgi_direct_samples = r.pbgi_direct_samples ? *r.pbgi_direct_samples : d.pbgi_direct_samples.value_or(options_.pbgi_direct_samples);
     options_.pbgi_spacing = r.pbgi_spacing ? *r.pbgi_spacing : d.pbgi_spacing.value_or(options_.pbgi_spacing);
     options_.hide_emitters = d.hide_emitters.value_or(false);
+    if (r.light_sampler && !info_->samples_lights)
+        throw UsageError(fmt::format("{} does not choose lights at its shading points (its light paths start on a light chosen "
+                                     "by power), so --light-sampler does not apply to it; the integrators it applies to: {}",
+                                     info_->name, light_sampling_integrator_names()));
+    options_.light_sampler = r.light_sampler.value_or(LightSamplerKind::Power);
     options_.spectral = r.spectral || d.spectral;
     if (options_.spectral && !info_->spectral)
         throw UsageError(fmt::format("{} does not render in spectral mode yet (--spectral, or the scene file's <default name=\"mode\" "
@@ -177,6 +182,7 @@ void check_spectral_materials(const SceneDescription& d) {
 const Scene& RenderJob::scene() {
     if (!scene_) {
         if (options_.spectral) check_spectral_materials(choice_.description);
+        choice_.description.light_sampler = options_.light_sampler;
         scene_ = Scene::build(choice_.description);
     }
     return *scene_;

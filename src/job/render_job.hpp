@@ -14,6 +14,7 @@
 
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -52,6 +53,7 @@ struct JobRequest {
     std::optional<int> pbgi_resolution;       // --pbgi-resolution (pbgi)
     std::optional<int> pbgi_direct_samples;   // --pbgi-direct-samples (pbgi)
     std::optional<int> pbgi_spacing;          // --pbgi-spacing (pbgi)
+    std::optional<LightSamplerKind> light_sampler;  // --light-sampler (next-event estimation; default power)
 };
 
 // The integrator `name` (or an alias); a UsageError listing them all otherwise.
@@ -70,9 +72,11 @@ public:
     RenderJob(SceneChoice scene, const JobRequest& request);
     RenderJob(int builtin_scene, const JobRequest& request) : RenderJob(builtin_scene_choice(builtin_scene), request) {}
     // With a scene already built from scene.description (shared between jobs, as the
-    // benchmarks do to build each BVH once).
+    // benchmarks do to build each BVH once), with the request's light sampler.
     RenderJob(SceneChoice scene, const JobRequest& request, std::shared_ptr<const Scene> built)
         : RenderJob(std::move(scene), request) {
+        if (built->light_sampler().kind() != options_.light_sampler)
+            throw std::invalid_argument("RenderJob: the shared scene was built with another light sampler");
         scene_ = std::move(built);
     }
 

@@ -1,5 +1,5 @@
-// A renderable scene: geometry in Embree, materials, lights with a power-proportional light
-// selection distribution, and the camera. Built once from a SceneDescription; immutable and
+// A renderable scene: geometry in Embree, materials, lights with their selection distributions
+// (next-event estimation's light sampler, light paths' power table), and the camera. Built once from a SceneDescription; immutable and
 // shared by all render threads afterwards.
 #pragma once
 
@@ -10,6 +10,7 @@
 
 #include "geometry/accel.hpp"
 #include "lights/light_distribution.hpp"
+#include "lights/light_sampler.hpp"
 #include "scene/scene_description.hpp"
 
 namespace pathlab {
@@ -98,9 +99,14 @@ public:
     // The environment light (constant or envmap), or -1.
     int environment_light() const { return environment_; }
 
-    // Chooses a light with probability proportional to its power (uniformly if all are 0).
-    LightChoice choose_light(float u) const { return light_distribution_.choose(u); }
-    float light_pmf(int index) const { return light_distribution_.pmf(index); }
+    // Next-event estimation's choice of a light for the point p with normal n (n = 0 in a
+    // medium), by the description's light_sampler, and the probability of choosing light i there.
+    LightChoice choose_light(const Vec3f& p, const Vec3f& n, float u) const { return light_sampler_.choose(p, n, u); }
+    float light_pmf(const Vec3f& p, const Vec3f& n, int index) const { return light_sampler_.pmf(p, n, index); }
+    const LightSampler& light_sampler() const { return light_sampler_; }
+    // Light paths' choice of the light they start on: in proportion to power (uniformly if all are 0).
+    LightChoice choose_emitter(float u) const { return light_distribution_.choose(u); }
+    float emitter_pmf(int index) const { return light_distribution_.pmf(index); }
     // The bounding sphere that lights at infinity emit light paths through.
     SceneSphere scene_sphere() const { return {center_, radius_}; }
 
@@ -140,6 +146,7 @@ private:
     std::vector<Light> lights_;
     std::vector<std::shared_ptr<const EmissionSpectrum>> light_spectra_;  // by light; empty when no emitter has one
     LightDistribution light_distribution_;
+    LightSampler light_sampler_;
     int environment_ = -1;
     bool has_media_ = false;
     std::vector<char> sealed_;          // by medium: no index-matched boundary (media_separated)

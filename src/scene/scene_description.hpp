@@ -11,6 +11,7 @@
 #include "cameras/camera.hpp"
 #include "core/reconstruction_filter.hpp"
 #include "geometry/shape.hpp"
+#include "lights/light_sampler.hpp"
 #include "lights/registry.hpp"
 #include "media/medium.hpp"
 #include "spectral/emission_spectrum.hpp"
@@ -59,6 +60,8 @@ struct SceneDescription {
     std::optional<float> ic_error;
     std::optional<bool> ic_gradients, ic_clamp_screen, ic_clamp_neighbours;
     bool spectral = false;                        // <default name="mode" value="spectral"/>: spectral mode
+    // How next-event estimation chooses a light (--light-sampler; not a scene-file setting).
+    LightSamplerKind light_sampler = LightSamplerKind::Power;
     std::optional<bool> hide_emitters;            // paths of no bounce (emitters seen directly) left out
     // The film: its reconstruction filter, the format of the default output (hdrfilm's
     // file_format: "openexr", "rgbe" or "pfm"), and extra outputs an integrator asks for

@@ -395,7 +395,7 @@ StrategyResult<T> Bdpt<T>::connect(const RenderContext& ctx, SubpathView light, 
         r.raster = k->raster;
     } else if (s == 1) {
         if (!pt.connectible()) return r;
-        const LightChoice choice = scene.choose_light(sampler.next1d());
+        const LightChoice choice = scene.choose_emitter(sampler.next1d());
         const Vec2f u = sampler.next2d();
         if (choice.index < 0) return r;
         const Light& l = scene.lights()[size_t(choice.index)];

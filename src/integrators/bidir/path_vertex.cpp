@@ -69,10 +69,10 @@ float pdf_light_origin(const Scene& scene, const PathVertexBase& v, const PathVe
     const Light& light = scene.lights()[size_t(v.light)];
     if (v.infinite) {
         // Light sampling picks directions at infinity: only the environment has a density.
-        return is_environment(light) ? scene.light_pmf(v.light) * environment_pdf_li(light, v.dir) : 0.0f;
+        return is_environment(light) ? scene.emitter_pmf(v.light) * environment_pdf_li(light, v.dir) : 0.0f;
     }
     const Vec3f w = normalize(from.p - v.p);
-    return scene.light_pmf(v.light) * pdf_emission(light, v.p, v.emitter_n, w, scene.scene_sphere()).pdfA;
+    return scene.emitter_pmf(v.light) * pdf_emission(light, v.p, v.emitter_n, w, scene.scene_sphere()).pdfA;
 }
 
 }  // namespace pathlab

@@ -181,9 +181,9 @@ std::vector<ParamInfo> ic_params() {
 }  // namespace
 
 const IntegratorInfo& ic_integrator() {
-    static const IntegratorInfo info{"ic", {"irrcache"}, "irradiance caching with gradients (Ward): cached indirect diffuse light at first hits, pt-mis elsewhere",
+    static const IntegratorInfo info = sampling_lights(IntegratorInfo{"ic", {"irrcache"}, "irradiance caching with gradients (Ward): cached indirect diffuse light at first hits, pt-mis elsewhere",
                                      false, true, ic_params(), [](const IntegratorOptions& o) { return make_for_transport<IrradianceCaching>(o); },
-                                     false, true};
+                                     false, true});
     return info;
 }
 

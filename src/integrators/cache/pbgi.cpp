@@ -174,9 +174,9 @@ std::vector<ParamInfo> pbgi_params() {
 }  // namespace
 
 const IntegratorInfo& pbgi_integrator() {
-    static const IntegratorInfo info{"pbgi", {}, "point-based global illumination (Christensen): indirect diffuse light at first hits gathered from a surfel octree, pt-mis elsewhere",
+    static const IntegratorInfo info = sampling_lights(IntegratorInfo{"pbgi", {}, "point-based global illumination (Christensen): indirect diffuse light at first hits gathered from a surfel octree, pt-mis elsewhere",
                                      false, true, pbgi_params(), [](const IntegratorOptions& o) { return make_for_transport<PointBasedGi>(o); },
-                                     /*any_camera=*/false, /*any_filter=*/true};
+                                     /*any_camera=*/false, /*any_filter=*/true});
     return info;
 }
 

@@ -12,15 +12,15 @@
 
 namespace pathlab {
 
-// One light chosen with probability proportional to power, one point or direction sampled on
-// it, one shadow ray. Returns f * Le * cos(theta) / (pmf * pdfW) in the path's colour (wl:
+// One light chosen by the scene's light sampler (Scene::choose_light), one point or direction
+// sampled on it, one shadow ray. Returns f * Le * cos(theta) / (pmf * pdfW) in the path's colour (wl:
 // transport.hpp). With `mis`, the result is weighted by the balance heuristic against BSDF
 // sampling of the same direction (both densities in solid angle, the light's including its
 // selection probability); delta lights cannot be found by BSDF sampling and keep weight 1.
 template <class Wl>
 ColourAt<Wl> estimate_light_sample(const Scene& scene, const ShadingPoint& sp, Sampler& sampler, bool mis, Wl& wl) {
     using Colour = ColourAt<Wl>;
-    const LightChoice choice = scene.choose_light(sampler.next1d());
+    const LightChoice choice = scene.choose_light(sp.p, sp.frame.n, sampler.next1d());
     const Vec2f u = sampler.next2d();
     if (choice.index < 0) return Colour(0.0f);
     const auto ls = sample_light(scene.lights()[size_t(choice.index)], sp.p, u);
@@ -68,8 +68,8 @@ std::optional<ShadingPoint> first_surface(const Scene& scene, const Ray& ray, bo
 
 // What a ray leaving a shading point finds: the surface it hits (if any), the radiance emitted
 // towards the shading point (a front-facing area light, or the environment if the ray
-// escapes), and the solid-angle density with which light sampling from `from` would have
-// produced this direction, including the light's selection probability. The BSDF-sampled
+// escapes), and the solid-angle density with which light sampling at `from` (a surface with
+// normal n) would have produced this direction, including the light's selection probability. The BSDF-sampled
 // half of MIS weighs its emission with this density.
 struct EmitterHit {
     bool hit = false;
@@ -78,21 +78,21 @@ struct EmitterHit {
     float pdf_light = 0;
 };
 
-inline EmitterHit trace_to_emitter(const Scene& scene, const Ray& ray, const Vec3f& from) {
+inline EmitterHit trace_to_emitter(const Scene& scene, const Ray& ray, const Vec3f& from, const Vec3f& n) {
     EmitterHit e;
     e.hit = scene.intersect(ray, e.isect);
     if (!e.hit) {
         const int env = scene.environment_light();
         if (env >= 0) {
             e.Le = scene.escaped_radiance(ray.d);
-            e.pdf_light = scene.light_pmf(env) * environment_pdf_li(scene.lights()[size_t(env)], ray.d);
+            e.pdf_light = scene.light_pmf(from, n, env) * environment_pdf_li(scene.lights()[size_t(env)], ray.d);
         }
         return e;
     }
     e.Le = emitted_radiance(scene, e.isect, -ray.d / length(ray.d));
     if (!is_black(e.Le)) {
         const Light& light = scene.lights()[size_t(e.isect.light)];
-        e.pdf_light = scene.light_pmf(e.isect.light) * surface_light_pdf_li(light, from, e.isect.p, e.isect.ng);
+        e.pdf_light = scene.light_pmf(from, n, e.isect.light) * surface_light_pdf_li(light, from, e.isect.p, e.isect.ng);
     }
     return e;
 }
@@ -104,7 +104,7 @@ inline EmitterHit trace_to_emitter(const Scene& scene, const Ray& ray, const Vec
 template <class Wl>
 ColourAt<Wl> estimate_bsdf_sample_mis(const Scene& scene, const ShadingPoint& sp, const BsdfSample& s, const ColourAt<Wl>& f,
                                       EmitterHit& found, const Wl& wl) {
-    found = trace_to_emitter(scene, sp.spawn(s.wo), sp.p);
+    found = trace_to_emitter(scene, sp.spawn(s.wo), sp.p, sp.frame.n);
     if (is_black(found.Le)) return ColourAt<Wl>(0.0f);
     const float weight = s.delta ? 1.0f : balance_heuristic(s.pdfW, found.pdf_light);
     const int light = found.hit ? found.isect.light : scene.environment_light();

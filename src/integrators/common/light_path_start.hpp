@@ -20,7 +20,7 @@ struct LightPathStart {
 // infinity would cross a medium that reaches infinity (it is all absorbed on its way, as
 // volpath's escaped rays find).
 inline std::optional<LightPathStart> start_light_path(const Scene& scene, Sampler& sampler) {
-    const LightChoice choice = scene.choose_light(sampler.next1d());
+    const LightChoice choice = scene.choose_emitter(sampler.next1d());
     const Vec2f u_pos = sampler.next2d(), u_dir = sampler.next2d();
     if (choice.index < 0) return std::nullopt;
     const Light& light = scene.lights()[size_t(choice.index)];

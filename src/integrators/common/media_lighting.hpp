@@ -26,7 +26,7 @@ template <class T>
 ColourOf<T> estimate_light(const Scene& scene, const ScatterVertex& v, Sampler& sampler, MediumState<T>& st, bool mis,
                            WavelengthsOf<T>& wl) {
     using Colour = ColourOf<T>;
-    const LightChoice choice = scene.choose_light(sampler.next1d());
+    const LightChoice choice = scene.choose_light(v.p, v.sp ? v.sp->frame.n : Vec3f(0.0f), sampler.next1d());
     const Vec2f u = sampler.next2d();
     if (choice.index < 0) return Colour(0.0f);
     const auto ls = sample_light(scene.lights()[size_t(choice.index)], v.p, u);
@@ -70,7 +70,7 @@ ColourOf<T> estimate_light(const Scene& scene, const ScatterVertex& v, Sampler& 
 // The radiance a walk that ended on a surface or in the sky finds (Le towards the path, in RGB),
 // the density with which light sampling at `from` would have chosen it (trace_to_emitter's), and
 // the light it belongs to.
-inline EmitterHit emission_found(const Scene& scene, const MediumWalk& w, const Vec3f& from, int& light) {
+inline EmitterHit emission_found(const Scene& scene, const MediumWalk& w, const Vec3f& from, const Vec3f& n, int& light) {
     EmitterHit e;
     light = -1;
     if (w.kind == MediumWalk::kEscaped) {
@@ -78,14 +78,14 @@ inline EmitterHit emission_found(const Scene& scene, const MediumWalk& w, const 
         if (env >= 0) {
             light = env;
             e.Le = scene.escaped_radiance(w.dir);
-            e.pdf_light = scene.light_pmf(env) * environment_pdf_li(scene.lights()[size_t(env)], w.dir);
+            e.pdf_light = scene.light_pmf(from, n, env) * environment_pdf_li(scene.lights()[size_t(env)], w.dir);
         }
     } else if (w.kind == MediumWalk::kSurface) {
         e.Le = emitted_radiance(scene, w.isect, -w.dir / length(w.dir));
         if (!is_black(e.Le)) {
             light = w.isect.light;
             const Light& l = scene.lights()[size_t(w.isect.light)];
-            e.pdf_light = scene.light_pmf(w.isect.light) * surface_light_pdf_li(l, from, w.isect.p, w.isect.ng);
+            e.pdf_light = scene.light_pmf(from, n, w.isect.light) * surface_light_pdf_li(l, from, w.isect.p, w.isect.ng);
         }
     }
     return e;
@@ -123,7 +123,7 @@ ScatterSample<T> sample_scatter(const Scene& scene, const ScatterVertex& v, Samp
         n.next = walk_media(scene, n.ray, n.medium, st, n.next_seg);
         const Colour f = bsdf_sample_colour(sp, *s, wl);
         n.weight = f * (std::abs(s->wo.z) / s->pdfW);
-        const EmitterHit e = emission_found(scene, n.next, sp.p, light);
+        const EmitterHit e = emission_found(scene, n.next, sp.p, sp.frame.n, light);
         const float weight = s->delta ? 1.0f : (mis ? balance_heuristic(s->pdfW, e.pdf_light) : 0.0f);
         if (!is_black(e.Le)) n.found = f * light_colour(scene, light, e.Le, wl) * (std::abs(s->wo.z) * weight / s->pdfW);
     } else {
@@ -133,7 +133,7 @@ ScatterSample<T> sample_scatter(const Scene& scene, const ScatterVertex& v, Samp
         n.ray = Ray{v.p, ps.wo, kInf};
         n.medium = v.medium;
         n.next = walk_media(scene, n.ray, n.medium, st, n.next_seg);
-        const EmitterHit e = emission_found(scene, n.next, v.p, light);
+        const EmitterHit e = emission_found(scene, n.next, v.p, Vec3f(0.0f), light);
         const float weight = mis ? balance_heuristic(ps.pdfW, e.pdf_light) : 0.0f;
         if (!is_black(e.Le)) n.found = Colour(ps.p) * light_colour(scene, light, e.Le, wl) * (weight / ps.pdfW);
         n.weight = Colour(ps.p / ps.pdfW);

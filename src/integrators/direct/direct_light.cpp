@@ -26,9 +26,9 @@ private:
 }  // namespace
 
 const IntegratorInfo& direct_light_integrator() {
-    static const IntegratorInfo info{"direct-light", {"1"}, "direct illumination by light sampling (one light chosen by power)",
+    static const IntegratorInfo info = sampling_lights(IntegratorInfo{"direct-light", {"1"}, "direct illumination by light sampling (one light chosen by power)",
                          false, true, {{"hide_emitters", ParamType::Boolean, "false", "emitters (and the environment) seen directly are black", "hideEmitters"}},
-                         [](const IntegratorOptions& o) { return make_for_transport<DirectLight>(o); }};
+                         [](const IntegratorOptions& o) { return make_for_transport<DirectLight>(o); }});
     return info;
 }
 

@@ -46,8 +46,8 @@ private:
 }  // namespace
 
 const IntegratorInfo& direct_mis_integrator() {
-    static const IntegratorInfo info{"direct-mis", {"3", "direct"}, "light + BRDF sampling combined by MIS (balance heuristic)",
-                         false, true, direct_params(), [](const IntegratorOptions& o) { return make_for_transport<DirectMis>(o); }};
+    static const IntegratorInfo info = sampling_lights(IntegratorInfo{"direct-mis", {"3", "direct"}, "light + BRDF sampling combined by MIS (balance heuristic)",
+                         false, true, direct_params(), [](const IntegratorOptions& o) { return make_for_transport<DirectMis>(o); }});
     return info;
 }
 

@@ -48,7 +48,7 @@ public:
             }
         }
         if (!(pdfW > 0) || is_black(f)) return L;
-        const EmitterHit e = trace_to_emitter(scene, sp.spawn(wo), sp.p);
+        const EmitterHit e = trace_to_emitter(scene, sp.spawn(wo), sp.p, sp.frame.n);
         if (is_black(e.Le)) return L;
         const int light = e.hit ? e.isect.light : scene.environment_light();
         return L + f * light_colour(scene, light, e.Le, wl) * (std::abs(wo.z) / pdfW);

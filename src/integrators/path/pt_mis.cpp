@@ -90,13 +90,13 @@ private:
 }  // namespace
 
 const IntegratorInfo& pt_mis3_integrator() {
-    static const IntegratorInfo info{"pt-mis3", {"4b"}, "path tracing, MIS direct lighting at every bounce + a third continuation ray",
-                                     false, true, path_params(), [](const IntegratorOptions& o) { return make_for_transport<PtMis>(o, true); }};
+    static const IntegratorInfo info = sampling_lights(IntegratorInfo{"pt-mis3", {"4b"}, "path tracing, MIS direct lighting at every bounce + a third continuation ray",
+                                     false, true, path_params(), [](const IntegratorOptions& o) { return make_for_transport<PtMis>(o, true); }});
     return info;
 }
 const IntegratorInfo& pt_mis_integrator() {
-    static const IntegratorInfo info{"pt-mis", {"4c", "path"}, "path tracing, MIS direct lighting whose BRDF ray continues the path",
-                                     false, true, path_params(), [](const IntegratorOptions& o) { return make_for_transport<PtMis>(o, false); }};
+    static const IntegratorInfo info = sampling_lights(IntegratorInfo{"pt-mis", {"4c", "path"}, "path tracing, MIS direct lighting whose BRDF ray continues the path",
+                                     false, true, path_params(), [](const IntegratorOptions& o) { return make_for_transport<PtMis>(o, false); }});
     return info;
 }
 

@@ -112,6 +112,7 @@ const IntegratorInfo& volpath_integrator() {
         IntegratorInfo i{"volpath", {"volpathmis"}, "volumetric path tracing: participating media, delta tracking, MIS",
                          false, true, path_params(), [](const IntegratorOptions& o) { return make_volpath(o); }};
         i.media = true;
+        i.samples_lights = true;
         return i;
     }();
     return info;

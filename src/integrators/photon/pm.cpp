@@ -342,6 +342,7 @@ const IntegratorInfo& pm_integrator() {
                          }(),
                          [](const IntegratorOptions& o) { return make_for_transport<PhotonMapper>(o); }};
         i.media = true;
+        i.samples_lights = true;
         return i;
     }();
     return info;

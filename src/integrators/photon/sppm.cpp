@@ -298,6 +298,7 @@ const IntegratorInfo& sppm_integrator() {
                          false, true, progressive_photon_params(), [](const IntegratorOptions& o) { return make_for_transport<Sppm>(o); },
                          false, false};
         i.media = true;
+        i.samples_lights = true;
         return i;
     }();
     return info;
@@ -310,6 +311,7 @@ const IntegratorInfo& ppm_integrator() {
                          [](const IntegratorOptions& o) { return make_for_transport<Sppm>(o, SppmFaults{}, CameraRays::PixelCentres); },
                          false, false};
         i.media = true;
+        i.samples_lights = true;
         return i;
     }();
     return info;

@@ -1,0 +1,70 @@
+// Choosing the light that next-event estimation samples at a point (--light-sampler):
+//   uniform  every light with the same probability
+//   power    in proportion to its power (light_distribution.hpp; light paths always start so)
+//   bvh      down a bounding volume hierarchy over the lights at finite positions, each step
+//            choosing a child in proportion to its importance at the point (light_bounds.hpp),
+//            as pbrt-v4 and Cycles do; the lights at infinity (environment, directional) beside
+//            the tree with a fixed share n_inf / (n_inf + 1), uniformly among them
+// pmf(p, n, i) is the probability with which choose(p, n, u) returns light i: the BSDF-sampled
+// half of MIS weighs an emitter it hits with it (for bvh, the same arithmetic along the light's
+// path in the tree).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "lights/light_bounds.hpp"
+#include "lights/light_distribution.hpp"
+
+namespace pathlab {
+
+enum class LightSamplerKind { Uniform, Power, Bvh };
+
+const char* light_sampler_name(LightSamplerKind kind);
+std::optional<LightSamplerKind> parse_light_sampler(const std::string& name);
+inline constexpr const char* kLightSamplerNames = "uniform, power, bvh";
+
+class LightSampler {
+public:
+    LightSampler() = default;
+    LightSampler(const std::vector<Light>& lights, const SceneSphere& sphere, LightSamplerKind kind);
+
+    LightSamplerKind kind() const { return kind_; }
+    // A light for the point p with normal n (n = 0 in a medium), and its probability.
+    LightChoice choose(const Vec3f& p, const Vec3f& n, float u) const;
+    float pmf(const Vec3f& p, const Vec3f& n, int light) const;
+
+    // The tree's size (bvh): nodes and bytes.
+    size_t nodes() const { return nodes_.size(); }
+    size_t bytes() const { return nodes_.size() * sizeof(Node) + trails_.size() * sizeof(Trail) + infinite_.size() * sizeof(int); }
+
+private:
+    struct Node {
+        LightBounds bounds;
+        int32_t right = -1;  // interior: the second child (the first follows the node)
+        int32_t light = -1;  // leaf: the light
+    };
+    struct Trail {  // a light's leaf: the choices (bit k: right at depth k) that lead to it
+        uint64_t bits = 0;
+        int32_t depth = -1;  // -1: not in the tree
+    };
+    struct Item {
+        LightBounds bounds;
+        int light;
+    };
+    int build(std::vector<Item>& items, size_t begin, size_t end, int depth, uint64_t bits);
+    float infinite_share() const;
+    // The probability of taking the child `right` at an interior node, for (p, n).
+    static float branch_probability(float left, float right, bool take_right);
+
+    LightSamplerKind kind_ = LightSamplerKind::Power;
+    int count_ = 0;
+    LightDistribution power_;
+    std::vector<Node> nodes_;
+    std::vector<Trail> trails_;  // by light
+    std::vector<int> infinite_;  // the lights at infinity
+};
+
+}  // namespace pathlab

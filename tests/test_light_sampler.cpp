@@ -1,0 +1,246 @@
+// The light samplers (--light-sampler uniform|power|bvh): each one's pmf over the lights sums
+// to 1 at every shading point, its choices follow its pmf (chi-square), the pmf the BSDF-sampled
+// half of MIS reads for a light equals the probability of choosing it (infinite lights
+// included), and every sampler converges to the same image (per-pixel z-tests).
+#include <gtest/gtest.h>
+
+#include <tbb/global_control.h>
+
+#include "integrators/common/direct_lighting.hpp"
+#include "job/usage_error.hpp"
+#include "judge/image_statistics.hpp"
+#include "render_helpers.hpp"
+#include "scenefile/scene_file.hpp"
+
+namespace pathlab::test {
+namespace {
+
+const LightSamplerKind kKinds[] = {LightSamplerKind::Uniform, LightSamplerKind::Power, LightSamplerKind::Bvh};
+
+// Every kind of light at once: a triangle-mesh emitter, an emitting sphere, a point, a spot, an
+// IES-less omni light, a directional sun and a constant sky (two lights at infinity).
+const char* kMixedLights = R"(<scene version="3.0.0">
+    <shape type="rectangle"><transform name="to_world"><scale value="3"/></transform><bsdf type="diffuse"/></shape>
+    <shape type="rectangle"><transform name="to_world"><scale value="0.3"/><rotate x="1" angle="180"/><translate z="2"/></transform>
+        <emitter type="area"><rgb name="radiance" value="5"/></emitter></shape>
+    <shape type="sphere"><point name="center" value="1.5, 0.5, 0.8"/><float name="radius" value="0.2"/>
+        <emitter type="area"><rgb name="radiance" value="2, 1, 0.5"/></emitter></shape>
+    <emitter type="point"><point name="position" value="-1, -1, 1"/><rgb name="intensity" value="3"/></emitter>
+    <emitter type="spot"><transform name="to_world"><lookat origin="0, 2, 2" target="0, 0, 0"/></transform>
+        <rgb name="intensity" value="20"/><float name="cutoff_angle" value="25"/></emitter>
+    <emitter type="directional"><vector name="direction" value="0.3, 0.2, -1"/><rgb name="irradiance" value="1"/></emitter>
+    <emitter type="constant"><rgb name="radiance" value="0.1, 0.2, 0.4"/></emitter>
+</scene>)";
+
+SceneDescription mixed_lights(LightSamplerKind kind) {
+    SceneDescription d = load_scene_text(kMixedLights, "mixed-lights.xml", ".");
+    d.light_sampler = kind;
+    return d;
+}
+
+SceneDescription many_lights(LightSamplerKind kind) {
+    SceneDescription d = load_scene_file(std::string(PATHLAB_SOURCE_DIR) + "/scenes/many-lights.xml");
+    d.light_sampler = kind;
+    return d;
+}
+
+// Shading points: (p, n) with p in the scene's bounds and n a random unit vector or 0 (a medium).
+std::vector<std::pair<Vec3f, Vec3f>> shading_points(const Scene& scene, int count) {
+    Sampler rng(7, 0, 0);
+    std::vector<std::pair<Vec3f, Vec3f>> out;
+    const Vec3f c = scene.bounds_center();
+    const float r = scene.bounds_radius();
+    for (int i = 0; i < count; ++i) {
+        const Vec3f p = c + Vec3f(rng.next1d() - 0.5f, rng.next1d() - 0.5f, rng.next1d() - 0.5f) * r;
+        const Vec3f n = i % 5 == 4 ? Vec3f(0.0f) : square_to_uniform_sphere(rng.next2d());
+        out.emplace_back(p, n);
+    }
+    return out;
+}
+
+class LightSamplers : public ::testing::TestWithParam<LightSamplerKind> {};
+
+TEST_P(LightSamplers, PmfSumsToOneAndIsWhatChooseReturns) {
+    for (const bool many : {false, true}) {
+        const auto scene = Scene::build(many ? many_lights(GetParam()) : mixed_lights(GetParam()));
+        const LightSampler& s = scene->light_sampler();
+        const int n = int(scene->lights().size());
+        ASSERT_GT(n, many ? 4000 : 6);
+        Sampler rng(11, 0, 0);
+        for (const auto& [p, nrm] : shading_points(*scene, many ? 40 : 400)) {
+            double sum = 0;
+            for (int i = 0; i < n; ++i) {
+                const float pmf = s.pmf(p, nrm, i);
+                ASSERT_GE(pmf, 0.0f);
+                sum += pmf;
+            }
+            // The bvh may choose no light (index -1) where the bounds of a node's children rule
+            // every light below it out: its pmf then sums to less than 1, the rest is "none".
+            if (GetParam() != LightSamplerKind::Bvh) EXPECT_NEAR(sum, 1.0, 1e-4) << "many=" << many;
+            else EXPECT_LE(sum, 1.0 + 1e-4) << "many=" << many;
+            for (int k = 0; k < 20; ++k) {
+                const LightChoice c = s.choose(p, nrm, rng.next1d());
+                if (c.index < 0) {
+                    EXPECT_LT(sum, 1.0 - 1e-6) << "no light chosen where the pmf sums to 1";
+                    continue;
+                }
+                EXPECT_EQ(c.pmf, s.pmf(p, nrm, c.index)) << "light " << c.index;  // bit for bit: MIS reads the same number
+                EXPECT_GT(c.pmf, 0.0f);
+            }
+        }
+    }
+}
+
+// The histogram of 400k choices at fixed points against the pmf: Pearson's chi-square over the
+// cells with an expected count of at least 5 (the rest pooled), at a false-alarm rate of 1e-6
+// per point (z of the Wilson-Hilferty approximation > 4.75).
+TEST_P(LightSamplers, ChoicesFollowThePmf) {
+    for (const bool many : {false, true}) {
+        const auto scene = Scene::build(many ? many_lights(GetParam()) : mixed_lights(GetParam()));
+        const LightSampler& s = scene->light_sampler();
+        const int n = int(scene->lights().size());
+        const auto points = shading_points(*scene, 3);
+        for (const auto& [p, nrm] : points) {
+            constexpr int kDraws = 400000;
+            std::vector<int> count(size_t(n), 0);
+            Sampler rng(13, 0, 0);
+            for (int k = 0; k < kDraws; ++k) {
+                const LightChoice c = s.choose(p, nrm, rng.next1d());
+                if (c.index >= 0) ++count[size_t(c.index)];
+            }
+            double chi2 = 0, pooled_expected = 0, pooled_observed = 0, total = 0;
+            int cells = 0, none = kDraws;
+            for (int i = 0; i < n; ++i) total += s.pmf(p, nrm, i), none -= count[size_t(i)];
+            // "No light" is one more cell, of probability 1 - the sum.
+            count.push_back(none);
+            for (int i = 0; i <= n; ++i) {
+                const double expected = (i < n ? double(s.pmf(p, nrm, i)) : std::max(0.0, 1 - total)) * kDraws;
+                if (expected < 1e-3) {
+                    EXPECT_EQ(count[size_t(i)], 0) << "light " << i << " (" << n << ": none) chosen with pmf " << expected / kDraws;
+                } else if (expected < 5) {
+                    pooled_expected += expected, pooled_observed += count[size_t(i)];
+                } else {
+                    chi2 += (count[size_t(i)] - expected) * (count[size_t(i)] - expected) / expected, ++cells;
+                }
+            }
+            if (pooled_expected >= 5) chi2 += (pooled_observed - pooled_expected) * (pooled_observed - pooled_expected) / pooled_expected, ++cells;
+            if (cells < 2) continue;
+            const double dof = cells - 1;
+            const double z = (std::cbrt(chi2 / dof) - (1 - 2 / (9 * dof))) / std::sqrt(2 / (9 * dof));
+            EXPECT_LT(z, 4.75) << "chi2 " << chi2 << " over " << dof << " degrees of freedom, many=" << many;
+        }
+    }
+}
+
+// The pmf the BSDF-sampled half finds (trace_to_emitter) equals light sampling's own, for
+// directions towards every kind of light a ray can hit: the surfaces and the sky (pbrt-v4
+// PR 163 mis-sampled infinite lights in its BVH sampler).
+TEST_P(LightSamplers, BsdfSampledHitsGetTheSamplersPdf) {
+    const auto scene = Scene::build(mixed_lights(GetParam()));
+    Sampler rng(5, 0, 0);
+    int surfaces = 0, sky = 0;
+    for (int k = 0; k < 4000; ++k) {
+        const Vec3f p(rng.next1d() * 4 - 2, rng.next1d() * 4 - 2, 0.001f);
+        const Vec3f n(0, 0, 1);
+        const LightChoice c = scene->choose_light(p, n, rng.next1d());
+        if (c.index < 0) continue;
+        const Light& light = scene->lights()[size_t(c.index)];
+        const auto ls = sample_light(light, p, rng.next2d());
+        if (!ls || ls->delta || ls->wi.z <= 0) continue;
+        const EmitterHit e = trace_to_emitter(*scene, Ray{p, ls->wi, kInf}, p, n);
+        const int found = e.hit ? e.isect.light : scene->environment_light();
+        if (found != c.index) continue;  // occluded by another emitter
+        const float expected = c.pmf * ls->pdfW;
+        ASSERT_NEAR(e.pdf_light, expected, 2e-3f * expected) << "light " << c.index;
+        (e.hit ? surfaces : sky)++;
+    }
+    EXPECT_GT(surfaces, 100);
+    EXPECT_GT(sky, 100);
+}
+
+INSTANTIATE_TEST_SUITE_P(Kinds, LightSamplers, ::testing::ValuesIn(kKinds),
+                         [](const ::testing::TestParamInfo<LightSamplerKind>& i) { return std::string(light_sampler_name(i.param)); });
+
+// The bvh ranks lights by their bounds: below one ceiling tile, facing it, the tile is chosen far
+// more often than its share of the power; a tile facing away (on the back wall, seen from behind
+// it) is never chosen.
+TEST(LightBvh, PrefersNearLightsAndRulesOutLightsFacingAway) {
+    const auto bvh = Scene::build(many_lights(LightSamplerKind::Bvh));
+    const auto power = Scene::build(many_lights(LightSamplerKind::Power));
+    const Vec3f p(-5.925f, 0.125f, 2.5f), up(0, 0, 1);  // 0.5 below the first tile of the ceiling grid
+    int nearest = -1;
+    float best = kInf;
+    for (size_t i = 0; i < bvh->lights().size(); ++i)
+        if (const auto* t = std::get_if<TriangleLight>(&bvh->lights()[i])) {
+            const float d = length(t->p0 + (t->e1 + t->e2) / 3.0f - p);
+            if (d < best) best = d, nearest = int(i);
+        }
+    ASSERT_GE(nearest, 0);
+    EXPECT_GT(bvh->light_pmf(p, up, nearest), 20 * power->light_pmf(p, up, nearest));
+    // Behind the back wall (y > 4): every tile there faces -y, away from this point.
+    const Vec3f behind(0, 4.5f, 1.5f);
+    for (size_t i = 0; i < bvh->lights().size(); ++i)
+        if (const auto* t = std::get_if<TriangleLight>(&bvh->lights()[i]); t && t->normal.y < -0.9f)
+            ASSERT_EQ(bvh->light_pmf(behind, Vec3f(0.0f), int(i)), 0.0f) << "light " << i;
+}
+
+// Every sampler converges to the same image: pt-mis with uniform and bvh against power, per-pixel
+// z-tests (false-alarm rate 1e-4 per comparison), on a course scene with a light of several
+// triangles and on the many-light scene.
+TEST(LightSamplerAgreement, EverySamplerConvergesToTheSameImage) {
+    const AgreementOptions agreement{1e-3, 1e-4};
+    for (const bool many : {false, true}) {
+        auto render_with = [&](LightSamplerKind kind, uint64_t seed) {
+            JobRequest r;
+            r.algorithm = "pt-mis";
+            r.spp = many ? 256 : 2048;
+            r.width = r.height = 12;
+            r.seed = seed;
+            r.max_depth = 3;
+            r.light_sampler = kind;
+            RenderJob job(many ? scene_choice_of(many_lights(kind)) : builtin_scene_choice(4), r);
+            return job.run();
+        };
+        const RenderResult base = render_with(LightSamplerKind::Power, 1);
+        for (const LightSamplerKind kind : {LightSamplerKind::Uniform, LightSamplerKind::Bvh}) {
+            const RenderResult a = render_with(kind, 2);
+            const AgreementResult res = test_agreement(a.film.mean(), a.film.standard_error(), base.film.mean(), base.film.standard_error(), agreement);
+            EXPECT_TRUE(res.agree) << light_sampler_name(kind) << " vs power, many=" << many << ": " << res.describe();
+        }
+    }
+}
+
+// The same bytes with 1 and 2 threads (the tree is read-only; every choice is a function of the
+// sample's own numbers).
+TEST(LightBvh, DeterministicAcrossThreadCounts) {
+    SceneDescription d = many_lights(LightSamplerKind::Bvh);
+    JobRequest r;
+    r.algorithm = "pt-mis";
+    r.spp = 4;
+    r.width = 32, r.height = 24;
+    r.light_sampler = LightSamplerKind::Bvh;
+    auto run = [&](int threads) {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+        RenderJob job(scene_choice_of(d), r);
+        return job.run();
+    };
+    const RenderResult a = run(1), b = run(2);
+    EXPECT_TRUE(bit_identical(a.film.mean(), b.film.mean()));
+}
+
+TEST(LightSamplerOption, RefusedByIntegratorsThatDoNotChooseLightsAtShadingPoints) {
+    JobRequest r;
+    r.algorithm = "bdpt";
+    r.light_sampler = LightSamplerKind::Bvh;
+    try {
+        RenderJob job(builtin_scene_choice(4), r);
+        FAIL() << "bdpt accepted --light-sampler";
+    } catch (const UsageError& e) {
+        EXPECT_NE(std::string(e.what()).find("pt-mis"), std::string::npos) << e.what();
+    }
+    r.algorithm = "volpath";
+    EXPECT_NO_THROW(RenderJob(builtin_scene_choice(4), r));
+}
+
+}  // namespace
+}  // namespace pathlab::test

@@ -28,7 +28,8 @@ test: build
 # next to pt-mis, splat accumulation, 1 minute), bdpt against pt-mis (12 minutes), pt-mis, bdpt, bpm and vcm on SmallVCM's kind of
 # scene at 512x512 (time per iteration, MSE per sample, efficiency: 10 minutes), the photon methods (10 minutes), irradiance caching (13 minutes),
 # rendering across processes (2 MPI ranks against 1 process, film reduction, checkpoints: 3 minutes), the lights (an environment map's cost
-# per sample against the constant environment, spot and IES: 2 minutes), volpath (volumes: throughput, MIS at equal time, optical thickness),
+# per sample against the constant environment, spot and IES: 2 minutes), the light samplers
+# (uniform, power and the light BVH at equal time on the many-light scenes and the course scenes: 6 minutes), volpath (volumes: throughput, MIS at equal time, optical thickness),
 # textures (textured against constant materials per sample, texture lookups: 2 minutes) and differentiable rendering (a gradient against a
 # primal render, memory vs spp and depth: 1 minute).
 bench: build
@@ -40,6 +41,7 @@ bench: build
 	$(BUILD)/bench/pathlab_bench ic
 	$(BUILD)/bench/pathlab_bench distributed
 	$(BUILD)/bench/pathlab_bench lights
+	$(BUILD)/bench/pathlab_bench many-lights
 	$(BUILD)/bench/pathlab_bench volumes
 	$(BUILD)/bench/pathlab_bench textures
 	$(BUILD)/bench/pathlab_bench diff

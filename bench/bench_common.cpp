@@ -31,6 +31,8 @@ RenderResult run(const Scene& scene, const std::string& algorithm, int size, int
     r.time_limit = seconds;
     r.seed = seed;
     r.sampler = sampler;
+    // The scene's light sampler (the job refuses a shared scene built with another one).
+    if (scene.light_sampler().kind() != LightSamplerKind::Power) r.light_sampler = scene.light_sampler().kind();
     // The caller's scene, shared without ownership: its BVH is built once for many runs.
     RenderJob job(scene_choice_of(scene.description()), r, std::shared_ptr<const Scene>(std::shared_ptr<const Scene>(), &scene));
     job.settings.after_pass = std::move(after_pass);

@@ -12,6 +12,7 @@
 //   pathlab_bench pbgi-gather  pbgi's gather against a ray-traced truth per cutoff and micro-buffer
 //   pathlab_bench volumes  volpath: samples/s, equal-time RMSE with and without MIS, optical thickness
 //   pathlab_bench distributed  2 MPI ranks against 1 process, film reduction, checkpoints
+//   pathlab_bench many-lights   light samplers (uniform, power, bvh) at equal time; the light BVH's build time and memory
 //   pathlab_bench lights   an environment map's cost per sample against the constant environment; spot and IES
 //   pathlab_bench textures textured against constant materials per sample; texture lookups
 //   pathlab_bench diff     a gradient's cost (path replay) relative to a primal render, its memory vs spp and depth
@@ -26,6 +27,7 @@
 #include "light_tracing.hpp"
 #include "irradiance_caching.hpp"
 #include "lights.hpp"
+#include "many_lights.hpp"
 #include "photon_mapping.hpp"
 #include "performance.hpp"
 #include "spectral.hpp"
@@ -130,6 +132,15 @@ int main(int argc, char** argv) {
     lic->add_option("--repeats", lo.repeats, "Interleaved rounds (median reported)")->capture_default_str();
     lic->add_option("--scenes", lo.scenes, "Course scene indices with an environment")->delimiter(',')->capture_default_str();
     lic->add_option("--map-width", lo.map_width, "Width of the constant environment map")->capture_default_str();
+    ManyLightsOptions mlo;
+    CLI::App* mlc = app.add_subcommand("many-lights", "Light samplers (uniform, power, bvh) at equal time; the light BVH's build time and memory");
+    mlc->add_option("--size", mlo.size, "Image width and height")->capture_default_str();
+    mlc->add_option("--seconds", mlo.seconds, "Seconds per timed render")->capture_default_str();
+    mlc->add_option("--repeats", mlo.repeats, "Interleaved rounds (medians reported)")->capture_default_str();
+    mlc->add_option("--ref-spp", mlo.ref_spp, "Samples per pixel of each reference")->capture_default_str();
+    mlc->add_option("--scene-files", mlo.scene_files, "Scene files of scenes/")->delimiter(',')->capture_default_str();
+    mlc->add_option("--scenes", mlo.scenes, "Course scene indices")->delimiter(',')->capture_default_str();
+    mlc->add_option("--algorithms", mlo.algorithms, "Integrators that sample lights")->delimiter(',')->capture_default_str();
     DistributedOptions dopt;
     CLI::App* dist = app.add_subcommand("distributed", "2 MPI ranks against 1 process, film reduction, checkpoint write and size");
     dist->add_option("--size", dopt.size, "Image width and height of the speedup renders")->capture_default_str();
@@ -179,6 +190,7 @@ int main(int argc, char** argv) {
     if (*smc && sm_files->count() > 0 && smc->count("--scenes") == 0) smo.scenes.clear();
     if (*dfc) differentiable_suite(dfo);
     if (*lic) lights_suite(lo);
+    if (*mlc) many_lights_suite(mlo);
     if (*vol) volumes_suite(vo);
     if (*txc) textures_suite(tx);
     if (*spc) spectral_suite(spo);

@@ -1,10 +1,9 @@
 #!/usr/bin/env python3
 """Writes the many-light scenes (issue "Many lights"; docs/lights.md):
 
-  scenes/many-lights.xml     three rooms in a row joined by doorways, the camera in the middle one;
-                             2560 small emissive tiles of different powers and tints on the
-                             ceilings and along the back wall, two thirds of them in the side rooms
-                             (behind walls, seen only through the doorways)
+  scenes/many-lights.xml     a hall of 24 x 24 m split in three by partitions, the camera in the
+                             middle part; 2304 small emissive tiles of different powers and tints
+                             under the ceiling, two thirds of them behind the partitions
   scenes/emissive-lamp.xml   a room lit by a lamp whose shade is an emissive mesh
   scenes/meshes/lamp-shade.obj   (1024 emitting triangles, each one a light)
 
@@ -16,6 +15,23 @@ import os
 import random
 
 ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "scenes")
+
+
+def preamble(origin, target, width, height, white):
+    """The scene element's start: the camera (fov 70) and the walls' white, red and blue."""
+    return f"""<scene version="3.0.0">
+    <default name="spp" value="64"/>
+    <sensor type="perspective">
+        <float name="fov" value="70"/>
+        <transform name="to_world"><lookat origin="{origin}" target="{target}" up="0, 0, 1"/></transform>
+        <film type="hdrfilm"><integer name="width" value="{width}"/><integer name="height" value="{height}"/><rfilter type="box"/></film>
+        <sampler type="independent"><integer name="sample_count" value="$spp"/></sampler>
+    </sensor>
+
+    <bsdf type="twosided" id="white"><bsdf type="diffuse"><rgb name="reflectance" value="{white}"/></bsdf></bsdf>
+    <bsdf type="twosided" id="red"><bsdf type="diffuse"><rgb name="reflectance" value="0.7, 0.15, 0.1"/></bsdf></bsdf>
+    <bsdf type="twosided" id="blue"><bsdf type="diffuse"><rgb name="reflectance" value="0.15, 0.25, 0.65"/></bsdf></bsdf>
+"""
 
 
 def rect(transform, body):
@@ -31,18 +47,17 @@ def wall_x(x, y0, y1, z0, z1, ref="white"):
 
 def room_shell():
     out = ""
-    # Floor, ceiling, front and back walls, the end walls: the hall [-6, 6] x [0, 4] x [0, 3].
-    out += rect('<scale x="6" y="2"/><translate y="2"/>', '<ref id="floor"/>')
-    out += rect('<scale x="6" y="2"/><rotate x="1" angle="180"/><translate y="2" z="3"/>', '<ref id="white"/>')
-    out += rect('<scale x="6" y="1.5"/><rotate x="1" angle="90"/><translate y="4" z="1.5"/>', '<ref id="white"/>')
-    out += rect('<scale x="6" y="1.5"/><rotate x="1" angle="-90"/><translate z="1.5"/>', '<ref id="white"/>')
-    out += wall_x(-6, 0, 4, 0, 3, "red")
-    out += wall_x(6, 0, 4, 0, 3, "blue")
-    # The two inner walls at x = -2 and x = 2, each with a doorway y in [1.5, 2.5], z in [0, 2.2].
-    for x in (-2, 2):
-        out += wall_x(x, 0, 1.5, 0, 3)
-        out += wall_x(x, 2.5, 4, 0, 3)
-        out += wall_x(x, 1.5, 2.5, 2.2, 3)
+    # Floor, ceiling and the four walls of the hall [-12, 12] x [0, 24] x [0, 3].
+    out += rect('<scale x="12" y="12"/><translate y="12"/>', '<ref id="floor"/>')
+    out += rect('<scale x="12" y="12"/><rotate x="1" angle="180"/><translate y="12" z="3"/>', '<ref id="white"/>')
+    out += rect('<scale x="12" y="1.5"/><rotate x="1" angle="90"/><translate y="24" z="1.5"/>', '<ref id="white"/>')
+    out += rect('<scale x="12" y="1.5"/><rotate x="1" angle="-90"/><translate z="1.5"/>', '<ref id="white"/>')
+    out += wall_x(-12, 0, 24, 0, 3, "red")
+    out += wall_x(12, 0, 24, 0, 3, "blue")
+    # Two partitions across the hall at x = -4 and x = 4, each leaving a passage y in [20, 24]:
+    # the lights of the side parts are behind them.
+    for x in (-4, 4):
+        out += wall_x(x, 0, 20, 0, 3)
     return out
 
 
@@ -50,45 +65,26 @@ def many_lights():
     rng = random.Random(20261205)
     tiles = ""
     count = 0
-    size = 0.05  # half the side of a tile
-    # 80 x 26 tiles under the ceiling, facing down.
-    for i in range(80):
-        for j in range(26):
-            x, y = -6 + 0.15 * (i + 0.5), 0.15 * (j + 0.5) + 0.05
-            if abs(abs(x) - 2) < 0.1:
-                continue  # not inside an inner wall
+    size = 0.06  # half the side of a tile
+    # 48 x 48 tiles under the ceiling (a grid of 0.5), facing down.
+    for i in range(48):
+        for j in range(48):
+            x, y = -12 + 0.5 * (i + 0.5), 0.5 * (j + 0.5)
+            if abs(abs(x) - 4) < 0.2:
+                continue  # not inside a partition
             tiles += tile(rng, f'<scale value="{size}"/><rotate x="1" angle="180"/><translate x="{x:.3f}" y="{y:.3f}" z="2.999"/>')
             count += 1
-    # A strip along the back wall, facing the rooms.
-    for i in range(80):
-        for k in range(6):
-            x, z = -6 + 0.15 * (i + 0.5), 1.0 + 0.15 * k
-            if abs(abs(x) - 2) < 0.1:
-                continue
-            tiles += tile(rng, f'<scale value="{size}"/><rotate x="1" angle="90"/><translate x="{x:.3f}" y="3.999" z="{z:.3f}"/>')
-            count += 1
-    head = f"""<!-- Many lights: three rooms in a row ([-6, 6] x [0, 4] x [0, 3], inner walls at x = -2 and 2
-     with doorways), the camera in the middle room looking towards the left doorway. {count} small
-     emissive tiles (each two triangles, so twice as many lights) of radiances spread over two
-     decades and of different tints, under the ceilings and along the back wall; two thirds of them
-     are in the side rooms, behind the walls. Choosing a light by power alone spends most shadow
-     rays on lights far away or hidden; --light-sampler bvh chooses by each light's bound at the
-     shading point (docs/lights.md).
+    head = f"""<!-- Many lights: a hall of 24 x 24 x 3 ([-12, 12] x [0, 24] x [0, 3]) split in three by two
+     partitions (x = -4 and 4, open at the far end), the camera in the middle part looking down at
+     the floor and the partitions (the tiles themselves out of view). {count}
+     small emissive tiles under the ceiling (each two triangles, so twice as many lights) of
+     radiances spread over two decades and of different tints; two thirds of them are behind the
+     partitions, and from any point most of the others are far away. Choosing a light by power
+     alone spends most shadow rays on lights far away or hidden; --light-sampler bvh chooses by
+     each light's bound at the shading point (docs/lights.md).
      Made by scripts/make-many-lights.py (do not edit by hand).
      pathlab --scene scenes/many-lights.xml -a pt-mis --light-sampler bvh --spp 64 -o many-lights.png -->
-<scene version="3.0.0">
-    <default name="spp" value="64"/>
-    <sensor type="perspective">
-        <float name="fov" value="80"/>
-        <transform name="to_world"><lookat origin="1.4, 0.35, 1.55" target="-3, 3.2, 1.1" up="0, 0, 1"/></transform>
-        <film type="hdrfilm"><integer name="width" value="320"/><integer name="height" value="240"/><rfilter type="box"/></film>
-        <sampler type="independent"><integer name="sample_count" value="$spp"/></sampler>
-    </sensor>
-
-    <bsdf type="twosided" id="white"><bsdf type="diffuse"><rgb name="reflectance" value="0.7"/></bsdf></bsdf>
-    <bsdf type="twosided" id="floor"><bsdf type="roughplastic"><rgb name="diffuse_reflectance" value="0.45, 0.35, 0.25"/><float name="alpha" value="0.2"/></bsdf></bsdf>
-    <bsdf type="twosided" id="red"><bsdf type="diffuse"><rgb name="reflectance" value="0.7, 0.15, 0.1"/></bsdf></bsdf>
-    <bsdf type="twosided" id="blue"><bsdf type="diffuse"><rgb name="reflectance" value="0.15, 0.25, 0.65"/></bsdf></bsdf>
+""" + preamble("2.5, 0.5, 1.2", "-2.5, 9, -4.8", 256, 256, "0.7") + """    <bsdf type="twosided" id="floor"><bsdf type="roughplastic"><rgb name="diffuse_reflectance" value="0.45, 0.35, 0.25"/><float name="alpha" value="0.2"/></bsdf></bsdf>
     <bsdf type="diffuse" id="tile"><rgb name="reflectance" value="0"/></bsdf>
 
 """
@@ -96,7 +92,7 @@ def many_lights():
 
 
 def tile(rng, transform):
-    level = 10 ** rng.uniform(-1.5, 0.5)  # radiance 0.03 to 3
+    level = 10 ** rng.uniform(-0.7, 1.3)  # radiance 0.2 to 20
     tint = rng.choice([(1.0, 0.85, 0.6), (1.0, 1.0, 1.0), (0.6, 0.8, 1.0), (1.0, 0.5, 0.3)])
     r, g, b = (level * c for c in tint)
     return rect(transform, f'<ref id="tile"/><emitter type="area"><rgb name="radiance" value="{r:.3g}, {g:.3g}, {b:.3g}"/></emitter>')
@@ -123,23 +119,11 @@ def lamp_shade_obj(segments=64, rings=8):
 def emissive_lamp():
     return """<!-- A room lit by a lamp whose shade is an emissive mesh: 1024 triangles, each one a light, on a
      truncated cone (scenes/meshes/lamp-shade.obj) standing on a table in a room of [-2, 2] x [-2, 2] x [0, 3].
-     From any point of the room most of the shade's triangles face away; --light-sampler bvh sees
+     From any point of the room about half of the shade's triangles face away; --light-sampler bvh sees
      it from their normal cones, power alone does not (docs/lights.md).
      Made by scripts/make-many-lights.py (do not edit by hand).
      pathlab --scene scenes/emissive-lamp.xml -a pt-mis --light-sampler bvh --spp 64 -o emissive-lamp.png -->
-<scene version="3.0.0">
-    <default name="spp" value="64"/>
-    <sensor type="perspective">
-        <float name="fov" value="70"/>
-        <transform name="to_world"><lookat origin="0, -1.9, 1.4" target="0, 0.6, 1.0" up="0, 0, 1"/></transform>
-        <film type="hdrfilm"><integer name="width" value="320"/><integer name="height" value="240"/><rfilter type="box"/></film>
-        <sampler type="independent"><integer name="sample_count" value="$spp"/></sampler>
-    </sensor>
-
-    <bsdf type="twosided" id="white"><bsdf type="diffuse"><rgb name="reflectance" value="0.75"/></bsdf></bsdf>
-    <bsdf type="twosided" id="red"><bsdf type="diffuse"><rgb name="reflectance" value="0.7, 0.15, 0.1"/></bsdf></bsdf>
-    <bsdf type="twosided" id="blue"><bsdf type="diffuse"><rgb name="reflectance" value="0.15, 0.25, 0.65"/></bsdf></bsdf>
-    <bsdf type="twosided" id="wood"><bsdf type="roughplastic"><rgb name="diffuse_reflectance" value="0.4, 0.25, 0.12"/><float name="alpha" value="0.15"/></bsdf></bsdf>
+""" + preamble("0, -1.9, 1.4", "0, 0.6, 1.0", 320, 240, "0.75") + """    <bsdf type="twosided" id="wood"><bsdf type="roughplastic"><rgb name="diffuse_reflectance" value="0.4, 0.25, 0.12"/><float name="alpha" value="0.15"/></bsdf></bsdf>
     <bsdf type="diffuse" id="shade"><rgb name="reflectance" value="0"/></bsdf>
 
     <shape type="rectangle"><transform name="to_world"><scale value="2"/></transform><ref id="white"/></shape>

@@ -242,5 +242,31 @@ TEST(LightSamplerOption, RefusedByIntegratorsThatDoNotChooseLightsAtShadingPoint
     EXPECT_NO_THROW(RenderJob(builtin_scene_choice(4), r));
 }
 
+
+// The variance of one light sample's estimate of the unshadowed irradiance at points of the
+// hall's floor, sum_i E_i^2 / pmf_i - (sum_i E_i)^2 (E_i of a small tile: L A cos cos / d^2):
+// the bvh's is a fraction of power's.
+TEST(LightBvh, LowersTheVarianceOfUnshadowedIrradianceOnTheManyLightFloor) {
+    const auto bvh = Scene::build(many_lights(LightSamplerKind::Bvh));
+    const auto power = Scene::build(many_lights(LightSamplerKind::Power));
+    const Vec3f n(0, 0, 1);
+    for (const Vec3f p : {Vec3f(0, 2, 0.01f), Vec3f(1, 12, 0.01f), Vec3f(-2, 22, 0.01f)}) {
+        double sum = 0, v_bvh = 0, v_power = 0;
+        for (size_t i = 0; i < bvh->lights().size(); ++i) {
+            const auto& t = std::get<TriangleLight>(bvh->lights()[i]);
+            const Vec3f c = t.p0 + (t.e1 + t.e2) / 3.0f, d = c - p;
+            const float d2 = dot(d, d);
+            const Vec3f w = d / std::sqrt(d2);
+            const double e = mean(t.radiance) * t.area * std::max(0.0f, -dot(t.normal, w)) * std::max(0.0f, dot(n, w)) / d2;
+            sum += e;
+            v_bvh += e * e / bvh->light_pmf(p, n, int(i));
+            v_power += e * e / power->light_pmf(p, n, int(i));
+        }
+        v_bvh -= sum * sum, v_power -= sum * sum;
+        RecordProperty("variance_ratio", std::to_string(v_power / v_bvh));
+        EXPECT_LT(v_bvh * 3, v_power) << "at (" << p.x << ", " << p.y << "): power " << v_power << ", bvh " << v_bvh;
+    }
+}
+
 }  // namespace
 }  // namespace pathlab::test

@@ -4,12 +4,12 @@
 // half-angle theta_o), how far emission spreads around a normal (theta_e: pi/2 for a surface's
 // cosine lobe, 0 for a spot's beam, whose cone is theta_o) and the total power phi.
 //
-// importance(p, n) bounds, up to a common factor, the power that can arrive at p on a surface
+// importance(p, n) estimates, up to a common factor, the power that can arrive at p on a surface
 // with normal n (n = 0: a point in a medium, no cosine there): phi cos(theta') / d^2, where d is
-// the distance to the box's centre and theta' the smallest angle between an emitter's normal and
-// the direction to p that the box and the cones allow; times the receiver's cosine bound. It is
-// 0 only where no emitter of the group can send light; the light sampler chooses between groups
-// in proportion to it.
+// the distance to the box's centre (no less than its bounding sphere's radius, twice that for a
+// single emitter) and theta' the smallest angle between an emitter's normal and the direction to
+// p that the box and the cones allow; times the receiver's cosine bound. It is 0 only where no
+// emitter of the group can send light; the light sampler chooses between groups in proportion to it.
 #pragma once
 
 #include <algorithm>
@@ -27,37 +27,48 @@ struct LightBounds {
     float cos_o = 1, sin_o = 0, cos_e = 1;  // of theta_o and theta_e (set_angles)
     float phi = 0;
     bool two_sided = false;
+    Vec3f centre{0.0f};  // of the box, and the radius of its bounding sphere (seal)
+    float radius = 0;
+    // The distance below which importance stops growing, in radii squared: a single emitter's
+    // (2 radii: closer than that its centre says little about where its light comes from);
+    // a group's bounding sphere otherwise.
+    float near = 1;
 
     void set_angles(float o, float e) {
         theta_o = std::min(o, kPi), theta_e = std::min(e, kPi);
         cos_o = std::cos(theta_o), sin_o = std::sin(theta_o), cos_e = std::cos(theta_e);
     }
-    Vec3f centre() const { return (lo + hi) * 0.5f; }
+    // After the box is final: its centre and bounding sphere.
+    void seal() {
+        if (lo.x > hi.x) return;
+        centre = (lo + hi) * 0.5f;
+        radius = 0.5f * length(hi - lo);
+    }
 
     float importance(const Vec3f& p, const Vec3f& n) const {
         if (!(phi > 0)) return 0.0f;
-        const Vec3f d = p - centre();
-        const float dd = dot(d, d);
-        const Vec3f diag = hi - lo;
-        const float r2 = 0.25f * dot(diag, diag);  // the box's bounding sphere, radius^2
+        const Vec3f d = p - centre;
+        const float dd = dot(d, d), r2 = radius * radius;
         // Inside the bounding sphere every direction is possible: the distance is clamped to its radius.
-        if (dd <= r2) return std::min(phi / std::max(r2, 1e-20f), 1e30f);
-        const Vec3f wi = d / std::sqrt(dd);  // from the lights towards p
+        if (dd <= r2) return std::min(phi / std::max(near * r2, 1e-20f), 1e30f);
+        const float inv_d = 1 / std::sqrt(dd);
+        const Vec3f wi = d * inv_d;  // from the lights towards p
+        // The half-angle theta_b the bounding sphere subtends at p.
+        const float sin_b = radius * inv_d, cos_b = std::sqrt(std::max(0.0f, 1 - sin_b * sin_b));
+        // theta_x = max(0, theta_w - theta_o), then theta' = max(0, theta_x - theta_b), as cosines.
         float cos_w = dot(w, wi);
         if (two_sided) cos_w = std::abs(cos_w);
-        const float sin_w = std::sqrt(std::max(0.0f, 1 - cos_w * cos_w));
-        const float sin2_b = r2 / dd, cos_b = std::sqrt(std::max(0.0f, 1 - sin2_b)), sin_b = std::sqrt(sin2_b);
-        // theta_x = max(0, theta_w - theta_o), then theta' = max(0, theta_x - theta_b), as cosines.
-        const bool in_cone = cos_w >= cos_o;
-        const float cos_x = in_cone ? 1.0f : cos_w * cos_o + sin_w * sin_o;
-        const float sin_x = in_cone ? 0.0f : sin_w * cos_o - cos_w * sin_o;
-        const float cos_p = cos_x >= cos_b ? 1.0f : cos_x * cos_b + sin_x * sin_b;
+        float cos_p = 1;
+        if (cos_w < cos_o) {
+            const float sin_w = std::sqrt(std::max(0.0f, 1 - cos_w * cos_w));
+            const float cos_x = cos_w * cos_o + sin_w * sin_o, sin_x = sin_w * cos_o - cos_w * sin_o;
+            if (cos_x < cos_b) cos_p = cos_x * cos_b + sin_x * sin_b;
+        }
         if (cos_p < cos_e) return 0.0f;  // theta' > theta_e: outside every emitter's lobe
-        float importance = std::min(phi * std::max(cos_p, 0.0f) / dd, 1e30f);
+        float importance = std::min(phi * std::max(cos_p, 0.0f) / std::max(dd, near * r2), 1e30f);
         if (n.x != 0 || n.y != 0 || n.z != 0) {
             const float cos_i = std::abs(dot(wi, n));
-            const float sin_i = std::sqrt(std::max(0.0f, 1 - cos_i * cos_i));
-            importance *= cos_i >= cos_b ? 1.0f : cos_i * cos_b + sin_i * sin_b;
+            if (cos_i < cos_b) importance *= cos_i * cos_b + std::sqrt(std::max(0.0f, 1 - cos_i * cos_i)) * sin_b;
         }
         return importance;
     }
@@ -86,6 +97,8 @@ inline LightBounds light_bounds(const Light& light, const SceneSphere& sphere) {
         add(ies->position);
         b.set_angles(kPi, kPi / 2);
     }
+    b.near = 4;
+    b.seal();
     return b;
 }
 
@@ -110,7 +123,12 @@ inline void unite_cones(Vec3f a, float theta_a, Vec3f b, float theta_b, Vec3f& w
 }
 
 inline LightBounds unite(const LightBounds& a, const LightBounds& b) {
-    if (!(a.phi > 0)) return b.phi > 0 ? b : LightBounds{min(a.lo, b.lo), max(a.hi, b.hi)};
+    if (!(a.phi > 0)) {
+        if (b.phi > 0) return b;
+        LightBounds u{min(a.lo, b.lo), max(a.hi, b.hi)};
+        u.seal();
+        return u;
+    }
     if (!(b.phi > 0)) return a;
     LightBounds u;
     u.lo = min(a.lo, b.lo), u.hi = max(a.hi, b.hi);
@@ -119,6 +137,7 @@ inline LightBounds unite(const LightBounds& a, const LightBounds& b) {
     float theta_o;
     unite_cones(a.w, a.theta_o, b.w, b.theta_o, u.w, theta_o);
     u.set_angles(theta_o, std::max(a.theta_e, b.theta_e));
+    u.seal();
     return u;
 }
 

@@ -66,7 +66,7 @@ int LightSampler::build(std::vector<Item>& items, size_t begin, size_t end, int 
     Vec3f clo(kInf), chi(-kInf);
     for (size_t i = begin; i < end; ++i) {
         all = unite(all, items[i].bounds);
-        const Vec3f c = items[i].bounds.centre();
+        const Vec3f c = items[i].bounds.centre;
         clo = min(clo, c), chi = max(chi, c);
     }
     nodes_[size_t(index)].bounds = all;
@@ -81,6 +81,9 @@ int LightSampler::build(std::vector<Item>& items, size_t begin, size_t end, int 
     constexpr int kBuckets = 12;
     size_t mid = begin + (end - begin) / 2;
     const Vec3f extent = chi - clo;
+    const auto bucket_of = [&](const Item& item, int axis) {
+        return std::clamp(int(float(kBuckets) * (item.bounds.centre[axis] - clo[axis]) / extent[axis]), 0, kBuckets - 1);
+    };
     const float longest = max_component(extent);
     int best_axis = -1;
     float best_plane = 0, best_cost = kInf;
@@ -89,12 +92,8 @@ int LightSampler::build(std::vector<Item>& items, size_t begin, size_t end, int 
             if (!(extent[axis] > 0)) continue;
             std::array<LightBounds, kBuckets> bucket{};
             std::array<size_t, kBuckets> count{};
-            auto slot = [&](const Item& it) {
-                const int k = int(float(kBuckets) * (it.bounds.centre()[axis] - clo[axis]) / extent[axis]);
-                return std::clamp(k, 0, kBuckets - 1);
-            };
             for (size_t i = begin; i < end; ++i) {
-                const int k = slot(items[i]);
+                const int k = bucket_of(items[i], axis);
                 bucket[size_t(k)] = unite(bucket[size_t(k)], items[i].bounds);
                 ++count[size_t(k)];
             }
@@ -111,10 +110,8 @@ int LightSampler::build(std::vector<Item>& items, size_t begin, size_t end, int 
         }
     if (best_axis >= 0) {
         const int axis = best_axis;
-        const auto it = std::partition(items.begin() + ptrdiff_t(begin), items.begin() + ptrdiff_t(end), [&](const Item& item) {
-            const int k = int(float(kBuckets) * (item.bounds.centre()[axis] - clo[axis]) / extent[axis]);
-            return float(std::clamp(k, 0, kBuckets - 1)) < best_plane;
-        });
+        const auto it = std::partition(items.begin() + ptrdiff_t(begin), items.begin() + ptrdiff_t(end),
+                                       [&](const Item& item) { return float(bucket_of(item, axis)) < best_plane; });
         mid = size_t(it - items.begin());
     }
     if (best_axis < 0 || mid == begin || mid == end) {
@@ -124,7 +121,7 @@ int LightSampler::build(std::vector<Item>& items, size_t begin, size_t end, int 
             if (extent[a] > extent[axis]) axis = a;
         std::nth_element(items.begin() + ptrdiff_t(begin), items.begin() + ptrdiff_t(mid), items.begin() + ptrdiff_t(end),
                          [axis](const Item& a, const Item& b) {
-                             const float ca = a.bounds.centre()[axis], cb = b.bounds.centre()[axis];
+                             const float ca = a.bounds.centre[axis], cb = b.bounds.centre[axis];
                              return ca < cb || (ca == cb && a.light < b.light);
                          });
     }

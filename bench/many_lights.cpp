@@ -1,5 +1,6 @@
 // `pathlab_bench many-lights` (part of `make bench`; docs/lights.md quotes it):
-//  1. equal time: each scene and algorithm rendered for `seconds` with every light sampler, in
+//  1. equal time: each scene and algorithm rendered for `seconds` with every light sampler (ris with
+//     its default candidates), in
 //     interleaved rounds; the MSE against a reference (bvh at ref_spp, another seed, its own
 //     noise subtracted), the median over the rounds, and power's MSE over each sampler's
 //     (above 1: better than power at equal time);
@@ -19,15 +20,20 @@
 namespace pathlab::bench {
 
 void many_lights_suite(const ManyLightsOptions& o) {
-    const LightSamplerKind kinds[] = {LightSamplerKind::Uniform, LightSamplerKind::Power, LightSamplerKind::Bvh};
+    const LightSamplerKind kinds[] = {LightSamplerKind::Uniform, LightSamplerKind::Power, LightSamplerKind::Bvh, LightSamplerKind::Ris};
     std::vector<std::pair<std::string, SceneDescription>> scenes;
     for (const std::string& f : o.scene_files) scenes.emplace_back(f, load_scene_file(std::string(PATHLAB_SOURCE_DIR) + "/scenes/" + f));
     for (const int i : o.scenes) scenes.emplace_back(fmt::format("{} {}", i, builtin_scene_choice(i).name), make_builtin_scene(i));
 
-    fmt::print("## Light samplers at equal time ({}x{}, {} s per render, median of {} rounds; reference bvh at {} spp)\n\n", o.size,
-               o.size, o.seconds, o.repeats, o.ref_spp);
-    fmt::print("| scene | lights | algorithm | MSE uniform | MSE power | MSE bvh | power/uniform | power/bvh | spp uniform | spp power | spp bvh |\n");
-    fmt::print("|---|---|---|---|---|---|---|---|---|---|---|\n");
+    fmt::print("## Light samplers at equal time ({}x{}, {} s per render, median of {} rounds; reference bvh at {} spp; ris with {} "
+               "candidates)\n\n",
+               o.size, o.size, o.seconds, o.repeats, o.ref_spp, kDefaultRisCandidates);
+    std::string head = "| scene | lights | algorithm |", rule = "|---|---|---|";
+    for (const LightSamplerKind k : kinds) head += fmt::format(" MSE {} |", light_sampler_name(k)), rule += "---|";
+    for (const LightSamplerKind k : kinds)
+        if (k != LightSamplerKind::Power) head += fmt::format(" power/{} |", light_sampler_name(k)), rule += "---|";
+    for (const LightSamplerKind k : kinds) head += fmt::format(" spp {} |", light_sampler_name(k)), rule += "---|";
+    fmt::print("{}\n{}\n", head, rule);
     for (auto& [name, desc] : scenes) {
         std::map<LightSamplerKind, std::unique_ptr<Scene>> built;
         for (const LightSamplerKind k : kinds) {
@@ -45,11 +51,13 @@ void many_lights_suite(const ManyLightsOptions& o) {
                     mse[k].push_back(e * e);
                     spp[k].push_back(double(r.stats.spp));
                 }
-            const double u = median(mse[LightSamplerKind::Uniform]), p = median(mse[LightSamplerKind::Power]),
-                         b = median(mse[LightSamplerKind::Bvh]);
-            fmt::print("| {} | {} | {} | {:.3g} | {:.3g} | {:.3g} | {:.2f} | {:.2f} | {:.0f} | {:.0f} | {:.0f} |\n", name,
-                       built[LightSamplerKind::Power]->lights().size(), algorithm, u, p, b, p / u, p / b,
-                       median(spp[LightSamplerKind::Uniform]), median(spp[LightSamplerKind::Power]), median(spp[LightSamplerKind::Bvh]));
+            std::string row = fmt::format("| {} | {} | {} |", name, built[LightSamplerKind::Power]->lights().size(), algorithm);
+            const double p = median(mse[LightSamplerKind::Power]);
+            for (const LightSamplerKind k : kinds) row += fmt::format(" {:.3g} |", median(mse[k]));
+            for (const LightSamplerKind k : kinds)
+                if (k != LightSamplerKind::Power) row += fmt::format(" {:.2f} |", p / median(mse[k]));
+            for (const LightSamplerKind k : kinds) row += fmt::format(" {:.0f} |", median(spp[k]));
+            fmt::print("{}\n", row);
             std::fflush(stdout);
         }
     }

@@ -16,7 +16,7 @@ struct ManyLightsOptions {
 };
 
 // `pathlab_bench many-lights`: equal-time MSE of next-event estimation's light samplers
-// (uniform, power, bvh) on the many-light scenes and the course scenes, as ratios to power; the
+// (uniform, power, bvh, ris) on the many-light scenes and the course scenes, as ratios to power; the
 // light BVH's build time and memory per 1000 lights.
 void many_lights_suite(const ManyLightsOptions& o);
 

@@ -39,7 +39,7 @@ void print_algorithms() {
     }
     fmt::print("\nParticipating media (scenes with a <medium>): {}; the others refuse such scenes.\n", media_integrator_names());
     fmt::print("Spectral mode (--spectral): {}.\n", spectral_integrator_names());
-    fmt::print("Light sampling at shading points (--light-sampler uniform|power|bvh): {}.\n", light_sampling_integrator_names());
+    fmt::print("Light sampling at shading points (--light-sampler uniform|power|bvh|ris): {}.\n", light_sampling_integrator_names());
 }
 
 }  // namespace

@@ -99,9 +99,13 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
     app.add_option_function<int>("--rr-depth", [&o](const int& v) { o.rr_depth = v, o.rr_depth_given = true; },
                                  "Bounces before Russian roulette starts (default: the scene file's, else 3)");
     app.add_option("--light-sampler", o.light_sampler,
-                   "How next-event estimation chooses a light: uniform, power (default: in proportion to power) or bvh (a "
-                   "light tree, by each light's bound at the shading point: for many lights); for the integrators that "
-                   "sample lights at their shading points (pathlab algorithms)");
+                   "How next-event estimation chooses a light: uniform, power (default: in proportion to power), bvh (a "
+                   "light tree, by each light's bound at the shading point: for many lights) or ris (bvh's choices as "
+                   "candidates, one kept by its unshadowed contribution); for the integrators that sample lights at their "
+                   "shading points (pathlab algorithms)");
+    app.add_option("--ris-candidates", o.ris_candidates,
+                   fmt::format("--light-sampler ris: the light samples drawn to keep one (1 to {}; default {})", kMaxRisCandidates,
+                               kDefaultRisCandidates));
     app.add_option("--mis", o.mis, "bdpt, vcm, bpm: the MIS heuristic, balance or power")->capture_default_str();
     app.add_option("--strategies", o.strategies_dir,
                    "bdpt: also write one image per strategy (s, t), weighted and unweighted, and montages, into this directory "
@@ -176,6 +180,7 @@ std::vector<RenderJob> make_jobs(const RenderCommandOptions& o, bool check_paths
         if (!request.light_sampler)
             throw UsageError(fmt::format("unknown light sampler '{}'. Valid light samplers: {}", *o.light_sampler, kLightSamplerNames));
     }
+    request.ris_candidates = o.ris_candidates;
     request.strategies_depth = o.strategies_depth;
     request.photons = o.photons;
     request.photon_radius = o.photon_radius;

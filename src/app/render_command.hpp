@@ -34,6 +34,7 @@ struct RenderCommandOptions {
     bool spectral = false;
     std::string mis = "balance";
     std::optional<std::string> light_sampler;
+    std::optional<int> ris_candidates;
     std::string strategies_dir;
     int strategies_depth = 4;
     std::optional<int64_t> photons;

@@ -89,6 +89,7 @@ struct IntegratorOptions {
     bool spectral = false;
     // How next-event estimation chooses a light (--light-sampler); the scene is built with it.
     LightSamplerKind light_sampler = LightSamplerKind::Power;
+    int ris_candidates = kDefaultRisCandidates;  // --ris-candidates: the light samples ris resamples
 };
 
 // What every pass of one render sees; fixed for the whole render.

@@ -66,7 +66,8 @@ std::string options_text(const IntegratorOptions& o) {
                        hex_float(o.photon_alpha), int(o.vcm_merging), int(o.vcm_connections), o.ic_rays, hex_float(o.ic_error),
                        int(o.ic_gradients)) +
            (o.spectral ? " mode=spectral" : "") + (o.volume_beam ? "" : " volume=points") +
-           (o.light_sampler == LightSamplerKind::Power ? "" : fmt::format(" lights={}", light_sampler_name(o.light_sampler)));  // the text of the defaults as it always was
+           (o.light_sampler == LightSamplerKind::Power ? "" : fmt::format(" lights={}", light_sampler_name(o.light_sampler))) +
+           (o.light_sampler == LightSamplerKind::Ris ? fmt::format(" ris={}", o.ris_candidates) : "");  // the text of the defaults as it always was
 }
 
 std::string metadata_key(const std::string& field) {

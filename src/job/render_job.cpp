@@ -125,6 +125,11 @@ RenderJob::RenderJob(SceneChoice scene, const JobRequest& r) : choice_(std::move
                                      "by power), so --light-sampler does not apply to it; the integrators it applies to: {}",
                                      info_->name, light_sampling_integrator_names()));
     options_.light_sampler = r.light_sampler.value_or(LightSamplerKind::Power);
+    if (r.ris_candidates && options_.light_sampler != LightSamplerKind::Ris)
+        throw UsageError("--ris-candidates is the number of light samples --light-sampler ris resamples; give --light-sampler ris");
+    options_.ris_candidates = r.ris_candidates.value_or(kDefaultRisCandidates);
+    if (options_.ris_candidates < 1 || options_.ris_candidates > kMaxRisCandidates)
+        throw UsageError(fmt::format("--ris-candidates must be between 1 and {}, not {}", kMaxRisCandidates, options_.ris_candidates));
     options_.spectral = r.spectral || d.spectral;
     if (options_.spectral && !info_->spectral)
         throw UsageError(fmt::format("{} does not render in spectral mode yet (--spectral, or the scene file's <default name=\"mode\" "
@@ -183,6 +188,7 @@ const Scene& RenderJob::scene() {
     if (!scene_) {
         if (options_.spectral) check_spectral_materials(choice_.description);
         choice_.description.light_sampler = options_.light_sampler;
+        choice_.description.ris_candidates = options_.ris_candidates;
         scene_ = Scene::build(choice_.description);
     }
     return *scene_;

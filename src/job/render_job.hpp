@@ -54,6 +54,7 @@ struct JobRequest {
     std::optional<int> pbgi_direct_samples;   // --pbgi-direct-samples (pbgi)
     std::optional<int> pbgi_spacing;          // --pbgi-spacing (pbgi)
     std::optional<LightSamplerKind> light_sampler;  // --light-sampler (next-event estimation; default power)
+    std::optional<int> ris_candidates;              // --ris-candidates (ris)
 };
 
 // The integrator `name` (or an alias); a UsageError listing them all otherwise.
@@ -75,7 +76,8 @@ public:
     // benchmarks do to build each BVH once), with the request's light sampler.
     RenderJob(SceneChoice scene, const JobRequest& request, std::shared_ptr<const Scene> built)
         : RenderJob(std::move(scene), request) {
-        if (built->light_sampler().kind() != options_.light_sampler)
+        if (built->light_sampler().kind() != options_.light_sampler ||
+            (options_.light_sampler == LightSamplerKind::Ris && built->light_sampler().candidates() != options_.ris_candidates))
             throw std::invalid_argument("RenderJob: the shared scene was built with another light sampler");
         scene_ = std::move(built);
     }

@@ -4,7 +4,7 @@
 // half-angle theta_o), how far emission spreads around a normal (theta_e: pi/2 for a surface's
 // cosine lobe, 0 for a spot's beam, whose cone is theta_o) and the total power phi.
 //
-// importance(p, n) estimates, up to a common factor, the power that can arrive at p on a surface
+// importance(p, n) (of CompactLightBounds) estimates, up to a common factor, the power that can arrive at p on a surface
 // with normal n (n = 0: a point in a medium, no cosine there): phi cos(theta') / d^2, where d is
 // the distance to the box's centre (no less than its bounding sphere's radius, twice that for a
 // single emitter) and theta' the smallest angle between an emitter's normal and the direction to
@@ -20,30 +20,16 @@
 
 namespace pathlab {
 
-struct LightBounds {
-    Vec3f lo{kInf}, hi{-kInf};
-    Vec3f w{0, 0, 1};
-    float theta_o = 0, theta_e = 0;  // radians
-    float cos_o = 1, sin_o = 0, cos_e = 1;  // of theta_o and theta_e (set_angles)
-    float phi = 0;
-    bool two_sided = false;
-    Vec3f centre{0.0f};  // of the box, and the radius of its bounding sphere (seal)
+// The part of a group's bounds that importance(p, n) reads (LightBounds::compact()): what the
+// light tree keeps per node after it is built, 52 bytes.
+struct CompactLightBounds {
+    Vec3f centre{0.0f};
     float radius = 0;
-    // The distance below which importance stops growing, in radii squared: a single emitter's
-    // (2 radii: closer than that its centre says little about where its light comes from);
-    // a group's bounding sphere otherwise.
+    Vec3f w{0, 0, 1};
+    float phi = 0;
+    float cos_o = 1, sin_o = 0, cos_e = 1;
     float near = 1;
-
-    void set_angles(float o, float e) {
-        theta_o = std::min(o, kPi), theta_e = std::min(e, kPi);
-        cos_o = std::cos(theta_o), sin_o = std::sin(theta_o), cos_e = std::cos(theta_e);
-    }
-    // After the box is final: its centre and bounding sphere.
-    void seal() {
-        if (lo.x > hi.x) return;
-        centre = (lo + hi) * 0.5f;
-        radius = 0.5f * length(hi - lo);
-    }
+    bool two_sided = false;
 
     float importance(const Vec3f& p, const Vec3f& n) const {
         if (!(phi > 0)) return 0.0f;
@@ -72,6 +58,35 @@ struct LightBounds {
         }
         return importance;
     }
+};
+
+struct LightBounds {
+    Vec3f lo{kInf}, hi{-kInf};
+    Vec3f w{0, 0, 1};
+    float theta_o = 0, theta_e = 0;  // radians
+    float cos_o = 1, sin_o = 0, cos_e = 1;  // of theta_o and theta_e (set_angles)
+    float phi = 0;
+    bool two_sided = false;
+    Vec3f centre{0.0f};  // of the box, and the radius of its bounding sphere (seal)
+    float radius = 0;
+    // The distance below which importance stops growing, in radii squared: a single emitter's
+    // (2 radii: closer than that its centre says little about where its light comes from);
+    // a group's bounding sphere otherwise.
+    float near = 1;
+
+    void set_angles(float o, float e) {
+        theta_o = std::min(o, kPi), theta_e = std::min(e, kPi);
+        cos_o = std::cos(theta_o), sin_o = std::sin(theta_o), cos_e = std::cos(theta_e);
+    }
+    // After the box is final: its centre and bounding sphere.
+    void seal() {
+        if (lo.x > hi.x) return;
+        centre = (lo + hi) * 0.5f;
+        radius = 0.5f * length(hi - lo);
+    }
+
+    // What importance() reads, in one cache line (the sampler's tree nodes hold this).
+    CompactLightBounds compact() const { return {centre, radius, w, phi, cos_o, sin_o, cos_e, near, two_sided}; }
 };
 
 // The bounds of a light at a finite position (not kLightInfinite).

@@ -10,12 +10,13 @@ const char* light_sampler_name(LightSamplerKind kind) {
         case LightSamplerKind::Uniform: return "uniform";
         case LightSamplerKind::Power: return "power";
         case LightSamplerKind::Bvh: return "bvh";
+        case LightSamplerKind::Ris: return "ris";
     }
     return "power";
 }
 
 std::optional<LightSamplerKind> parse_light_sampler(const std::string& name) {
-    for (const LightSamplerKind k : {LightSamplerKind::Uniform, LightSamplerKind::Power, LightSamplerKind::Bvh})
+    for (const LightSamplerKind k : {LightSamplerKind::Uniform, LightSamplerKind::Power, LightSamplerKind::Bvh, LightSamplerKind::Ris})
         if (name == light_sampler_name(k)) return k;
     return std::nullopt;
 }
@@ -43,10 +44,10 @@ float split_cost(const LightBounds& b) {
 
 }  // namespace
 
-LightSampler::LightSampler(const std::vector<Light>& lights, const SceneSphere& sphere, LightSamplerKind kind)
-    : kind_(kind), count_(int(lights.size())) {
+LightSampler::LightSampler(const std::vector<Light>& lights, const SceneSphere& sphere, LightSamplerKind kind, int candidates)
+    : kind_(kind), count_(int(lights.size())), candidates_(kind == LightSamplerKind::Ris ? candidates : 1) {
     if (kind_ == LightSamplerKind::Power) power_ = LightDistribution(lights, sphere);
-    if (kind_ != LightSamplerKind::Bvh) return;
+    if (kind_ != LightSamplerKind::Bvh && kind_ != LightSamplerKind::Ris) return;
     std::vector<Item> items;
     trails_.assign(lights.size(), {});
     for (size_t i = 0; i < lights.size(); ++i) {
@@ -69,7 +70,7 @@ int LightSampler::build(std::vector<Item>& items, size_t begin, size_t end, int 
         const Vec3f c = items[i].bounds.centre;
         clo = min(clo, c), chi = max(chi, c);
     }
-    nodes_[size_t(index)].bounds = all;
+    nodes_[size_t(index)].bounds = all.compact();
     if (end - begin == 1) {
         nodes_[size_t(index)].light = items[begin].light;
         trails_[size_t(items[begin].light)] = {bits, depth};
@@ -145,7 +146,8 @@ LightChoice LightSampler::choose(const Vec3f& p, const Vec3f& n, float u) const 
     switch (kind_) {
         case LightSamplerKind::Power: return power_.choose(u);
         case LightSamplerKind::Uniform: return {std::min(int(u * float(count_)), count_ - 1), 1.0f / float(count_)};
-        case LightSamplerKind::Bvh: break;
+        case LightSamplerKind::Bvh:
+        case LightSamplerKind::Ris: break;
     }
     constexpr float kBelowOne = 0x1.fffffep-1f;
     const float share = infinite_share();
@@ -176,7 +178,8 @@ float LightSampler::pmf(const Vec3f& p, const Vec3f& n, int light) const {
     switch (kind_) {
         case LightSamplerKind::Power: return power_.pmf(light);
         case LightSamplerKind::Uniform: return 1.0f / float(count_);
-        case LightSamplerKind::Bvh: break;
+        case LightSamplerKind::Bvh:
+        case LightSamplerKind::Ris: break;
     }
     const Trail& trail = trails_[size_t(light)];
     const float share = infinite_share();

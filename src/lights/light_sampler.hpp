@@ -5,6 +5,9 @@
 //            choosing a child in proportion to its importance at the point (light_bounds.hpp),
 //            as pbrt-v4 and Cycles do; the lights at infinity (environment, directional) beside
 //            the tree with a fixed share n_inf / (n_inf + 1), uniformly among them
+//   ris      bvh's choices as the candidates of resampled importance sampling: next-event
+//            estimation draws candidates() light samples and keeps one by its unshadowed
+//            contribution (integrators/common/light_resampling.hpp); choose and pmf are bvh's
 // pmf(p, n, i) is the probability with which choose(p, n, u) returns light i: the BSDF-sampled
 // half of MIS weighs an emitter it hits with it (for bvh, the same arithmetic along the light's
 // path in the tree).
@@ -20,18 +23,23 @@
 
 namespace pathlab {
 
-enum class LightSamplerKind { Uniform, Power, Bvh };
+enum class LightSamplerKind { Uniform, Power, Bvh, Ris };
 
 const char* light_sampler_name(LightSamplerKind kind);
 std::optional<LightSamplerKind> parse_light_sampler(const std::string& name);
-inline constexpr const char* kLightSamplerNames = "uniform, power, bvh";
+inline constexpr const char* kLightSamplerNames = "uniform, power, bvh, ris";
+inline constexpr int kDefaultRisCandidates = 4;  // --ris-candidates
+inline constexpr int kMaxRisCandidates = 64;
 
 class LightSampler {
 public:
     LightSampler() = default;
-    LightSampler(const std::vector<Light>& lights, const SceneSphere& sphere, LightSamplerKind kind);
+    LightSampler(const std::vector<Light>& lights, const SceneSphere& sphere, LightSamplerKind kind,
+                 int candidates = kDefaultRisCandidates);
 
     LightSamplerKind kind() const { return kind_; }
+    // The light samples next-event estimation draws to keep one (ris); 1 for the other kinds.
+    int candidates() const { return candidates_; }
     // A light for the point p with normal n (n = 0 in a medium), and its probability.
     LightChoice choose(const Vec3f& p, const Vec3f& n, float u) const;
     float pmf(const Vec3f& p, const Vec3f& n, int light) const;
@@ -41,8 +49,8 @@ public:
     size_t bytes() const { return nodes_.size() * sizeof(Node) + trails_.size() * sizeof(Trail) + infinite_.size() * sizeof(int); }
 
 private:
-    struct Node {
-        LightBounds bounds;
+    struct alignas(64) Node {  // one cache line
+        CompactLightBounds bounds;
         int32_t right = -1;  // interior: the second child (the first follows the node)
         int32_t light = -1;  // leaf: the light
     };
@@ -61,6 +69,7 @@ private:
 
     LightSamplerKind kind_ = LightSamplerKind::Power;
     int count_ = 0;
+    int candidates_ = 1;
     LightDistribution power_;
     std::vector<Node> nodes_;
     std::vector<Trail> trails_;  // by light

@@ -62,6 +62,7 @@ struct SceneDescription {
     bool spectral = false;                        // <default name="mode" value="spectral"/>: spectral mode
     // How next-event estimation chooses a light (--light-sampler; not a scene-file setting).
     LightSamplerKind light_sampler = LightSamplerKind::Power;
+    int ris_candidates = kDefaultRisCandidates;  // --ris-candidates (ris)
     std::optional<bool> hide_emitters;            // paths of no bounce (emitters seen directly) left out
     // The film: its reconstruction filter, the format of the default output (hdrfilm's
     // file_format: "openexr", "rgbe" or "pfm"), and extra outputs an integrator asks for

@@ -7,31 +7,42 @@
 
 #include "samplers/sampler.hpp"
 #include "core/sampling.hpp"
+#include "integrators/common/light_resampling.hpp"
 #include "integrators/common/shading.hpp"
 #include "integrators/common/transport.hpp"
 
 namespace pathlab {
 
 // One light chosen by the scene's light sampler (Scene::choose_light), one point or direction
-// sampled on it, one shadow ray. Returns f * Le * cos(theta) / (pmf * pdfW) in the path's colour (wl:
+// sampled on it (or, with ris, one of several such candidates: light_resampling.hpp), one shadow
+// ray. Returns f * Le * cos(theta) / (pmf * pdfW) (ris: / NeeSample::pdf) in the path's colour (wl:
 // transport.hpp). With `mis`, the result is weighted by the balance heuristic against BSDF
 // sampling of the same direction (both densities in solid angle, the light's including its
 // selection probability); delta lights cannot be found by BSDF sampling and keep weight 1.
 template <class Wl>
 ColourAt<Wl> estimate_light_sample(const Scene& scene, const ShadingPoint& sp, Sampler& sampler, bool mis, Wl& wl) {
     using Colour = ColourAt<Wl>;
-    const LightChoice choice = scene.choose_light(sp.p, sp.frame.n, sampler.next1d());
-    const Vec2f u = sampler.next2d();
-    if (choice.index < 0) return Colour(0.0f);
-    const auto ls = sample_light(scene.lights()[size_t(choice.index)], sp.p, u);
-    if (!ls || is_black(ls->Le)) return Colour(0.0f);
+    // A dispersive interface (which reduces wl to the hero) keeps the plain light sample: its
+    // colour is known only per wavelength, and RIS's target is in RGB.
+    const bool dispersive = changes_wavelengths(*sp.material, wl);
+    const bool transmits = sp.material->is_dielectric();
+    const auto nee = sample_nee(scene, sp.p, sp.frame.n, sampler, dispersive ? 1 : scene.light_sampler().candidates(),
+                                [&](const LightSample& c, int) {
+                                    if (dot(c.wi, sp.ng) <= 0 && !transmits) return 0.0f;
+                                    const Vec3f w = sp.frame.to_local(c.wi);
+                                    float pdf;
+                                    const Rgb f = sp.material->eval_and_pdf(sp, sp.wi, w, pdf);
+                                    return luminance(f) * luminance(c.Le) * std::abs(w.z);
+                                });
+    if (!nee) return Colour(0.0f);
+    const LightChoice choice = nee->choice;
+    const LightSample* ls = &nee->ls;
     // Lights behind the surface reach it only through a transmitting material (rough glass).
-    if (dot(ls->wi, sp.ng) <= 0 && !sp.material->is_dielectric()) return Colour(0.0f);
+    if (dot(ls->wi, sp.ng) <= 0 && !transmits) return Colour(0.0f);
     const Vec3f wo = sp.frame.to_local(ls->wi);
     // The BSDF in RGB first (a shadow ray is traced only where it is not black), its colour once
-    // the light is known to be visible; a dispersive interface (which reduces wl to the hero) at once.
+    // the light is known to be visible; a dispersive interface at once.
     float pdf_bsdf;
-    const bool dispersive = changes_wavelengths(*sp.material, wl);
     Colour f(0.0f);
     Rgb f_rgb(0.0f);
     if (dispersive) [[unlikely]] {
@@ -45,9 +56,8 @@ ColourAt<Wl> estimate_light_sample(const Scene& scene, const ShadingPoint& sp, S
                                                 : spawn_segment(sp.p, sp.ng, ls->point, ls->normal);
     if (scene.occluded(shadow)) return Colour(0.0f);
     if (!dispersive) f = bsdf_colour(sp, wo, f_rgb, wl);
-    const float pdf_light = choice.pmf * ls->pdfW;
-    const float weight = (mis && !ls->delta) ? balance_heuristic(pdf_light, pdf_bsdf) : 1.0f;
-    return f * light_colour(scene, choice.index, ls->Le, wl) * (std::abs(wo.z) * weight / pdf_light);
+    const float weight = (mis && !ls->delta) ? balance_heuristic(nee->pdf_source, pdf_bsdf) : 1.0f;
+    return f * light_colour(scene, choice.index, ls->Le, wl) * (std::abs(wo.z) * weight / nee->pdf);
 }
 
 // The direct estimators' first hit: `L` becomes what the camera ray sees there (the emitter it

@@ -26,11 +26,19 @@ template <class T>
 ColourOf<T> estimate_light(const Scene& scene, const ScatterVertex& v, Sampler& sampler, MediumState<T>& st, bool mis,
                            WavelengthsOf<T>& wl) {
     using Colour = ColourOf<T>;
-    const LightChoice choice = scene.choose_light(v.p, v.sp ? v.sp->frame.n : Vec3f(0.0f), sampler.next1d());
-    const Vec2f u = sampler.next2d();
-    if (choice.index < 0) return Colour(0.0f);
-    const auto ls = sample_light(scene.lights()[size_t(choice.index)], v.p, u);
-    if (!ls || is_black(ls->Le)) return Colour(0.0f);
+    const bool dispersive = v.sp && changes_wavelengths(*v.sp->material, wl);  // as estimate_light_sample
+    const auto nee = sample_nee(scene, v.p, v.sp ? v.sp->frame.n : Vec3f(0.0f), sampler,
+                                dispersive ? 1 : scene.light_sampler().candidates(), [&](const LightSample& c, int) {
+                                    if (!v.sp) return phase_eval(*v.phase, v.wi, c.wi) * luminance(c.Le);
+                                    const ShadingPoint& sp = *v.sp;
+                                    if (dot(c.wi, sp.ng) <= 0 && !sp.material->is_dielectric()) return 0.0f;
+                                    const Vec3f w = sp.frame.to_local(c.wi);
+                                    float pdf;
+                                    return luminance(sp.material->eval_and_pdf(sp, sp.wi, w, pdf)) * luminance(c.Le) * std::abs(w.z);
+                                });
+    if (!nee) return Colour(0.0f);
+    const LightChoice choice = nee->choice;
+    const LightSample* ls = &nee->ls;
     Colour f;
     float pdf_scatter, cosine;
     Ray shadow;
@@ -61,9 +69,8 @@ ColourOf<T> estimate_light(const Scene& scene, const ScatterVertex& v, Sampler& 
     if (scene.media_separated(medium, scene.light_medium(choice.index))) return Colour(0.0f);  // blocked: no ray needed
     const Colour Tr = shadow_transmittance(scene, shadow, medium, st);
     if (is_black(Tr)) return Colour(0.0f);
-    const float pdf_light = choice.pmf * ls->pdfW;
-    const float weight = !ls->delta ? (mis ? balance_heuristic(pdf_light, pdf_scatter) : 1.0f) : 1.0f;
-    const Colour contribution = f * light_colour(scene, choice.index, ls->Le, wl) * (cosine * weight / pdf_light);
+    const float weight = !ls->delta ? (mis ? balance_heuristic(nee->pdf_source, pdf_scatter) : 1.0f) : 1.0f;
+    const Colour contribution = f * light_colour(scene, choice.index, ls->Le, wl) * (cosine * weight / nee->pdf);
     return scene.has_media() ? contribution * Tr : contribution;
 }
 

@@ -4,12 +4,13 @@
 // half-angle theta_o), how far emission spreads around a normal (theta_e: pi/2 for a surface's
 // cosine lobe, 0 for a spot's beam, whose cone is theta_o) and the total power phi.
 //
-// importance(p, n) (of CompactLightBounds) estimates, up to a common factor, the power that can arrive at p on a surface
-// with normal n (n = 0: a point in a medium, no cosine there): phi cos(theta') / d^2, where d is
-// the distance to the box's centre (no less than its bounding sphere's radius, twice that for a
-// single emitter) and theta' the smallest angle between an emitter's normal and the direction to
-// p that the box and the cones allow; times the receiver's cosine bound. It is 0 only where no
-// emitter of the group can send light; the light sampler chooses between groups in proportion to it.
+// importance(p, n) (of CompactLightBounds) estimates, up to a common factor, the power that can
+// arrive at p on a surface with normal n (n = 0: a point in a medium, no cosine there):
+// phi cos(theta') / d^2, where d is the distance to the box's centre (no less than its bounding
+// sphere's radius, twice that for a single emitter) and theta' the smallest angle between an
+// emitter's normal and the direction to p that the box and the cones allow; times the receiver's
+// cosine bound. It is 0 only where no emitter of the group can send light; the light sampler
+// chooses between groups in proportion to it.
 #pragma once
 
 #include <algorithm>

@@ -132,8 +132,9 @@ TEST_F(CliLimits, AFilmTooLargeForMemoryFailsThatSceneOnly) {
 // the figure and the option to lower (they ran for minutes and ended in std::bad_alloc): the
 // photons per light path come from a pilot of 256 light paths; nothing is written.
 TEST_F(CliLimits, PhotonMapsAndStrategyImagesTooLargeForMemoryAreRefusedUpFront) {
-    if (available_memory() == 0 || available_memory() > (uint64_t(900) << 30))
-        GTEST_SKIP() << "this machine could hold 10^10 light paths' photons (or does not say how much memory it has)";
+    if (available_memory() == 0 || available_memory() > (uint64_t(300) << 30))
+        GTEST_SKIP() << "this machine could hold 10^10 light paths' photons or 2048x2048 images of 594 strategies (or does not say "
+                        "how much memory it has)";
     for (const char* a : {"pm", "sppm"}) {
         const CliResult r = run({"-s", "2", "-a", a, "--photons", "10000000000", "--resolution", "8x8", "--spp", "1", "-q", "-o", path("p.pfm")});
         EXPECT_EQ(r.code, 1) << a << ": " << r.err;
@@ -141,14 +142,37 @@ TEST_F(CliLimits, PhotonMapsAndStrategyImagesTooLargeForMemoryAreRefusedUpFront)
         EXPECT_TRUE(contains(r.err, "GiB is available: lower --photons (about ")) << r.err;
         EXPECT_FALSE(fs::exists(path("p.pfm")));
     }
-    const CliResult s = run({"-s", "2", "-a", "bdpt", "--strategies", path("st"), "--strategies-depth", "1000000", "--max-depth", "1000",
-                             "--resolution", "1024x1024", "--spp", "1", "-q", "-o", path("b.pfm")});
+    const CliResult s = run({"-s", "2", "-a", "bdpt", "--strategies", path("st"), "--strategies-depth", "32", "--resolution", "2048x2048",
+                             "--spp", "1", "-q", "-o", path("b.pfm")});
     EXPECT_EQ(s.code, 1) << s.err;
-    EXPECT_TRUE(contains(s.err, "--strategies images of paths up to 1000 bounces")) << s.err;
+    EXPECT_TRUE(contains(s.err, "--strategies images of paths up to 32 bounces (594 strategies")) << s.err;
     EXPECT_TRUE(contains(s.err, ": lower --strategies-depth (at most ")) << s.err;
     EXPECT_FALSE(fs::exists(path("b.pfm")));
     // what fits still renders
     EXPECT_EQ(run({"-s", "2", "-a", "pm", "--photons", "2000", "--resolution", "8x8", "--spp", "1", "-q", "-o", path("p.pfm")}).code, 0);
+}
+
+// --strategies writes at most 32 bounces (594 strategies, 2,376 files): 10^6 with unlimited
+// paths (1024 bounces, 526,850 strategies) grew past 13 GiB on 8x8 pixels and wrote millions of
+// files; it is refused before anything renders. A path limit below it still caps the depth.
+TEST_F(CliLimits, StrategyImagesDeeperThan32BouncesAreRefused) {
+    const CliResult u = run({"-s", "2", "-a", "bdpt", "--strategies", path("st"), "--strategies-depth", "1000000", "--resolution", "8x8",
+                             "--spp", "1", "-q", "-o", path("b.pfm")});
+    EXPECT_EQ(u.code, 2) << u.err;
+    EXPECT_TRUE(contains(u.err, "--strategies images of paths up to 1024 bounces would be 526850 strategies and 2107400 files; at most "
+                                "32 bounces are written (594 strategies): lower --strategies-depth or give --max-depth (paths are unlimited here)")) << u.err;
+    EXPECT_FALSE(fs::exists(path("b.pfm")));
+    EXPECT_FALSE(fs::exists(path("st")));
+    const CliResult m = run({"-s", "2", "-a", "bdpt", "--strategies", path("st"), "--strategies-depth", "40", "--max-depth", "33",
+                             "--resolution", "8x8", "--spp", "1", "-q", "-o", path("b.pfm")});
+    EXPECT_EQ(m.code, 2) << m.err;
+    EXPECT_TRUE(contains(m.err, "up to 33 bounces would be 629 strategies")) << m.err;
+    EXPECT_TRUE(contains(m.err, "lower --strategies-depth or --max-depth")) << m.err;
+    const CliResult ok = run({"-s", "2", "-a", "bdpt", "--strategies", path("st"), "--strategies-depth", "1000000", "--max-depth", "2",
+                              "--resolution", "8x8", "--spp", "1", "-q", "-o", path("b.pfm")});
+    EXPECT_EQ(ok.code, 0) << ok.err;
+    EXPECT_TRUE(fs::exists(path("st/n2-s0-t4-weighted.exr")));
+    EXPECT_FALSE(fs::exists(path("st/n3-s0-t5-weighted.exr")));
 }
 
 // Sample counts are 64-bit: a pixel past 2^32 samples keeps counting and averaging.

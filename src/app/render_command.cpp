@@ -14,6 +14,8 @@
 #include "app/interrupt.hpp"
 #include "job/usage_error.hpp"
 #include "image/image_io.hpp"
+#include "integrators/bidir/strategy_images.hpp"
+#include "integrators/common/path_rules.hpp"
 #include "job/output_paths.hpp"
 #include "job/checkpoint.hpp"
 #include "job/rank_group.hpp"
@@ -327,6 +329,16 @@ std::vector<RenderJob> make_jobs(const RenderCommandOptions& o, bool check_paths
         if (!o.strategies_dir.empty()) {
             if (jobs[j].integrator_info().name != "bdpt")
                 throw UsageError(fmt::format("--strategies writes the strategies of bdpt, not of {}", jobs[j].integrator_info().name));
+            // The depth bdpt writes is the lower of --strategies-depth and the paths' own limit.
+            const IntegratorOptions& io = jobs[j].integrator_options();
+            const bool unlimited = io.max_depth < 0;
+            const int depth = std::min(io.strategies_depth, unlimited ? kMaxBounces : io.max_depth), most = StrategyImages::kMaxLength;
+            if (depth > most)
+                throw UsageError(fmt::format(
+                    "--strategies images of paths up to {} bounces would be {} strategies and {} files; at most {} bounces are written "
+                    "({} strategies): lower --strategies-depth{}",
+                    depth, StrategyImages::count(depth), 4 * StrategyImages::count(depth), most, StrategyImages::count(most),
+                    unlimited ? " or give --max-depth (paths are unlimited here)" : " or --max-depth"));
             const std::string dir = jobs[j].expand(o.strategies_dir);
             paths.output((std::filesystem::path(dir) / "montage-weighted.png").string(), "--strategies", /*image=*/true);
             jobs[j].integrator_options().strategies_dir = dir;

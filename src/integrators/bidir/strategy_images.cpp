@@ -12,10 +12,12 @@ namespace pathlab {
 void StrategyImages::begin_pass(int width, int height, int chunks) {
     const size_t pixels = size_t(width) * size_t(height), n = size_t(count(max_length_));
     if (width != width_ || height != height_ || weighted_.empty()) {
-        // Two films and two pass images per strategy.
+        // Two films and two pass images per strategy, and the montage write() makes (floats,
+        // then 8-bit PNG pixels).
         const double per_strategy = double(pixels) * double(2 * sizeof(PixelSums) + 2 * sizeof(Vec3d));
+        const double montage = double((max_length_ + 2) * (width + kGap)) * double((max_length_ + 1) * (height + kGap)) * (sizeof(Rgb) + 3);
         check_memory(
-            double(n) * per_strategy,
+            double(n) * per_strategy + montage,
             [&] {
                 return fmt::format("--strategies images of paths up to {} bounces ({} strategies, {} images at {}x{})", max_length_, n, 2 * n,
                                    width, height);
@@ -52,7 +54,7 @@ void StrategyImages::finish_pass() {
 void StrategyImages::write() const {
     if (weighted_.empty()) return;
     namespace fs = std::filesystem;
-    const int gap = 2, cols = max_length_ + 2, rows = max_length_ + 1;
+    const int gap = kGap, cols = max_length_ + 2, rows = max_length_ + 1;
     for (const bool weighted : {true, false}) {
         Image montage(cols * (width_ + gap) - gap, rows * (height_ + gap) - gap);
         for (int n = 0; n <= max_length_; ++n)

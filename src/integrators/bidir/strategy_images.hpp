@@ -32,6 +32,9 @@ public:
         return n * (n + 3) / 2 + s;
     }
     static int count(int max_length) { return (max_length + 1) * (max_length + 4) / 2; }
+    // The deepest set written: 32 bounces are 594 strategies, 2,376 files and a montage of
+    // 34x33 cells; more is no figure anyone reads (and 1024 bounces were 2 million files).
+    static constexpr int kMaxLength = 32;
 
     void begin_pass(int width, int height, int chunks);
     std::vector<StrategySplat>& chunk(int c) { return lists_[size_t(c)]; }
@@ -50,6 +53,7 @@ private:
     std::vector<Film> weighted_, unweighted_;
     std::vector<std::vector<StrategySplat>> lists_;
     std::vector<Vec3d> pass_weighted_, pass_unweighted_;  // strategy-major
+    static constexpr int kGap = 2;                        // black pixels between montage cells
 };
 
 }  // namespace pathlab

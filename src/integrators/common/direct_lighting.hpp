@@ -19,21 +19,30 @@ namespace pathlab {
 // transport.hpp). With `mis`, the result is weighted by the balance heuristic against BSDF
 // sampling of the same direction (both densities in solid angle, the light's including its
 // selection probability); delta lights cannot be found by BSDF sampling and keep weight 1.
+// RIS's target at a surface (light_resampling.hpp): the luminance of the unshadowed
+// contribution f * Le * |cos theta| of a candidate light sample; 0 behind an opaque surface.
+inline float surface_target(const ShadingPoint& sp, const LightSample& c) {
+    if (dot(c.wi, sp.ng) <= 0 && !sp.material->is_dielectric()) return 0.0f;
+    const Vec3f w = sp.frame.to_local(c.wi);
+    float pdf;
+    return luminance(sp.material->eval_and_pdf(sp, sp.wi, w, pdf)) * luminance(c.Le) * std::abs(w.z);
+}
+
+// The candidates next-event estimation draws at a surface (sp) or a point in a medium (null): a
+// dispersive interface (which reduces wl to the hero) keeps the plain light sample, since its
+// colour is known only per wavelength and RIS's target is in RGB.
+template <class Wl>
+int nee_candidates(const Scene& scene, const ShadingPoint* sp, const Wl& wl) {
+    return sp && changes_wavelengths(*sp->material, wl) ? 1 : scene.light_sampler().candidates();
+}
+
 template <class Wl>
 ColourAt<Wl> estimate_light_sample(const Scene& scene, const ShadingPoint& sp, Sampler& sampler, bool mis, Wl& wl) {
     using Colour = ColourAt<Wl>;
-    // A dispersive interface (which reduces wl to the hero) keeps the plain light sample: its
-    // colour is known only per wavelength, and RIS's target is in RGB.
     const bool dispersive = changes_wavelengths(*sp.material, wl);
     const bool transmits = sp.material->is_dielectric();
-    const auto nee = sample_nee(scene, sp.p, sp.frame.n, sampler, dispersive ? 1 : scene.light_sampler().candidates(),
-                                [&](const LightSample& c, int) {
-                                    if (dot(c.wi, sp.ng) <= 0 && !transmits) return 0.0f;
-                                    const Vec3f w = sp.frame.to_local(c.wi);
-                                    float pdf;
-                                    const Rgb f = sp.material->eval_and_pdf(sp, sp.wi, w, pdf);
-                                    return luminance(f) * luminance(c.Le) * std::abs(w.z);
-                                });
+    const auto nee = sample_nee(scene, sp.p, sp.frame.n, sampler, nee_candidates(scene, &sp, wl),
+                                [&](const LightSample& c, int) { return surface_target(sp, c); });
     if (!nee) return Colour(0.0f);
     const LightChoice choice = nee->choice;
     const LightSample* ls = &nee->ls;

@@ -26,15 +26,9 @@ template <class T>
 ColourOf<T> estimate_light(const Scene& scene, const ScatterVertex& v, Sampler& sampler, MediumState<T>& st, bool mis,
                            WavelengthsOf<T>& wl) {
     using Colour = ColourOf<T>;
-    const bool dispersive = v.sp && changes_wavelengths(*v.sp->material, wl);  // as estimate_light_sample
-    const auto nee = sample_nee(scene, v.p, v.sp ? v.sp->frame.n : Vec3f(0.0f), sampler,
-                                dispersive ? 1 : scene.light_sampler().candidates(), [&](const LightSample& c, int) {
-                                    if (!v.sp) return phase_eval(*v.phase, v.wi, c.wi) * luminance(c.Le);
-                                    const ShadingPoint& sp = *v.sp;
-                                    if (dot(c.wi, sp.ng) <= 0 && !sp.material->is_dielectric()) return 0.0f;
-                                    const Vec3f w = sp.frame.to_local(c.wi);
-                                    float pdf;
-                                    return luminance(sp.material->eval_and_pdf(sp, sp.wi, w, pdf)) * luminance(c.Le) * std::abs(w.z);
+    const auto nee = sample_nee(scene, v.p, v.sp ? v.sp->frame.n : Vec3f(0.0f), sampler, nee_candidates(scene, v.sp, wl),
+                                [&](const LightSample& c, int) {
+                                    return v.sp ? surface_target(*v.sp, c) : phase_eval(*v.phase, v.wi, c.wi) * luminance(c.Le);
                                 });
     if (!nee) return Colour(0.0f);
     const LightChoice choice = nee->choice;

@@ -279,6 +279,44 @@ TEST_F(Distributed, ResumedRenderEqualsTheUninterruptedOneBitForBit) {
     }
 }
 
+// `pathlab --resume FILE` alone continues the render: the checkpoint records its command (the
+// scene, the estimator, the options given); options given beside it replace the recorded ones,
+// and what then differs from the checkpoint's render is refused as for any --resume.
+TEST_F(Distributed, ResumeWithoutTheCommandLineContinuesTheRender) {
+    const std::vector<std::string> base = {"--scene", "3", "-a", "sppm", "--resolution", "16x12", "--seed", "5", "-q"};
+    auto with = [&](std::vector<std::string> extra) {
+        std::vector<std::string> args = base;
+        args.insert(args.end(), extra.begin(), extra.end());
+        return run(args);
+    };
+    ASSERT_EQ(with({"--spp", "9", "-o", path("whole.exr")}).code, 0);
+    ASSERT_EQ(with({"--spp", "4", "--checkpoint", path("c.ckpt"), "-o", path("part.exr")}).code, 0);
+    const CliResult info = run({"info", path("c.ckpt")});
+    EXPECT_TRUE(contains(info.out, "pathlab:command: pathlab render ceiling-glossy --algorithm sppm --spp 4 --resolution 16x12 --seed 5 "
+                                   "--output " + path("part.exr") + " --checkpoint " + path("c.ckpt") + " --quiet"))
+        << info.out;
+    // Another seed beside it: not this checkpoint's render.
+    const CliResult seed = run({"--resume", path("c.ckpt"), "--spp", "9", "--seed", "6", "-o", path("b.exr")});
+    EXPECT_EQ(seed.code, 2);
+    EXPECT_TRUE(contains(seed.err, "seed: 5 in the checkpoint, 6 in this render")) << seed.err;
+    EXPECT_EQ(read_checkpoint_info(path("c.ckpt")).passes.to_string(), "0-3");
+    // More samples: the recorded output becomes the render never interrupted, byte for byte.
+    const CliResult more = run({"--resume", path("c.ckpt"), "--spp", "9"});
+    ASSERT_EQ(more.code, 0) << more.err;
+    EXPECT_TRUE(same_render(path("whole.exr"), path("part.exr")));
+    EXPECT_EQ(read_checkpoint_info(path("c.ckpt")).passes.to_string(), "0-8");
+    // The checkpoint now records --spp 9; another output beside it (and `render`, its long form).
+    ASSERT_EQ(run({"render", "--resume", path("c.ckpt"), "-o", path("resumed.exr")}).code, 0);
+    EXPECT_TRUE(same_render(path("whole.exr"), path("resumed.exr")));
+    const CliResult fewer = run({"--resume", path("c.ckpt"), "--spp", "2"});
+    EXPECT_EQ(fewer.code, 2);
+    EXPECT_TRUE(contains(fewer.err, "raise --spp")) << fewer.err;
+    // A file that is not a checkpoint is named.
+    const CliResult bad = run({"--resume", path("whole.exr")});
+    EXPECT_EQ(bad.code, 2);
+    EXPECT_TRUE(contains(bad.err, path("whole.exr") + ": not a pathlab checkpoint")) << bad.err;
+}
+
 TEST_F(Distributed, CheckpointOfAnotherRenderIsRefusedSayingWhatDiffers) {
     ASSERT_EQ(run({"--scene", "3", "--resolution", "16x12", "--seed", "5", "-q", "--spp", "2", "--checkpoint", path("c.ckpt"), "-o",
                    path("a.exr")})

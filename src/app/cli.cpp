@@ -2,12 +2,16 @@
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
+
 #include <fmt/format.h>
 
 #include "app/command_arguments.hpp"
 #include "app/diff_commands.hpp"
 #include "app/render_command.hpp"
+#include "app/resumed_command.hpp"
 #include "app/tool_commands.hpp"
+#include "job/checkpoint.hpp"
 #include "job/rank_group.hpp"
 #include "job/usage_error.hpp"
 #include "integrators/integrator.hpp"
@@ -44,7 +48,7 @@ void print_algorithms() {
 
 }  // namespace
 
-int run_cli(int argc, const char* const* argv, RankGroup* ranks) {
+int run_cli(int argc, const char* const* argv, RankGroup* ranks, bool resuming) {
     CLI::App app{"pathlab: a physically based Monte Carlo renderer and light-transport laboratory.\n"
                  "Renders the 8 NPGR010 Cornell-box scenes (or scene files) with a chosen estimator.\n"
                  "Usage: pathlab SCENE [options]   (or pathlab render SCENE [options]; pathlab COMMAND --help)\n"
@@ -110,7 +114,30 @@ int run_cli(int argc, const char* const* argv, RankGroup* ranks) {
         return 2;
     }
 
+    const bool rendering = app.get_subcommands().empty() || *render_cmd;
+    if (rendering) render_opt.given = given_options(*render_cmd ? *render_cmd : app);
+
     try {
+        // `pathlab --resume r.ckpt [options]`: the render the checkpoint records, with these options.
+        if (rendering && !render_opt.resume.empty() && scene_spec(render_opt.scenes).empty() && !resuming) {
+            if (ranks && ranks->size() > 1)
+                throw UsageError("across processes, --resume needs the render's scene and options again (give them as when it started)");
+            CheckpointInfo info;
+            try {
+                info = read_checkpoint_info(render_opt.resume);
+            } catch (const CheckpointError& e) {
+                throw UsageError(e.what());
+            }
+            std::vector<std::string> now(argv + 1, argv + argc);
+            if (*render_cmd) now.erase(std::find(now.begin(), now.end(), std::string("render")));
+            std::vector<std::string> args = resumed_arguments(render_opt.resume, info.command, render_opt.given, now);
+            args.insert(args.begin(), {argv[0], "render"});
+            const bool quiet = std::find_if(args.begin(), args.end(), [](const std::string& a) { return a == "-q" || a == "--quiet"; }) != args.end();
+            if (!quiet) fmt::print(stderr, "pathlab: continuing {}: pathlab {}\n", render_opt.resume, shell_words(args, 1));
+            std::vector<const char*> again;
+            for (const std::string& a : args) again.push_back(a.c_str());
+            return run_cli(int(again.size()), again.data(), ranks, /*resuming=*/true);
+        }
         if (ranks && ranks->size() > 1 && !app.get_subcommands().empty() && !*render_cmd)
             throw UsageError(fmt::format("only rendering runs across processes; start `pathlab {}` without mpirun",
                                          app.get_subcommands().front()->get_name()));

@@ -12,6 +12,7 @@
 #include "app/tool_commands.hpp"
 #include "image/image_header.hpp"
 #include "image/image_io.hpp"
+#include "app/resumed_command.hpp"
 #include "job/checkpoint.hpp"
 #include "job/output_paths.hpp"
 #include "job/render_identity.hpp"
@@ -98,6 +99,8 @@ ImageHeader checkpoint_header(const CheckpointInfo& info) {
     h.attributes.emplace_back("pathlab:passes", info.passes.to_string());
     h.attributes.emplace_back("pathlab:seconds", fmt::format("{:.3f}", info.seconds));
     h.attributes.emplace_back("pathlab:version", info.writer);
+    // What continues it: `pathlab --resume FILE` runs this command (app/resumed_command.hpp).
+    if (!info.command.empty()) h.attributes.emplace_back("pathlab:command", command_line(info.command));
     return h;
 }
 

@@ -355,8 +355,9 @@ void print_messages(const std::string& messages) {
     for (size_t a = 0; a < messages.size();) {
         size_t b = messages.find('\n', a);
         if (b == std::string::npos) b = messages.size();
-        // A message's continuation lines (indented) are printed as they are.
-        fmt::print(stderr, "{}{}\n", messages[a] == ' ' ? "" : "pathlab: ", messages.substr(a, b - a));
+        // A message's continuation lines (indented) are printed as they are; a message that
+        // ends its last line leaves no empty one.
+        if (b > a) fmt::print(stderr, "{}{}\n", messages[a] == ' ' ? "" : "pathlab: ", messages.substr(a, b - a));
         a = b + 1;
     }
 }
@@ -490,8 +491,11 @@ int run_render_command(const RenderCommandOptions& o, RankGroup* ranks) {
         job.settings.done = *PassSet::parse(done_text);
         if (!checkpoints[j].empty()) {
             job.settings.checkpoint_every = o.checkpoint_every;
-            job.settings.checkpoint = [&, j](RankGroup& parts, const Film& film, const PassSet& done, const RenderStats& st) {
-                const CheckpointInfo info{identity, done, width, height, seconds_before + st.seconds, PATHLAB_VERSION};
+            const std::string command =
+                checkpoint_command(job.scene_choice(), o.algorithm_given ? job.integrator_info().name : "", o.given);
+            job.settings.checkpoint = [&, j, command](RankGroup& parts, const Film& film, const PassSet& done, const RenderStats& st) {
+                CheckpointInfo info{identity, done, width, height, seconds_before + st.seconds, PATHLAB_VERSION};
+                info.command = command;
                 try {
                     write_checkpoint(checkpoints[j], parts, film, info);
                     return true;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "app/command_arguments.hpp"
+#include "app/resumed_command.hpp"
 
 namespace pathlab {
 
@@ -57,6 +58,7 @@ struct RenderCommandOptions {
     double checkpoint_every = 300;   // --checkpoint-every SECONDS
     std::string resume;              // --resume FILE
     uint64_t first_sample = 0;       // --first-sample N
+    OptionGroups given;              // the options given, which checkpoints record (resumed_command.hpp)
 };
 
 class RankGroup;

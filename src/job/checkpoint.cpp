@@ -19,7 +19,8 @@ constexpr size_t kChunkPixels = size_t(1) << 14;  // 2.5 MiB per write
 
 std::string header_text(const CheckpointInfo& info) {
     return info.identity.to_text() + fmt::format("passes={}\nwidth={}\nheight={}\nseconds={}\npathlab={}\n", info.passes.to_string(),
-                                                 info.width, info.height, info.seconds, info.writer);
+                                                 info.width, info.height, info.seconds, info.writer) +
+           (info.command.empty() ? "" : "command=" + info.command + "\n");
 }
 
 uint32_t le32(const uint8_t* p) { return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24; }
@@ -70,6 +71,7 @@ public:
                 else if (key == "height") info.height = std::stoi(value);
                 else if (key == "seconds") info.seconds = std::stod(value);
                 else if (key == "pathlab") info.writer = value;
+                else if (key == "command") info.command = value;
                 else info.identity.fields.emplace_back(key, value);
             } catch (const std::exception&) {
                 throw bad(fmt::format("corrupted: header line '{}'", line));

@@ -44,6 +44,7 @@ struct CheckpointInfo {
     int width = 0, height = 0;
     double seconds = 0;  // time spent rendering it, over every run so far
     std::string writer;  // the pathlab version that wrote it
+    std::string command;  // the command that continues it (app/resumed_command.hpp); "" from before it was recorded
 };
 
 // Writes `path` atomically from the ranks' films summed (parts.reduce_film; a collective: call

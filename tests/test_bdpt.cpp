@@ -14,6 +14,7 @@
 
 #include "integrators/bidir/bdpt.hpp"
 #include "integrators/bidir/strategy_images.hpp"
+#include "image/image_io.hpp"
 #include "integrators/integrators.hpp"
 #include "judge/image_statistics.hpp"
 #include "render_helpers.hpp"
@@ -162,8 +163,41 @@ TEST_P(BdptStrategies, EachLengthsStrategiesAddUpAndConverge) {
             for (int c = 0; c < 3; ++c)
                 ASSERT_NEAR(sum[i][c], mine[i][c], 1e-5f * std::max(1.0f, mine[i][c])) << "length " << n << ", pixel " << i;
     }
-    EXPECT_TRUE(std::filesystem::exists(dir + "/montage-weighted.png"));
-    EXPECT_TRUE(std::filesystem::exists(dir + "/montage-unweighted.png"));
+    // The montages: labels in their top and left margins (white text on black), and each row
+    // (path length) at an exposure of its own, so that every row shows its light (one exposure
+    // for all left the longer paths black).
+    for (const char* name : {"/montage-weighted.png", "/montage-unweighted.png"}) {
+        const Image8 m = read_png8(dir + name);
+        const int cols = kDepth + 2, gap = 2, top = 14, left = m.width - (cols * (kW + gap) - gap);
+        ASSERT_EQ(m.height, top + (kDepth + 1) * (kH + gap) - gap) << name;
+        ASSERT_GT(left, 20) << name << ": room for the row labels";
+        const auto white = [&](int x0, int x1, int y0, int y1) {
+            int n = 0;
+            for (int y = y0; y < y1; ++y)
+                for (int x = x0; x < x1; ++x) n += m.at(x, y, 0) == 255 && m.at(x, y, 1) == 255 && m.at(x, y, 2) == 255;
+            return n;
+        };
+        EXPECT_GT(white(left, m.width, 0, top), 20) << name << ": the s labels";
+        int rows_lit = 0;
+        for (int n = 0; n <= kDepth; ++n) {
+            const int y0 = top + n * (kH + gap);
+            EXPECT_GT(white(0, left, y0, y0 + kH), 10) << name << ": the label of row " << n;
+            std::vector<double> lit;  // the row's lit pixels' luminance, as the montage scales them
+            for (int s = 0; s <= n + 1; ++s) {
+                if (s == 1 && n == 0) continue;
+                for (int y = y0; y < y0 + kH; ++y)
+                    for (int x = left + s * (kW + gap); x < left + s * (kW + gap) + kW; ++x)
+                        if (const double l = 0.2126 * m.at(x, y, 0) + 0.7152 * m.at(x, y, 1) + 0.0722 * m.at(x, y, 2); l > 0) lit.push_back(l);
+            }
+            if (lit.empty()) continue;  // no light of this length here (strategies.xml's light is not seen directly)
+            ++rows_lit;
+            std::nth_element(lit.begin(), lit.begin() + lit.size() / 2, lit.end());
+            // 0.18 in sRGB is 118 of 255; the rounding of 8 bits and the cells' colours move it.
+            EXPECT_GT(lit[lit.size() / 2], 80) << name << ": row " << n << " is too dark to read";
+            EXPECT_LT(lit[lit.size() / 2], 160) << name << ": row " << n;
+        }
+        EXPECT_GE(rows_lit, kDepth) << name;
+    }
     std::filesystem::remove_all(dir);
 }
 INSTANTIATE_TEST_SUITE_P(Scenes, BdptStrategies,

@@ -494,8 +494,7 @@ int run_render_command(const RenderCommandOptions& o, RankGroup* ranks) {
             const std::string command =
                 checkpoint_command(job.scene_choice(), o.algorithm_given ? job.integrator_info().name : "", o.given);
             job.settings.checkpoint = [&, j, command](RankGroup& parts, const Film& film, const PassSet& done, const RenderStats& st) {
-                CheckpointInfo info{identity, done, width, height, seconds_before + st.seconds, PATHLAB_VERSION};
-                info.command = command;
+                CheckpointInfo info{identity, done, width, height, seconds_before + st.seconds, PATHLAB_VERSION, command};
                 try {
                     write_checkpoint(checkpoints[j], parts, film, info);
                     return true;

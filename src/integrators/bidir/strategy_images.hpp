@@ -1,7 +1,10 @@
 // One image per BDPT strategy (s, t), weighted and unweighted, for paths of up to L bounces
 // (`--strategies DIR`), and a montage laid out like Veach's thesis figure 10.3: a row per path
 // length (0 to L bounces, top to bottom), a column per number of light vertices s (t = length +
-// 2 - s), black where no strategy exists (t = 0, and s = t = 1, which bdpt does not use).
+// 2 - s), black where no strategy exists (t = 0, and s = t = 1, which bdpt does not use);
+// columns labelled s=K, rows n=K with the factor that row is scaled by (the median luminance of
+// its lit pixels to 0.18: each row has an exposure of its own, since longer paths carry less
+// light).
 // The weighted images of one length add up to that length's part of the bdpt image. Each is a
 // film of its own (one sample per pixel and pass), so each carries its standard errors.
 //

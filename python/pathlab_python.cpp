@@ -250,6 +250,19 @@ py::object to_python(const nlohmann::json& j) {
 }  // namespace
 
 PYBIND11_MODULE(pathlab, m) {
+    // Images come and go as NumPy arrays: without NumPy, say so at import, naming this
+    // interpreter (a python3 first on PATH, pyenv's or a virtualenv's, often lacks it), not at
+    // the first render as "No module named 'numpy'".
+    try {
+        py::module_::import("numpy");
+    } catch (py::error_already_set& e) {
+        const py::module_ sys = py::module_::import("sys");
+        const std::string exe = py::str(sys.attr("executable")), version = py::str(sys.attr("version")).cast<std::string>().substr(0, 6);
+        throw py::import_error(fmt::format(
+            "pathlab needs NumPy, which this Python ({}, {}) cannot import ({}): install it for this interpreter ({} -m pip install "
+            "numpy), or use /usr/bin/python3 with Debian's python3-numpy (scripts/install-deps.sh installs it)",
+            exe, version, e.what(), exe));
+    }
     m.doc() = "pathlab: a physically based Monte Carlo renderer and light-transport laboratory (see README, Python)";
     m.attr("__version__") = PATHLAB_VERSION;
 

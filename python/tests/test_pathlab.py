@@ -8,6 +8,7 @@ import json
 import os
 import signal
 import subprocess
+import sys
 import threading
 import time
 
@@ -28,6 +29,15 @@ def cli(*args):
 
 def same_bits(a, b):
     return a.shape == b.shape and a.dtype == b.dtype and np.array_equal(a.view(np.uint32), b.view(np.uint32))
+
+
+def test_import_without_numpy_says_which_python_lacks_it():
+    # sys.modules['numpy'] = None makes `import numpy` fail, as in a Python without NumPy.
+    code = "import sys; sys.modules['numpy'] = None; import pathlab"
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert r.returncode != 0
+    assert "ImportError: pathlab needs NumPy, which this Python (" + sys.executable in r.stderr, r.stderr
+    assert "-m pip install numpy" in r.stderr, r.stderr
 
 
 def test_lists_the_scenes_and_the_estimators():

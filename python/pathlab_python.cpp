@@ -29,6 +29,7 @@
 #include "image/image_io.hpp"
 #include "integrators/integrator.hpp"
 #include "job/render_job.hpp"
+#include "lights/light_sampler.hpp"
 #include "job/scene_choice.hpp"
 #include "job/usage_error.hpp"
 #include "judge/image_compare.hpp"
@@ -189,7 +190,8 @@ RenderResult run_interruptibly(RenderJob& job) {
 }
 
 py::tuple py_render(const py::object& scene_obj, const py::object& algorithm, std::optional<uint64_t> spp, uint64_t seed, int threads,
-                 double time, const py::object& resolution, std::optional<int> max_depth, const py::object& sampler) {
+                 double time, const py::object& resolution, std::optional<int> max_depth, const py::object& sampler, bool spectral,
+                 std::optional<int> rr_depth, const py::object& light_sampler, std::optional<int> ris_candidates) {
     std::shared_ptr<PyScene> scene = scene_argument(scene_obj);
     JobRequest request;
     if (!algorithm.is_none()) {
@@ -206,6 +208,17 @@ py::tuple py_render(const py::object& scene_obj, const py::object& algorithm, st
     request.time_limit = time;
     request.seed = seed;
     request.max_depth = max_depth;
+    // As the command line's --spectral, --rr-depth, --light-sampler and --ris-candidates (RenderJob
+    // refuses what an estimator does not do, as there).
+    request.spectral = spectral;
+    if (rr_depth && *rr_depth < 0) throw py::value_error("rr_depth must be zero or positive");
+    request.rr_depth = rr_depth;
+    if (!light_sampler.is_none()) {
+        const std::string name = string_argument(light_sampler, "light_sampler", kLightSamplerNames);
+        request.light_sampler = parse_light_sampler(name);
+        if (!request.light_sampler) throw py::value_error(fmt::format("unknown light sampler '{}'; valid: {}", name, kLightSamplerNames));
+    }
+    request.ris_candidates = ris_candidates;
     if (!resolution.is_none()) {
         const auto size = py::isinstance<py::tuple>(resolution) || py::isinstance<py::list>(resolution)
                               ? std::optional<std::vector<int>>(resolution.cast<std::vector<int>>())
@@ -220,11 +233,21 @@ py::tuple py_render(const py::object& scene_obj, const py::object& algorithm, st
     request.sampler = sampler_name == "sobol" ? SamplerKind::Sobol : SamplerKind::Independent;
     if (threads < 0) throw py::value_error("threads must be 0 (all cores) or positive");
 
-    if (!scene->built) scene->built = std::shared_ptr<const Scene>(Scene::build(scene->choice.description));
-    RenderJob job = translating([&] { return RenderJob(scene->choice, request, scene->built); });
+    // The scene's BVH is built once and shared by its renders with the default light sampler in
+    // RGB; another light sampler, or spectral mode (which checks the scene's materials first),
+    // builds the scene for that render.
+    std::optional<RenderJob> job;
+    translating([&] {
+        job.emplace(scene->choice, request);
+        const IntegratorOptions& o = job->integrator_options();
+        if (o.spectral || o.light_sampler != LightSamplerKind::Power) return 0;
+        if (!scene->built) scene->built = std::shared_ptr<const Scene>(Scene::build(scene->choice.description));
+        job.emplace(scene->choice, request, scene->built);
+        return 0;
+    });
     std::optional<tbb::global_control> limit;
     if (threads > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, size_t(threads));
-    const RenderResult r = run_interruptibly(job);
+    const RenderResult r = run_interruptibly(*job);
     return py::make_tuple(to_array(r.film.mean()), to_array(r.film.standard_error()));
 }
 
@@ -295,11 +318,14 @@ PYBIND11_MODULE(pathlab, m) {
           "A built-in scene (course index, name or acronym) or a scene file, with values for its $name parameters");
     m.def("render", &py_render, py::arg("scene"), py::arg("algorithm") = py::none(), py::arg("spp") = py::none(), py::arg("seed") = 1234,
           py::arg("threads") = 0, py::kw_only(), py::arg("time") = 0.0, py::arg("resolution") = py::none(), py::arg("max_depth") = py::none(),
-          py::arg("sampler") = "independent",
+          py::arg("sampler") = "independent", py::arg("spectral") = false, py::arg("rr_depth") = py::none(),
+          py::arg("light_sampler") = py::none(), py::arg("ris_candidates") = py::none(),
           "Renders a scene (a pathlab.Scene, or what load() takes) and returns (image, standard_error), float32 arrays of shape\n"
           "(height, width, 3). As the command line: algorithm defaults to the scene file's integrator, else pt-mis; spp to the\n"
           "scene file's sample count, else 64 (unlimited with time=seconds); seed to 1234; threads=0 uses all cores. The same\n"
-          "settings give the same bytes as `pathlab SCENE -a ALGORITHM --spp N --seed S -o out.exr`.");
+          "settings give the same bytes as `pathlab SCENE -a ALGORITHM --spp N --seed S -o out.exr`; spectral, rr_depth,\n"
+          "light_sampler ('uniform', 'power', 'bvh', 'ris') and ris_candidates are --spectral, --rr-depth, --light-sampler and\n"
+          "--ris-candidates.");
     m.def("compare", [](const py::object& a, const py::object& b) {
         const Image ia = to_image(a, "a"), ib = to_image(b, "b");
         if (ia.width() != ib.width() || ia.height() != ib.height())

@@ -61,17 +61,26 @@ def test_load_takes_indices_names_and_files_with_defines():
     ("3", "pt-mis", []),
     ("4", "bdpt", []),  # splats: the light-tracing strategy
     ("scenes/example.xml", "direct-mis", ["-D", "spp=2"]),
+    ("3", "pt-mis", ["--spectral", "--rr-depth", "1"]),
+    ("scenes/many-lights.xml", "direct-mis", ["--light-sampler", "ris", "--ris-candidates", "3"]),
 ])
 def test_render_equals_the_command_line_bit_for_bit(tmp_path, scene, algorithm, extra):
     path = os.path.join(SOURCE, scene) if scene.endswith(".xml") else scene
     out = tmp_path / "cli.exr"
     cli(path, "-a", algorithm, "--spp", 3, "--seed", 77, "--resolution", "20x14", "-q", "-o", out, *extra)
-    defines = dict([extra[1].split("=")]) if extra else {}
-    img, stderr = pathlab.render(pathlab.load(path, defines=defines), algorithm=algorithm, spp=3, seed=77, resolution=(20, 14))
+    defines = dict([extra[1].split("=")]) if extra[:1] == ["-D"] else {}
+    # The same options by keyword: --light-sampler ris -> light_sampler="ris", --spectral -> spectral=True.
+    options = {}
+    for i, word in enumerate(extra):
+        if word.startswith("--"):
+            value = extra[i + 1] if i + 1 < len(extra) and not extra[i + 1].startswith("-") else True
+            options[word[2:].replace("-", "_")] = int(value) if isinstance(value, str) and value.isdigit() else value
+    img, stderr = pathlab.render(pathlab.load(path, defines=defines), algorithm=algorithm, spp=3, seed=77, resolution=(20, 14), **options)
     assert img.dtype == np.float32 and img.shape == (14, 20, 3) and stderr.shape == (14, 20, 3)
     assert same_bits(img, pathlab.read(str(out)))
     # Any thread count, and a scene reused for a second render, give the same bytes.
-    again, _ = pathlab.render(pathlab.load(path, defines=defines), algorithm=algorithm, spp=3, seed=77, resolution=(20, 14), threads=1)
+    again, _ = pathlab.render(pathlab.load(path, defines=defines), algorithm=algorithm, spp=3, seed=77, resolution=(20, 14), threads=1,
+                              **options)
     assert same_bits(img, again)
 
 

@@ -293,7 +293,7 @@ TEST_F(Distributed, ResumeWithoutTheCommandLineContinuesTheRender) {
     ASSERT_EQ(with({"--spp", "4", "--checkpoint", path("c.ckpt"), "-o", path("part.exr")}).code, 0);
     const CliResult info = run({"info", path("c.ckpt")});
     EXPECT_TRUE(contains(info.out, "pathlab:command: pathlab render ceiling-glossy --algorithm sppm --spp 4 --resolution 16x12 --seed 5 "
-                                   "--output " + path("part.exr") + " --checkpoint " + path("c.ckpt") + " --quiet"))
+                                   "--output " + path("part.exr") + " --quiet"))
         << info.out;
     // Another seed beside it: not this checkpoint's render.
     const CliResult seed = run({"--resume", path("c.ckpt"), "--spp", "9", "--seed", "6", "-o", path("b.exr")});
@@ -311,6 +311,12 @@ TEST_F(Distributed, ResumeWithoutTheCommandLineContinuesTheRender) {
     const CliResult fewer = run({"--resume", path("c.ckpt"), "--spp", "2"});
     EXPECT_EQ(fewer.code, 2);
     EXPECT_TRUE(contains(fewer.err, "raise --spp")) << fewer.err;
+    // A copy resumed checkpoints to itself, not to the file its first run wrote.
+    fs::copy_file(path("c.ckpt"), path("copy.ckpt"));
+    const std::string original = file_bytes(path("c.ckpt"));
+    ASSERT_EQ(run({"--resume", path("copy.ckpt"), "--spp", "12", "-o", path("copy.exr")}).code, 0);
+    EXPECT_EQ(read_checkpoint_info(path("copy.ckpt")).passes.to_string(), "0-11");
+    EXPECT_TRUE(file_bytes(path("c.ckpt")) == original) << "the first run's checkpoint is left alone";
     // A file that is not a checkpoint is named.
     const CliResult bad = run({"--resume", path("whole.exr")});
     EXPECT_EQ(bad.code, 2);

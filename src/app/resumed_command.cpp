@@ -11,8 +11,16 @@
 namespace pathlab {
 namespace {
 
-// The options a checkpoint's command leaves out: the scene (recorded on its own) and --resume.
-bool recorded(const std::string& name) { return name != "--scene" && name != "--resume"; }
+// The options a checkpoint's command leaves out: the scene (recorded on its own), --resume, and
+// --checkpoint (a resumed render goes on checkpointing to the file it resumes, not to where the
+// first run did, unless --checkpoint is given again).
+bool recorded(const std::string& name) { return name != "--scene" && name != "--resume" && name != "--checkpoint"; }
+
+// Options naming files the render writes: recorded by absolute path, so that resuming from
+// another folder writes where the first run did.
+bool names_a_file(const std::string& name) {
+    return name == "--output" || name == "--stats" || name == "--strategies" || name == "--ic-records";
+}
 
 }  // namespace
 
@@ -27,7 +35,8 @@ OptionGroups given_options(const CLI::App& app) {
             continue;
         }
         // One group per value: -D a=1 -D b=2, -o x.exr -o x.png.
-        for (const std::string& value : opt->results()) groups.push_back({name, value});
+        for (const std::string& value : opt->results())
+            groups.push_back({name, names_a_file(name) && !value.empty() ? std::filesystem::absolute(value).lexically_normal().string() : value});
     }
     return groups;
 }

@@ -1,6 +1,7 @@
 // The command a checkpoint continues: `pathlab --resume r.ckpt` alone carries on the render the
 // checkpoint holds. A checkpoint records its render's command (its scene, a file by its absolute
-// path, and the options given, -a naming that render's estimator), as JSON:
+// path, and the options given: -a naming that render's estimator, outputs by absolute path, and
+// not --checkpoint, since a resumed render checkpoints to the file it resumes), as JSON:
 //   [["/abs/scene.xml"], ["-a", "bdpt"], ["--spp", "256"], ["-D", "x=1"], ["-q"]]
 // Resuming without a scene runs that command with the options given now replacing its own;
 // whatever then differs from the checkpoint's render (scene, estimator, its options, size, seed,

@@ -18,7 +18,8 @@ void embree_error(void*, RTCError code, const char* message) {
 
 void throw_on_device_error(RTCDevice device, const char* what) {
     if (const RTCError e = rtcGetDeviceError(device); e != RTC_ERROR_NONE)
-        throw std::runtime_error(fmt::format("Embree failed to {} (error {})", what, int(e)));
+        throw std::runtime_error(e == RTC_ERROR_OUT_OF_MEMORY ? fmt::format("Embree ran out of memory to {} (the scene is too large)", what)
+                                                              : fmt::format("Embree failed to {} (error {})", what, int(e)));
 }
 
 // Nearest root t of |o + t d - c| = r with tmin < t < tmax, in double precision, using the
@@ -122,15 +123,26 @@ Accel::~Accel() {
 
 namespace {
 
+// A triangle mesh's geometry (not committed). Embree returns null geometries and buffers when it
+// runs out of memory (a scene of millions of shapes): an error, not a write through null.
 RTCGeometry mesh_geometry(RTCDevice device_, const MeshDesc& mesh) {
     RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+    if (!geom) {
+        throw_on_device_error(device_, "add a mesh");
+        throw std::runtime_error("Embree could not add a mesh");
+    }
     auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
                                                           3 * sizeof(float), mesh.positions.size()));
+    auto* idx = v ? static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                                   3 * sizeof(uint32_t), mesh.triangles.size()))
+                  : nullptr;
+    if (!v || !idx) {
+        rtcReleaseGeometry(geom);
+        throw_on_device_error(device_, fmt::format("store a mesh of {} triangles", mesh.triangles.size()).c_str());
+        throw std::runtime_error(fmt::format("Embree could not store a mesh of {} triangles", mesh.triangles.size()));
+    }
     std::memcpy(v, mesh.positions.data(), mesh.positions.size() * sizeof(Vec3f));
-    auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                               3 * sizeof(uint32_t), mesh.triangles.size()));
     std::memcpy(idx, mesh.triangles.data(), mesh.triangles.size() * 3 * sizeof(uint32_t));
-    rtcCommitGeometry(geom);
     return geom;
 }
 
@@ -142,6 +154,7 @@ uint32_t Accel::add_group(const std::vector<MeshDesc>& meshes) {
     groups_.push_back(group);
     for (const MeshDesc& m : meshes) {
         RTCGeometry geom = mesh_geometry(device_, m);
+        rtcCommitGeometry(geom);
         rtcAttachGeometry(group, geom);
         rtcReleaseGeometry(geom);
     }
@@ -165,13 +178,7 @@ uint32_t Accel::add_instance(uint32_t group, const Transform& t) {
 }
 
 uint32_t Accel::add_mesh(const MeshDesc& mesh) {
-    RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                          3 * sizeof(float), mesh.positions.size()));
-    std::memcpy(v, mesh.positions.data(), mesh.positions.size() * sizeof(Vec3f));
-    auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                               3 * sizeof(uint32_t), mesh.triangles.size()));
-    std::memcpy(idx, mesh.triangles.data(), mesh.triangles.size() * 3 * sizeof(uint32_t));
+    RTCGeometry geom = mesh_geometry(device_, mesh);
     rtcSetGeometryMask(geom, mesh.media.index_matched ? kMaskMediumBoundaries : kMaskSurfaces);
     rtcCommitGeometry(geom);
     const uint32_t id = rtcAttachGeometry(scene_, geom);
@@ -183,6 +190,10 @@ uint32_t Accel::add_mesh(const MeshDesc& mesh) {
 uint32_t Accel::add_sphere(const SphereDesc& sphere) {
     spheres_.push_back(std::make_unique<SphereDesc>(sphere));
     RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_USER);
+    if (!geom) {
+        throw_on_device_error(device_, "add a sphere");
+        throw std::runtime_error("Embree could not add a sphere");
+    }
     rtcSetGeometryUserPrimitiveCount(geom, 1);
     rtcSetGeometryUserData(geom, spheres_.back().get());
     rtcSetGeometryBoundsFunction(geom, sphere_bounds, nullptr);
@@ -192,6 +203,7 @@ uint32_t Accel::add_sphere(const SphereDesc& sphere) {
     rtcCommitGeometry(geom);
     const uint32_t id = rtcAttachGeometry(scene_, geom);
     rtcReleaseGeometry(geom);
+    throw_on_device_error(device_, "add a sphere");
     return id;
 }
 

@@ -7,7 +7,10 @@
 #include <fstream>
 #include <sstream>
 
+#include <sys/wait.h>
 #include <unistd.h>
+
+#include <fmt/format.h>
 
 #include "cli_runner.hpp"
 #include "core/memory.hpp"
@@ -150,6 +153,24 @@ TEST_F(CliLimits, PhotonMapsAndStrategyImagesTooLargeForMemoryAreRefusedUpFront)
     EXPECT_FALSE(fs::exists(path("b.pfm")));
     // what fits still renders
     EXPECT_EQ(run({"-s", "2", "-a", "pm", "--photons", "2000", "--resolution", "8x8", "--spp", "1", "-q", "-o", path("p.pfm")}).code, 0);
+}
+
+// The memory a render may take is also bounded by its address-space limit (ulimit -v, as batch
+// systems set it) and its cgroup: under a 3 GB limit, 20 million light paths of pm (5.4 GiB of
+// photons) are refused up front; they ran 31 s and ended in std::bad_alloc when only the
+// machine's free memory was read.
+TEST_F(CliLimits, AnAddressSpaceLimitBoundsTheMemoryCheck) {
+    const std::string err = path("err.txt");
+    const std::string command = fmt::format("(ulimit -v 3000000; timeout -s KILL 120 {} 1 -a pm --photons 20000000 --resolution 16x16 --spp 1 -q -o {}) 2> {}",
+                                            PATHLAB_BINARY, path("pm.pfm"), err);
+    const int status = std::system(command.c_str());
+    ASSERT_TRUE(WIFEXITED(status)) << "killed by a signal";
+    EXPECT_EQ(WEXITSTATUS(status), 1);
+    std::ifstream in(err);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_TRUE(contains(text, "pm's 20000000 light paths (about ")) << text;
+    EXPECT_TRUE(contains(text, "GiB is available: lower --photons")) << text;
+    EXPECT_FALSE(fs::exists(path("pm.pfm")));
 }
 
 // --strategies writes at most 32 bounces (594 strategies, 2,376 files): 10^6 with unlimited

@@ -11,7 +11,8 @@
 
 namespace pathlab {
 
-// Memory this machine can still give (MemAvailable of /proc/meminfo), or 0 when unknown.
+// Memory this process can still take: MemAvailable of /proc/meminfo, lowered by its address-space
+// limit (ulimit -v) and its cgroup's memory.max; 0 when unknown.
 uint64_t available_memory();
 
 // Bytes in GiB, for messages.

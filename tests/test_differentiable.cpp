@@ -421,6 +421,29 @@ TEST(DiffCli, ParamsNamesAreAcceptedByOptimize) {
     EXPECT_EQ(bad.code, 2);
     EXPECT_TRUE(test::contains(bad.err, "unknown parameter 'red.albedo'")) << bad.err;
     EXPECT_TRUE(test::contains(bad.err, "green.reflectance.value")) << bad.err;
+    // --out naming the folder of a file they read (optimize's scene.xml was written over the
+    // scene, final.exr over a target of that name) is refused, and the file is left as it was.
+    // (opt/scene.xml is the scene optimize wrote above: a scene file like any other.)
+    const std::string before = [&] {
+        std::ifstream in(dir / "opt" / "scene.xml");
+        return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    }();
+    for (const std::string command : {"optimize", "gradient"}) {
+        auto args = [&](const std::string& scene_file, const std::string& target_file) {
+            std::vector<std::string> a = {command, "--scene", scene_file, "--target", target_file, "--params", "red.reflectance.value",
+                                          "--spp", "1", "--out", out};
+            if (command == "optimize") a.insert(a.end(), {"--iterations", "1", "-q"});
+            return a;
+        };
+        const test::CliResult over = test::run(args(out + "/scene.xml", target));
+        EXPECT_EQ(over.code, 2) << command;
+        EXPECT_TRUE(test::contains(over.err, "--out " + out + " holds " + out + "/scene.xml, which " + command + " reads")) << over.err;
+        const test::CliResult target_there = test::run(args(scene, out + "/final.exr"));
+        EXPECT_EQ(target_there.code, 2) << command;
+        EXPECT_TRUE(test::contains(target_there.err, "holds " + out + "/final.exr")) << target_there.err;
+    }
+    std::ifstream in(dir / "opt" / "scene.xml");
+    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()), before);
     fs::remove_all(dir);
 }
 

@@ -216,6 +216,25 @@ nlohmann::json gradient_json(const ParameterSet& set, const std::vector<double>&
     return j;
 }
 
+// gradient and optimize write images, scene.xml, textures and JSON under fixed names in --out:
+// a folder that holds a file they read (the scene file, a texture or mesh it reads, the target)
+// is refused, since one of those names may be that file (optimize's scene.xml over the scene).
+void refuse_out_dir_with_inputs(const std::string& out_dir, const SceneChoice& scene, const std::string& target, const char* command) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    const fs::path dir = fs::weakly_canonical(fs::absolute(out_dir), ec);
+    if (ec) return;
+    std::vector<std::string> inputs = scene.files;
+    if (!target.empty()) inputs.push_back(target);
+    for (const std::string& in : inputs) {
+        const fs::path p = fs::weakly_canonical(fs::absolute(in), ec);
+        if (ec) continue;
+        if (p.parent_path() == dir)
+            throw UsageError(fmt::format("--out {} holds {}, which {} reads: its outputs there could replace it; choose another folder",
+                                         out_dir, in, command));
+    }
+}
+
 }  // namespace
 
 // ---- params ------------------------------------------------------------------------------
@@ -278,6 +297,7 @@ int run_gradient_command(const GradientOptions& o) {
     }
     if (!o.common.resolution.empty()) parse_resolution_option(o.common.resolution, w, h);
     const DiffSettings s = settings_of(o.common, w, h);
+    refuse_out_dir_with_inputs(o.out_dir, scene, o.target, "gradient");
     const std::unique_ptr<Scene> built = Scene::build(scene.description);
     std::filesystem::create_directories(o.out_dir);
     const Image primal = render_primal(*built, s);
@@ -364,6 +384,7 @@ int run_optimize_command(const OptimizeOptions& o) {
     Optimizer opt(usage_on_invalid([&] { return parse_optimizer_kind(o.optimizer); }), o.lr, size_t(set.size));
     if (o.iterations < 0) throw UsageError("--iterations must not be negative");
     if (!(o.lr > 0)) throw UsageError("--lr must be positive");
+    refuse_out_dir_with_inputs(o.out_dir, scene, o.target, "optimize");
     std::filesystem::create_directories(o.out_dir);
     check_writable_path(o.out_dir + "/loss.json");
 

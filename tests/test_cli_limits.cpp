@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -171,6 +172,33 @@ TEST_F(CliLimits, AnAddressSpaceLimitBoundsTheMemoryCheck) {
     EXPECT_TRUE(contains(text, "pm's 20000000 light paths (about ")) << text;
     EXPECT_TRUE(contains(text, "GiB is available: lower --photons")) << text;
     EXPECT_FALSE(fs::exists(path("pm.pfm")));
+}
+
+// A named pipe where a file is read (an image, a checkpoint, a mapping, a spectrum) is refused
+// as not a regular file; opening one waited for a writer for ever. Run under `timeout`, so that
+// a regression fails (exit 124) rather than hangs.
+TEST_F(CliLimits, NamedPipesAreRefusedNotWaitedOn) {
+    for (const char* name : {"p.exr", "p.ckpt", "p.map", "p.spd"}) ASSERT_EQ(::mkfifo(path(name).c_str(), 0600), 0) << name;
+    ASSERT_EQ(run({"1", "--spp", "1", "--resolution", "4x4", "-q", "-o", path("a.exr")}).code, 0);
+    std::ofstream(path("s.xml")) << "<scene version=\"3.0.0\"><bsdf type=\"diffuse\" id=\"m\"><spectrum name=\"reflectance\" "
+                                    "filename=\"p.spd\"/></bsdf><shape type=\"sphere\"><ref id=\"m\"/></shape><emitter type=\"constant\"/></scene>";
+    const std::string bin = PATHLAB_BINARY;
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {"info " + path("p.exr"), "p.exr: not a regular file"},
+        {"info " + path("p.ckpt"), "p.ckpt"},
+        {"merge " + path("m.exr") + " " + path("a.exr") + " " + path("p.exr"), "p.exr: not a regular file"},
+        {"merge " + path("m.exr") + " " + path("a.exr") + " " + path("p.ckpt"), "p.ckpt"},
+        {"check 1 -a pt-mis --references " + dir_.string() + " --mapping " + path("p.map"), "p.map: cannot read the mapping file: not a regular file"},
+        {path("s.xml") + " --resolution 4x4 --spp 1 -q -o " + path("s.exr"), "p.spd': not a regular file"},
+    };
+    for (const auto& [args, message] : cases) {
+        const int status = std::system(fmt::format("timeout 20 {} {} 2> {}", bin, args, path("err.txt")).c_str());
+        ASSERT_TRUE(WIFEXITED(status)) << args;
+        EXPECT_EQ(WEXITSTATUS(status), 2) << args << " (124: it waited on the pipe)";
+        std::ifstream in(path("err.txt"));
+        const std::string err((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        EXPECT_TRUE(contains(err, message)) << args << ": " << err;
+    }
 }
 
 // --strategies writes at most 32 bounces (594 strategies, 2,376 files): 10^6 with unlimited

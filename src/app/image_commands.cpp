@@ -80,13 +80,6 @@ CLI::App* add_info_command(CLI::App& app, InfoOptions& o) {
 
 namespace {
 
-// Whether the file begins as a checkpoint does (job/checkpoint.hpp).
-bool is_checkpoint_file(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    char magic[sizeof kCheckpointMagic] = {};
-    return in.read(magic, sizeof magic) && std::equal(std::begin(magic), std::end(magic), std::begin(kCheckpointMagic));
-}
-
 // A checkpoint described as info describes an image: its render's identity as the metadata
 // (the fields an EXR of that render carries, pathlab:scene ...), the passes it holds, the
 // time spent and the version that wrote it; the image is the film's mean so far.

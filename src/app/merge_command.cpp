@@ -41,16 +41,10 @@ struct MergeInput {
     Image mean, standard_error;         // an EXR
 };
 
-bool is_checkpoint(const std::string& path) {
-    char head[8] = {};
-    std::ifstream(path, std::ios::binary).read(head, 8);
-    return std::memcmp(head, kCheckpointMagic, 8) == 0;
-}
-
 MergeInput read_input(const std::string& path) {
     MergeInput in;
     in.path = path;
-    if (is_checkpoint(path)) {
+    if (is_checkpoint_file(path)) {
         Checkpoint c;
         try {
             c = read_checkpoint(path);

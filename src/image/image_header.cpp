@@ -21,6 +21,7 @@
 #include <ImfVecAttribute.h>
 
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 
@@ -130,6 +131,8 @@ ImageHeader exr_header(const std::string& path) {
 
 // The first `max` bytes of a file.
 std::string file_prefix(const std::string& path, size_t max) {
+    std::error_code ec;  // checked before it is opened: a named pipe would wait for a writer
+    if (!std::filesystem::is_regular_file(path, ec)) throw ImageIoError(fmt::format("{}: not a regular file", path));
     std::ifstream in(path, std::ios::binary);
     if (!in) throw ImageIoError(fmt::format("{}: cannot open", path));
     std::string s(max, '\0');
@@ -185,6 +188,8 @@ uint32_t big_endian32(const std::string& s, size_t at) {
 ImageHeader png_header(const std::string& path) {
     ImageHeader h;
     h.format = "PNG";
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec)) throw ImageIoError(fmt::format("{}: not a regular file", path));
     std::ifstream in(path, std::ios::binary);
     const std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     // Chunks after the 8-byte signature: length, type, data, CRC.

@@ -3,6 +3,8 @@
 #include <xxhash.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <cstring>
 #include <sstream>
 
@@ -178,6 +180,14 @@ Checkpoint read_checkpoint(const std::string& path) {
         }
     }
     return c;
+}
+
+bool is_checkpoint_file(const std::string& path) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec)) return false;
+    std::ifstream in(path, std::ios::binary);
+    char magic[sizeof kCheckpointMagic] = {};
+    return in.read(magic, sizeof magic) && std::memcmp(magic, kCheckpointMagic, sizeof magic) == 0;
 }
 
 }  // namespace pathlab

@@ -60,5 +60,8 @@ struct Checkpoint {
 Checkpoint read_checkpoint(const std::string& path);
 // The header only, with the file's size checked (not its checksum).
 CheckpointInfo read_checkpoint_info(const std::string& path);
+// Whether `path` is a regular file that begins as a checkpoint does (its magic); a named pipe or
+// a folder is not (and is not opened: a pipe would wait for a writer).
+bool is_checkpoint_file(const std::string& path);
 
 }  // namespace pathlab

@@ -60,6 +60,8 @@ std::string stderr_path_for(const std::string& image_path) {
 }
 
 std::map<int, std::string> read_reference_mapping(const std::string& path) {
+    std::error_code ec;  // checked before it is opened: a named pipe would wait for a writer
+    if (!fs::is_regular_file(path, ec)) throw ReferenceMappingError(fmt::format("{}: cannot read the mapping file: not a regular file", path));
     std::ifstream in(path);
     if (!in) throw ReferenceMappingError(fmt::format("{}: cannot read the mapping file", path));
     std::map<int, std::string> mapping;

@@ -350,9 +350,11 @@ std::string XmlSource::spectrum_value(const pugi::xml_node& c, const PluginInfo&
     if (c.attribute("filename")) {
         if (c.attribute("value")) fail(c, "a <spectrum> has a value or a filename, not both");
         const std::string path = find_file(c, attr(c, "filename"), "spectrum file");
-        std::ifstream in(path, std::ios::binary);
+        // Checked before it is opened: opening a named pipe waits for a writer (a hang).
         std::error_code ec;
-        if (!in || !std::filesystem::is_regular_file(path, ec)) fail(c, fmt::format("cannot read the spectrum file '{}'", path));
+        if (!std::filesystem::is_regular_file(path, ec)) fail(c, fmt::format("cannot read the spectrum file '{}': not a regular file", path));
+        std::ifstream in(path, std::ios::binary);
+        if (!in) fail(c, fmt::format("cannot read the spectrum file '{}'", path));
         // A spectrum of more than 16 MiB of text is no measured spectrum (it was read cut short,
         // silently: the spectrum of its first 16 MiB).
         const uint64_t bytes = std::filesystem::file_size(path, ec);

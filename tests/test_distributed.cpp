@@ -409,7 +409,12 @@ TEST_F(Distributed, TruncatedOrCorruptedCheckpointIsRefusedAndKept) {
         return f;
     };
     const uint64_t many = 1000;
+    // The header's time spent: "nan" over its value, the same length (a NaN or negative time
+    // was carried into every later checkpoint).
+    const size_t seconds_at = good.find("seconds=") + 8, seconds_length = good.find('\n', seconds_at) - seconds_at;
+    ASSERT_GE(seconds_length, 3u);
     const std::vector<Damage> forgeries = {
+        {"seconds not a number", forged(seconds_at, "nan" + std::string(seconds_length - 3, ' ')), "corrupted: nan seconds of rendering"},
         {"a count past the passes", forged(count_at, std::string(reinterpret_cast<const char*>(&many), 8)), "pixel 0 is invalid: 1000 samples in 2 passes"},
         {"squares smaller than the sum allows", forged(sumsq_at, std::string(sizeof(PixelSums::sumsq[0]), '\0')), "pixel 0 is invalid: channel 0"},
     };

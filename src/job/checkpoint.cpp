@@ -79,6 +79,7 @@ public:
                 throw bad(fmt::format("corrupted: header line '{}'", line));
             }
         }
+        if (!(info.seconds >= 0) || !std::isfinite(info.seconds)) throw bad(fmt::format("corrupted: {} seconds of rendering", info.seconds));
         const std::optional<PassSet> set = PassSet::parse(passes);
         if (!have_passes || !set) throw bad("corrupted: no valid list of passes in its header");
         info.passes = *set;

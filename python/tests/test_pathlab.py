@@ -185,3 +185,14 @@ def test_wrong_types_raise_type_error_naming_the_valid_values():
         pathlab.render(3, algorithm="pt-magic", spp=1)
     with pytest.raises(ValueError, match="(?s)unknown scene 'kitchen'.*ceiling-glossy"):
         pathlab.load("kitchen")
+
+
+def test_rmse_refuses_standard_errors_that_are_not_standard_errors():
+    img = np.full((4, 4, 3), 0.5, np.float32)
+    ref = np.full((4, 4, 3), 0.4, np.float32)
+    assert pathlab.rmse(img, ref) == pytest.approx(0.1, rel=1e-5)
+    for bad in (np.nan, -1.0, np.inf):
+        se = np.zeros((4, 4, 3), np.float32)
+        se[2, 1, 0] = bad
+        with pytest.raises(ValueError, match=r"standard error at pixel \(1, 2\)"):
+            pathlab.rmse(img, ref, reference_se=se)

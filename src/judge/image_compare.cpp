@@ -1,6 +1,7 @@
 #include "judge/image_compare.hpp"
 
 #include <cmath>
+#include <stdexcept>
 #include <limits>
 
 #include <fmt/format.h>
@@ -101,7 +102,15 @@ double rmse_against_reference(const Image& image, const Image& reference, const 
             const double a = image[i][c], b = reference[i][c];
             if (!std::isfinite(a) || !std::isfinite(b)) continue;
             sum_sq += (a - b) * (a - b);
-            if (noisy) noise += double(reference_se[i][c]) * reference_se[i][c];
+            if (noisy) {
+                // A NaN or negative standard error is no standard error (a NaN made the result 0).
+                const double se = reference_se[i][c];
+                if (!(se >= 0) || !std::isfinite(se))
+                    throw std::invalid_argument(fmt::format("the reference's standard error at pixel ({}, {}) is {}: standard errors are "
+                                                            "finite and not negative",
+                                                            i % size_t(reference.width()), i / size_t(reference.width()), se));
+                noise += se * se;
+            }
             ++n;
         }
     return n ? std::sqrt(std::max(0.0, (sum_sq - noise) / double(n))) : std::numeric_limits<double>::quiet_NaN();

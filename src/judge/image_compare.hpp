@@ -54,7 +54,8 @@ namespace pathlab {
 // RMSE of `image` against a Monte Carlo reference whose per-pixel standard errors are
 // `reference_se` (empty: an exact reference). The reference's own expected squared error,
 // mean(se^2), is subtracted from the mean squared difference, so a finite-spp reference
-// does not inflate the figure (clamped at 0). Non-finite pixel-channels are left out.
+// does not inflate the figure (clamped at 0). Non-finite pixel-channels are left out; a standard
+// error that is NaN, infinite or negative throws std::invalid_argument.
 double rmse_against_reference(const Image& image, const Image& reference, const Image& reference_se = {});
 
 }  // namespace pathlab

@@ -344,7 +344,11 @@ TEST_F(Tools, ReferenceThenCheckReportsOkMissingAndBlackByDesign) {
     // PASSED references of another estimator. `reference` leaves it as it is.
     const std::string good = read_text(path("refs/manifest.json"));
     for (const std::string& bad : {std::string("{\"scenes\": [ {\"file\": \"2-ceiling-diffuse.exr\","), std::string("[1, 2]"),
-                                   std::string("{\"scenes\": {}}"), std::string("{\"scenes\": [{\"file\": \"2-ceiling-diffuse.exr\", \"resolution\": [\"a\", 2]}]}")}) {
+                                   std::string("{\"scenes\": {}}"), std::string("{\"scenes\": [{\"file\": \"2-ceiling-diffuse.exr\", \"resolution\": [\"a\", 2]}]}"),
+                                   std::string("{\"scenes\": [{\"file\": \"2-ceiling-diffuse.exr\", \"resolution\": \"x\"}]}"),
+                                   std::string("{\"scenes\": [{\"file\": \"2-ceiling-diffuse.exr\", \"resolution\": [16]}]}"),
+                                   std::string("{\"scenes\": [{\"file\": \"2-ceiling-diffuse.exr\", \"spp\": -5}]}"),
+                                   std::string("{\"scenes\": [{\"file\": \"2-ceiling-diffuse.exr\", \"algorithm\": 3}]}")}) {
         std::ofstream(path("refs/manifest.json")) << bad;
         r = run({"check", "-a", "pt-mis", "--references", path("refs"), "--scene", "2", "--spp", "16"});
         EXPECT_EQ(r.code, 2) << bad << ": " << r.out << r.err;

@@ -36,6 +36,21 @@ nlohmann::json read_manifest(const fs::path& path) {
             if (!e.contains("file") || !e["file"].is_string()) throw fail("an entry of \"scenes\" has no \"file\" name");
             const std::string file = e["file"].get<std::string>();
             if (e.contains("index") && !e["index"].is_number_integer()) throw fail(fmt::format("the entry of '{}': its index is not a whole number", file));
+            // The fields check compares: of the wrong type they were read as absent, and a
+            // reference of any size or sample count PASSED.
+            if (e.contains("resolution")) {
+                const nlohmann::json& r = e["resolution"];
+                if (!r.is_array() || r.size() != 2 || !r[0].is_number_unsigned() || !r[1].is_number_unsigned() || r[0].get<uint64_t>() < 1 ||
+                    r[1].get<uint64_t>() < 1 || r[0].get<uint64_t>() > (1u << 16) || r[1].get<uint64_t>() > (1u << 16))
+                    throw fail(fmt::format("the entry of '{}': its resolution is not [width, height] in pixels", file));
+            }
+            for (const char* key : {"spp", "seed", "invalid_samples"})
+                if (e.contains(key) && !e[key].is_number_unsigned())
+                    throw fail(fmt::format("the entry of '{}': its {} is not a whole number of at least 0", file, key));
+            if (e.contains("max_depth") && !e["max_depth"].is_number_integer())
+                throw fail(fmt::format("the entry of '{}': its max_depth is not a whole number", file));
+            for (const char* key : {"scene", "algorithm", "family", "scene_hash", "scene_file"})
+                if (e.contains(key) && !e[key].is_string()) throw fail(fmt::format("the entry of '{}': its {} is not a string", file, key));
             try {
                 (void)reference_record_from_json(e);
             } catch (const nlohmann::json::exception& x) {

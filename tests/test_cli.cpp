@@ -203,6 +203,11 @@ TEST_F(Cli, SampleIndicesPastTheLastAreRefusedUpFront) {
     r = run({"-s", "2", "--first-sample", "4611686018427387902", "--spp", "2", "--resolution", "8x8", "-q", "-o", path("far.exr")});
     EXPECT_EQ(r.code, 0) << r.err;
     EXPECT_TRUE(fs::exists(path("far.exr")));
+    // --time without --spp has no last sample: it rendered passes past 2^62.
+    r = run({"-s", "2", "--first-sample", "4611686018427387900", "--time", "1", "--resolution", "8x8", "-q", "-o", path("timed.exr")});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_TRUE(contains(r.err, "with --time and no --spp may reach past the last sample index")) << r.err;
+    EXPECT_FALSE(fs::exists(path("timed.exr")));
 }
 
 // sppm's options: only with sppm, in range; a render with them runs.

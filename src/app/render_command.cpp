@@ -235,6 +235,13 @@ std::vector<RenderJob> make_jobs(const RenderCommandOptions& o, bool check_paths
         if (o.first_sample >= kMaxSampleIndex || job.settings.spp > kMaxSampleIndex - o.first_sample)
             throw UsageError(fmt::format("--first-sample {} with {} samples per pixel reaches past the last sample index, 2^62 = {}",
                                          o.first_sample, job.settings.spp, kMaxSampleIndex));
+        // A render bounded by --time alone (no spp) could run past 2^62: it must start 2^40
+        // samples before it (more than any render reaches: 10^12 passes).
+        constexpr uint64_t kTimedMargin = uint64_t(1) << 40;
+        if (job.settings.spp == 0 && o.first_sample > kMaxSampleIndex - kTimedMargin)
+            throw UsageError(fmt::format("--first-sample {} with --time and no --spp may reach past the last sample index, 2^62 = {}: "
+                                         "give --spp, or a first sample at most 2^62 - 2^40 = {}",
+                                         o.first_sample, kMaxSampleIndex, kMaxSampleIndex - kTimedMargin));
     }
     if (!(o.checkpoint_every >= 0) || !std::isfinite(o.checkpoint_every))
         throw UsageError("--checkpoint-every must be zero (only at the end) or a positive number of seconds");

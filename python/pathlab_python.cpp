@@ -240,10 +240,9 @@ py::tuple py_render(const py::object& scene_obj, const py::object& algorithm, st
     translating([&] {
         job.emplace(scene->choice, request);
         const IntegratorOptions& o = job->integrator_options();
-        if (o.spectral || o.light_sampler != LightSamplerKind::Power) return 0;
+        if (o.spectral || o.light_sampler != LightSamplerKind::Power) return;
         if (!scene->built) scene->built = std::shared_ptr<const Scene>(Scene::build(scene->choice.description));
         job.emplace(scene->choice, request, scene->built);
-        return 0;
     });
     std::optional<tbb::global_control> limit;
     if (threads > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, size_t(threads));

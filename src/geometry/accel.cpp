@@ -22,6 +22,12 @@ void throw_on_device_error(RTCDevice device, const char* what) {
                                                               : fmt::format("Embree failed to {} (error {})", what, int(e)));
 }
 
+// For a call that returned null (a geometry, a buffer): Embree's error, else a plain failure.
+[[noreturn]] void throw_failure(RTCDevice device, const std::string& what) {
+    throw_on_device_error(device, what.c_str());
+    throw std::runtime_error(fmt::format("Embree could not {}", what));
+}
+
 // Nearest root t of |o + t d - c| = r with tmin < t < tmax, in double precision, using the
 // numerically stable quadratic form (Haines et al., "Precision Improvements for Ray/Sphere
 // Intersection", Ray Tracing Gems, 2019). Returns a negative value when there is none.
@@ -127,10 +133,7 @@ namespace {
 // runs out of memory (a scene of millions of shapes): an error, not a write through null.
 RTCGeometry mesh_geometry(RTCDevice device_, const MeshDesc& mesh) {
     RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-    if (!geom) {
-        throw_on_device_error(device_, "add a mesh");
-        throw std::runtime_error("Embree could not add a mesh");
-    }
+    if (!geom) throw_failure(device_, "add a mesh");
     auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
                                                           3 * sizeof(float), mesh.positions.size()));
     auto* idx = v ? static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
@@ -138,8 +141,7 @@ RTCGeometry mesh_geometry(RTCDevice device_, const MeshDesc& mesh) {
                   : nullptr;
     if (!v || !idx) {
         rtcReleaseGeometry(geom);
-        throw_on_device_error(device_, fmt::format("store a mesh of {} triangles", mesh.triangles.size()).c_str());
-        throw std::runtime_error(fmt::format("Embree could not store a mesh of {} triangles", mesh.triangles.size()));
+        throw_failure(device_, fmt::format("store a mesh of {} triangles", mesh.triangles.size()));
     }
     std::memcpy(v, mesh.positions.data(), mesh.positions.size() * sizeof(Vec3f));
     std::memcpy(idx, mesh.triangles.data(), mesh.triangles.size() * 3 * sizeof(uint32_t));
@@ -190,10 +192,7 @@ uint32_t Accel::add_mesh(const MeshDesc& mesh) {
 uint32_t Accel::add_sphere(const SphereDesc& sphere) {
     spheres_.push_back(std::make_unique<SphereDesc>(sphere));
     RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_USER);
-    if (!geom) {
-        throw_on_device_error(device_, "add a sphere");
-        throw std::runtime_error("Embree could not add a sphere");
-    }
+    if (!geom) throw_failure(device_, "add a sphere");
     rtcSetGeometryUserPrimitiveCount(geom, 1);
     rtcSetGeometryUserData(geom, spheres_.back().get());
     rtcSetGeometryBoundsFunction(geom, sphere_bounds, nullptr);

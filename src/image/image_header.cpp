@@ -20,13 +20,14 @@
 #include <ImfTileDescriptionAttribute.h>
 #include <ImfVecAttribute.h>
 
+#include <algorithm>
 #include <cstring>
-#include <filesystem>
-#include <fstream>
 #include <iterator>
+#include <limits>
 
 #include <fmt/format.h>
 
+#include "image/file_io.hpp"
 #include "image/image_io.hpp"
 
 namespace pathlab {
@@ -129,15 +130,12 @@ ImageHeader exr_header(const std::string& path) {
     return h;
 }
 
-// The first `max` bytes of a file.
+// The first `max` bytes of a file, read as the image readers read (io::FileSource: a named pipe,
+// a device or a folder is refused, not opened and waited on).
 std::string file_prefix(const std::string& path, size_t max) {
-    std::error_code ec;  // checked before it is opened: a named pipe would wait for a writer
-    if (!std::filesystem::is_regular_file(path, ec)) throw ImageIoError(fmt::format("{}: not a regular file", path));
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw ImageIoError(fmt::format("{}: cannot open", path));
-    std::string s(max, '\0');
-    in.read(s.data(), std::streamsize(max));
-    s.resize(size_t(in.gcount()));
+    const io::FileSource source(path);
+    std::string s(size_t(std::min<uint64_t>(max, source.size())), '\0');
+    source.read(0, s.data(), s.size());
     return s;
 }
 
@@ -188,10 +186,7 @@ uint32_t big_endian32(const std::string& s, size_t at) {
 ImageHeader png_header(const std::string& path) {
     ImageHeader h;
     h.format = "PNG";
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(path, ec)) throw ImageIoError(fmt::format("{}: not a regular file", path));
-    std::ifstream in(path, std::ios::binary);
-    const std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string data = file_prefix(path, std::numeric_limits<size_t>::max());
     // Chunks after the 8-byte signature: length, type, data, CRC.
     for (size_t p = 8; p + 12 <= data.size();) {
         const uint32_t len = big_endian32(data, p);

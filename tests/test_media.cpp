@@ -418,8 +418,9 @@ TEST_F(GridFiles, VdbGridReadsBackInItsWorldSpace) {
 }
 
 // Hostile .vdb files made from a good one: OpenVDB trusts a file's layout, and looped forever on
-// a grid offset pointing backwards and on a file cut inside its header; each is refused with the
-// file and its problem before OpenVDB reads it.
+// a grid offset pointing backwards and on a file cut inside its header, and grew by gigabytes on
+// a flipped count or length; each is refused with the file and its problem, before OpenVDB reads
+// it or (the tree's counts) as its reading reaches the end of the file.
 TEST_F(GridFiles, VdbFilesWithABrokenLayoutAreRefusedBeforeOpenVdbReadsThem) {
     VoxelGrid g;
     g.res = {3, 3, 3};
@@ -441,8 +442,26 @@ TEST_F(GridFiles, VdbFilesWithABrokenLayoutAreRefusedBeforeOpenVdbReadsThem) {
         std::memcpy(bad.data() + offset, &value, 8);
         return bad;
     };
+    const auto with32 = [&](size_t offset, uint32_t value) {
+        std::string bad = good;
+        std::memcpy(bad.data() + offset, &value, 4);
+        return bad;
+    };
+    // The grid's data: its compression flags (4 bytes), its metadata count, then name, type, size
+    // and value of each entry; after the metadata its transform (a map name, 120 bytes of a
+    // uniform scale map), then the tree: buffer count, background, tile count, child count.
+    const size_t grid = at + 24, map = good.find("UniformScaleMap");
+    const auto after = [&](const std::string& text) { return good.find(text) + text.size(); };
+    ASSERT_NE(map, std::string::npos);
+    ASSERT_NE(good.find("__delayedload"), std::string::npos);
     const std::vector<std::pair<std::string, std::string>> cases = {
         {with(at, -5), "grid 1 spans bytes -5"},                        // (it looped forever)
+        {with(at, int64_t(grid) + 4), "grid 1 spans bytes"},             // (read as if it were there)
+        {with32(grid + 4, 0x7ffffff0), "grid 1 claims 2147483632 metadata entries"},  // (gigabytes)
+        {with32(grid + 8, 1u << 30), "its grid metadata name claims 1073741824 bytes"},
+        {with32(after("vec3i"), 500), "(vec3i) has 500 bytes, not 12"},  // (out of step: gigabytes)
+        {with32(after("__delayedload") + 4, 0x7fffffff), "claims 2147483647 leaf nodes"},
+        {with32(map + 15 + 120 + 12, 1u << 30), "its grid data runs past the end of the file"},  // (gigabytes)
         {with(at + 8, int64_t(1) << 40), "not within its part of the file"},
         {with(at + 16, int64_t(good.size()) + 1), "not within its part of the file"},
         {good.substr(0, 40), "it ends inside its UUID"},                // (it looped forever)

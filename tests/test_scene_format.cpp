@@ -527,9 +527,10 @@ TEST(SceneFileMeshes, PlyAndSerializedRenderAsTheSameObj) {
     EXPECT_THROW(load_ply_mesh(dir + "/bad.ply"), MeshLoadError);
 }
 
-// Hostile PLY headers are refused before Assimp reads them (issue 45): a header that never ends
+// Hostile PLY files are refused before Assimp reads them (issue 45): a header that never ends
 // (Assimp hung on it), a misspelled end_header in a binary file (Assimp crashed), counts that the
-// file cannot hold (a 198-byte file claiming 1e9 vertices grew to 9.8 GB), unknown lines.
+// file cannot hold (a 198-byte file claiming 1e9 vertices grew to 9.8 GB; a list's count),
+// unknown lines.
 TEST(SceneFileMeshes, HostilePlyHeadersAreRefusedWithTheirProblem) {
     const std::string dir = temp_dir("hostile-ply");
     const auto refused = [&](const std::string& name, const std::string& bytes, const std::string& problem) {
@@ -557,6 +558,24 @@ TEST(SceneFileMeshes, HostilePlyHeadersAreRefusedWithTheirProblem) {
     refused("no-format.ply", "ply\n" + vertex + "end_header\n", "no format line");
     refused("not-ply.ply", "PLY\nformat ascii 1.0\nend_header\n", "starts with the line 'ply'");
     refused("type.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty real x\nend_header\n0\n", "unknown property type 'real'");
+    // Lists whose count the file cannot hold: an ASCII face claiming 20 million indices, followed
+    // by 3, became a polygon of 20 million zeros (2.8 GB, exit 0); binary ones too, and negative,
+    // non-integer and cut-short counts.
+    const std::string faces = "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+    const std::string ascii = "ply\nformat ascii 1.0\n" + vertex + faces + "0 0 0\n1 0 0\n0 1 0\n";
+    refused("ascii-list.ply", ascii + "20000000 0 1 2\n", "its list 'vertex_indices' claims 20000000 values, more than the file holds");
+    refused("ascii-short.ply", ascii + "5 0 1 2\n", "the file ends inside element 'face' (item 1 of 1), in its list 'vertex_indices' of 5 values");
+    refused("ascii-count.ply", ascii + "3.5 0 1 2\n", "its list 'vertex_indices' has the count '3.5', not a count");
+    refused("ascii-negative.ply", ascii + "-3 0 1 2\n", "has the count '-3', not a count");
+    const auto binary = [&](const std::string& count_type, const std::string& count) {
+        std::string b = "ply\nformat binary_little_endian 1.0\n" + vertex + "element face 1\nproperty list " + count_type +
+                        " int vertex_indices\nend_header\n";
+        b.append(36, '\0');
+        return b + count + std::string(12, '\0');
+    };
+    refused("binary-list.ply", binary("uint", std::string("\x00\xca\x9a\x3b", 4)), "claims 1000000000 values, more than the file holds after it (12 bytes)");
+    refused("binary-negative.ply", binary("int", "\xfd\xff\xff\xff"), "claims -1 values");
+    EXPECT_EQ(load_ply_mesh((write_file(dir + "/binary.ply", binary("uchar", "\x03")), dir + "/binary.ply")).triangles.size(), 1u);
     // The smallest body the header allows is accepted (3 ASCII values need 5 bytes: "0 0 0").
     write_file(dir + "/tight.ply", "ply\nformat ascii 1.0\n" + vertex + "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
                                   "0 0 0\n1 0 0\n0 1 0\n3 0 1 2");

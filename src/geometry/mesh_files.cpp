@@ -5,6 +5,8 @@
 #include <assimp/scene.h>
 #include <zlib.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -35,10 +37,13 @@ void check_finite(const MeshDesc& m, const std::string& path) {
     if (m.triangles.empty()) throw MeshLoadError(fmt::format("mesh '{}' has no faces", path));
 }
 
-// A PLY header read and checked before Assimp sees the file (Assimp hangs on a header without
-// end_header and crashes on some broken binary ones): it must start with "ply", give its format,
-// end with end_header within kMaxPlyHeader bytes, and declare no more elements than the rest of
-// the file can hold at their smallest (a binary property's size; an ASCII value at least "0 ").
+// A PLY file read and checked before Assimp sees it (Assimp hangs on a header without end_header,
+// crashes on some broken binary ones, and takes a list's count on trust: an ASCII face claiming
+// 20 million indices, followed by 3, became a polygon of 20 million zeros, 2.8 GB): the header
+// must start with "ply", give its format, end with end_header within kMaxPlyHeader bytes, and
+// declare no more elements than the rest of the file can hold at their smallest (a binary
+// property's size; an ASCII value at least "0 "); then the body is walked as the header
+// describes it, and every list's count must be a count whose values the file holds.
 constexpr size_t kMaxPlyHeader = size_t(1) << 20;
 
 size_t ply_type_size(const std::string& type) {
@@ -51,7 +56,74 @@ size_t ply_type_size(const std::string& type) {
     return 0;
 }
 
-void check_ply_header(const std::string& path) {
+struct PlyProperty {
+    std::string name;
+    size_t size = 0;        // a value's bytes (binary)
+    size_t count_size = 0;  // a list's count's bytes; 0: not a list
+    bool count_signed = false;
+};
+
+struct PlyElement {
+    std::string name;
+    uint64_t count = 0;
+    std::vector<PlyProperty> properties;
+};
+
+// The body of a PLY file, read forward through a buffer.
+class PlyBody {
+public:
+    PlyBody(std::ifstream& in, uint64_t size) : in_(in), left_(size) {}
+    uint64_t left() const { return left_ + (end_ - at_); }
+    bool byte(unsigned char& c) {
+        if (at_ == end_ && !fill()) return false;
+        c = static_cast<unsigned char>(buffer_[at_++]);
+        return true;
+    }
+    bool bytes(void* out, size_t n) {
+        auto* o = static_cast<char*>(out);
+        for (size_t i = 0; i < n; ++i) {
+            unsigned char c;
+            if (!byte(c)) return false;
+            o[i] = char(c);
+        }
+        return true;
+    }
+    bool skip(uint64_t n) {
+        if (n > left()) return false;
+        const uint64_t buffered = std::min<uint64_t>(n, end_ - at_);
+        at_ += size_t(buffered), n -= buffered;
+        if (n > 0) in_.seekg(std::streamoff(n), std::ios::cur), left_ -= n;
+        return true;
+    }
+    // The next whitespace-separated word (ASCII), or false at the end of the file.
+    bool word(std::string& out) {
+        out.clear();
+        unsigned char c;
+        do {
+            if (!byte(c)) return false;
+        } while (std::isspace(c));
+        do {
+            if (out.size() < 64) out += char(c);
+        } while (byte(c) && !std::isspace(c));
+        return true;
+    }
+
+private:
+    bool fill() {
+        if (left_ == 0) return false;
+        const size_t n = size_t(std::min<uint64_t>(left_, buffer_.size()));
+        in_.read(buffer_.data(), std::streamsize(n));
+        if (!in_) return false;
+        left_ -= n, at_ = 0, end_ = n;
+        return true;
+    }
+    std::ifstream& in_;
+    uint64_t left_;  // bytes of the file not yet in the buffer
+    std::vector<char> buffer_ = std::vector<char>(size_t(1) << 16);
+    size_t at_ = 0, end_ = 0;
+};
+
+void check_ply_file(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
     if (!in) throw MeshLoadError(fmt::format("cannot read mesh '{}'", path));
     const uint64_t file_size = std::filesystem::file_size(path);
@@ -59,9 +131,8 @@ void check_ply_header(const std::string& path) {
         throw MeshLoadError(fmt::format("mesh '{}', header line {}: {}", path, line, what));
     };
     std::string text;
-    bool binary = false, format = false, ended = false;
-    uint64_t minimum_body = 0, element_bytes = 0, element_count = 0;
-    const auto close_element = [&] { minimum_body += element_count * element_bytes; };
+    bool binary = false, big_endian = false, format = false, ended = false;
+    std::vector<PlyElement> elements;
     size_t header_bytes = 0;
     for (int line = 1; std::getline(in, text); ++line) {
         header_bytes += text.size() + 1;
@@ -84,45 +155,102 @@ void check_ply_header(const std::string& path) {
             words >> f;
             if (f != "ascii" && f != "binary_little_endian" && f != "binary_big_endian")
                 fail(line, fmt::format("unknown format '{}' (ascii, binary_little_endian or binary_big_endian)", f));
-            binary = f != "ascii", format = true;
+            binary = f != "ascii", big_endian = f == "binary_big_endian", format = true;
         } else if (key == "element") {
-            close_element();
             std::string name, count;
             words >> name >> count;
             if (count.empty() || count.find_first_not_of("0123456789") != std::string::npos || count.size() > 12)
                 fail(line, fmt::format("element '{}' has no count", name));
-            element_count = std::stoull(count), element_bytes = 0;
-            if (element_count > kMaxElements) fail(line, fmt::format("element '{}' claims {} items: too large", name, element_count));
+            elements.push_back({name, std::stoull(count), {}});
+            if (elements.back().count > kMaxElements) fail(line, fmt::format("element '{}' claims {} items: too large", name, elements.back().count));
         } else if (key == "property") {
+            if (elements.empty()) fail(line, "a property before any element");
             std::string type;
             words >> type;
+            PlyProperty p;
             if (type == "list") {
                 std::string count_type, item_type;
                 words >> count_type >> item_type;
                 if (!ply_type_size(count_type) || !ply_type_size(item_type)) fail(line, "a list property needs two known types");
-                element_bytes += binary ? ply_type_size(count_type) : 2;
+                if (count_type.find("float") != std::string::npos || count_type == "double") fail(line, "a list's count must have an integer type");
+                p.size = ply_type_size(item_type), p.count_size = ply_type_size(count_type);
+                p.count_signed = count_type[0] != 'u';
             } else {
                 if (!ply_type_size(type)) fail(line, fmt::format("unknown property type '{}'", type));
-                element_bytes += binary ? ply_type_size(type) : 2;
+                p.size = ply_type_size(type);
             }
+            words >> p.name;
+            elements.back().properties.push_back(p);
         } else {
             fail(line, fmt::format("unknown header line '{}'", text.substr(0, 40)));
         }
     }
     if (!ended) throw MeshLoadError(fmt::format("mesh '{}': the header has no end_header line (the file ends in it)", path));
     if (!format) throw MeshLoadError(fmt::format("mesh '{}': the header has no format line", path));
-    close_element();
+    uint64_t minimum_body = 0;
+    for (const PlyElement& e : elements) {
+        uint64_t item = 0;
+        for (const PlyProperty& p : e.properties) item += binary ? (p.count_size ? p.count_size : p.size) : 2;
+        minimum_body += e.count * item;
+    }
     if (!binary && minimum_body > 0) --minimum_body;  // (the last value needs no separator after it)
     const uint64_t body = file_size > header_bytes ? file_size - header_bytes : 0;
     if (minimum_body > body)
         throw MeshLoadError(fmt::format("mesh '{}': the header's elements need at least {} bytes, the file holds {} after it", path, minimum_body, body));
+
+    // The body, as the header describes it.
+    PlyBody reader(in, body);
+    std::string word;
+    for (const PlyElement& e : elements) {
+        const bool lists = std::any_of(e.properties.begin(), e.properties.end(), [](const PlyProperty& p) { return p.count_size > 0; });
+        if (binary && !lists) {  // fixed-size items: the size check above holds them
+            uint64_t item = 0;
+            for (const PlyProperty& p : e.properties) item += p.size;
+            reader.skip(e.count * item);
+            continue;
+        }
+        for (uint64_t i = 0; i < e.count; ++i)
+            for (const PlyProperty& p : e.properties) {
+                const auto ends = [&](const std::string& inside) {
+                    return MeshLoadError(fmt::format("mesh '{}': the file ends inside element '{}' (item {} of {}){}", path, e.name, i + 1, e.count, inside));
+                };
+                if (p.count_size == 0) {  // one value
+                    if (binary ? !reader.skip(p.size) : !reader.word(word)) throw ends("");
+                    continue;
+                }
+                int64_t n = 0;
+                if (binary) {
+                    unsigned char b[8] = {};
+                    if (!reader.bytes(b, p.count_size)) throw ends("");
+                    if (big_endian) std::reverse(b, b + p.count_size);
+                    uint64_t u = 0;
+                    for (size_t k = 0; k < p.count_size; ++k) u |= uint64_t(b[k]) << (8 * k);
+                    const bool negative = p.count_signed && (b[p.count_size - 1] & 0x80);
+                    n = negative ? -1 : int64_t(u);
+                } else {
+                    if (!reader.word(word)) throw ends("");
+                    if (word.empty() || word.size() > 12 || word.find_first_not_of("0123456789") != std::string::npos)
+                        throw MeshLoadError(fmt::format("mesh '{}': element '{}' (item {} of {}): its list '{}' has the count '{}', not a count",
+                                                        path, e.name, i + 1, e.count, p.name, word));
+                    n = int64_t(std::stoull(word));
+                }
+                const uint64_t least = binary ? p.size : 1;  // an ASCII value and a space, but the last
+                if (n < 0 || uint64_t(n) > kMaxElements || uint64_t(n) * least > reader.left())
+                    throw MeshLoadError(fmt::format("mesh '{}': element '{}' (item {} of {}): its list '{}' claims {} values, more than the "
+                                                    "file holds after it ({} bytes)",
+                                                    path, e.name, i + 1, e.count, p.name, n, reader.left()));
+                for (int64_t k = 0; k < n; ++k)
+                    if (binary ? !reader.skip(p.size) : !reader.word(word))
+                        throw ends(fmt::format(", in its list '{}' of {} values", p.name, n));
+            }
+    }
 }
 
 }  // namespace
 
 MeshDesc load_ply_mesh(const std::string& path) {
     require_regular_file(path);
-    check_ply_header(path);
+    check_ply_file(path);
     Assimp::Importer importer;
     // No post-processing: Assimp's own steps would triangulate differently, join identical
     // vertices or reorder; the fan below is Mitsuba's.

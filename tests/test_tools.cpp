@@ -374,7 +374,8 @@ TEST_F(Tools, ReferenceThenCheckReportsOkMissingAndBlackByDesign) {
 }
 
 // Two renders of different scenes (their EXRs carry the scene's name and hash): compare warns,
-// and with --strict refuses (exit 2); renders of one scene, and images without the metadata, pass quietly.
+// and with --strict refuses (exit 2); renders of one scene, and images without the metadata, pass quietly
+// (with --strict, an image without it is refused: nothing shows it renders the same scene).
 TEST_F(Tools, CompareWarnsOfRendersOfDifferentScenes) {
     for (const char* s : {"2", "3"})
         ASSERT_EQ(run({"-s", s, "--resolution", "8x8", "--spp", "1", "-q", "-o", path(std::string("r") + s + ".exr")}).code, 0);
@@ -389,6 +390,14 @@ TEST_F(Tools, CompareWarnsOfRendersOfDifferentScenes) {
     r = run({"compare", path("r2.exr"), path("r2b.exr"), "--strict"});
     EXPECT_EQ(r.code, 0) << r.err;
     EXPECT_FALSE(contains(r.err, "warning")) << r.err;
+    // An image that does not say its scene: quietly compared, but --strict refuses it.
+    ASSERT_EQ(run({"convert", path("r3.exr"), path("r3.pfm")}).code, 0);
+    r = run({"compare", path("r2.exr"), path("r3.pfm")});
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_FALSE(contains(r.err, "warning")) << r.err;
+    r = run({"compare", path("r2.exr"), path("r3.pfm"), "--strict"});
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_TRUE(contains(r.err, path("r3.pfm") + " does not say which scene it renders")) << r.err;
 }
 
 TEST_F(Tools, CheckUsageErrors) {

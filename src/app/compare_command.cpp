@@ -64,7 +64,7 @@ CLI::App* add_compare_command(CLI::App& app, CompareOptions& o) {
     cmd->add_option("--diff", o.diff_path, "Write a false-colour PNG of the signed luminance difference A - B (blue: A darker, red: A brighter)");
     cmd->add_option("--diff-scale", o.diff_scale, "Difference shown at full colour in --diff (default: the 99th percentile of |difference|)");
     cmd->add_flag("--json", o.json, "Print the results as JSON");
-    cmd->add_flag("--strict", o.strict, "Refuse (exit 2) two renders of different scenes, by their EXRs' scene hashes (default: a warning)");
+    cmd->add_flag("--strict", o.strict, "Refuse (exit 2) two renders of different scenes, by their EXRs' scene hashes (default: a warning), and an image that does not say its scene");
     cmd->add_option("--z-test", o.z_test_variance,
                     "Judge A as Mitsuba 3's render tests do, given this image of B's per-sample variance: a z-test per pixel and "
                     "channel in XYZ at a Sidak-corrected --alpha, passing when 99.75% of them pass (exit code 1 if not); needs --spp");
@@ -135,6 +135,14 @@ int run_compare_command(const CompareOptions& o) {
     const Image a = read_input(o.a, scene_a), b = read_input(o.b, scene_b);
     // Renders of different scenes (both EXRs say which, by the scene's hash): a warning, or with
     // --strict a refusal. The numbers would say nothing of either render.
+    // --strict compares only renders that say they are of one scene: an image without the hash
+    // (a PNG, another renderer's EXR) cannot show it.
+    if (o.strict)
+        for (const auto& [file, scene] : {std::pair{o.a, scene_a}, std::pair{o.b, scene_b}})
+            if (scene.empty())
+                throw UsageError(fmt::format("{} does not say which scene it renders (no pathlab:sceneHash: not a pathlab EXR): "
+                                             "--strict compares only renders of one scene",
+                                             file));
     if (!scene_a.empty() && !scene_b.empty() && scene_a != scene_b) {
         const std::string why = fmt::format("{} is a render of {}, {} of {}: images of different scenes", o.a, scene_a, o.b, scene_b);
         if (o.strict) throw UsageError(why + " (--strict)");

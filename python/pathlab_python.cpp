@@ -21,6 +21,7 @@
 #include <condition_variable>
 #include <exception>
 #include <mutex>
+#include <limits>
 #include <optional>
 #include <thread>
 
@@ -106,6 +107,18 @@ std::string string_argument(const py::object& v, const char* name, const std::st
     return v.cast<std::string>();
 }
 
+// An int argument within [lo, hi] (None: absent): another type is a TypeError, an int outside
+// the range a ValueError naming it (pybind11's own conversion called -1 or 2**64 a wrong type).
+template <typename T>
+std::optional<T> int_argument(const py::object& v, const char* name, T lo, T hi, const char* why = "") {
+    if (v.is_none()) return std::nullopt;
+    if (!py::isinstance<py::int_>(v) || py::isinstance<py::bool_>(v))
+        throw py::type_error(fmt::format("{} must be an int, not {}", name, py::str(py::type::of(v).attr("__name__")).cast<std::string>()));
+    const py::int_ low(lo), high(hi);
+    if (v < low || v > high) throw py::value_error(fmt::format("{} must be an int from {} to {}{}, not {}", name, lo, hi, why, py::str(v).cast<std::string>()));
+    return v.cast<T>();
+}
+
 // An image as a float32 array of shape (height, width, 3) that owns its copy of the pixels.
 py::array_t<float> to_array(const Image& img) {
     py::array_t<float> a({py::ssize_t(img.height()), py::ssize_t(img.width()), py::ssize_t(3)});
@@ -189,21 +202,25 @@ RenderResult run_interruptibly(RenderJob& job) {
     return std::move(*result);
 }
 
-py::tuple py_render(const py::object& scene_obj, const py::object& algorithm, std::optional<uint64_t> spp, uint64_t seed, int threads,
-                 double time, const py::object& resolution, std::optional<int> max_depth, const py::object& sampler, bool spectral,
-                 std::optional<int> rr_depth, const py::object& light_sampler, std::optional<int> ris_candidates) {
+py::tuple py_render(const py::object& scene_obj, const py::object& algorithm, const py::object& spp_arg, const py::object& seed_arg,
+                 const py::object& threads_arg, double time, const py::object& resolution, const py::object& max_depth_arg,
+                 const py::object& sampler, bool spectral, const py::object& rr_depth_arg, const py::object& light_sampler,
+                 const py::object& ris_candidates_arg) {
+    constexpr int kIntMax = std::numeric_limits<int>::max();
+    // As the command line: sample indices from 2^62 on are refused (such a render never ends).
+    const std::optional<uint64_t> spp = int_argument<uint64_t>(spp_arg, "spp", 1, (uint64_t(1) << 62) - 1, " (sample indices end at 2^62)");
+    const uint64_t seed = *int_argument<uint64_t>(seed_arg, "seed", 0, std::numeric_limits<uint64_t>::max());
+    const int threads = *int_argument<int>(threads_arg, "threads", 0, kIntMax);
+    const std::optional<int> max_depth = int_argument<int>(max_depth_arg, "max_depth", -1, kIntMax);
+    const std::optional<int> rr_depth = int_argument<int>(rr_depth_arg, "rr_depth", 0, kIntMax);
+    const std::optional<int> ris_candidates = int_argument<int>(ris_candidates_arg, "ris_candidates", 1, kIntMax);
     std::shared_ptr<PyScene> scene = scene_argument(scene_obj);
     JobRequest request;
     if (!algorithm.is_none()) {
         const std::string name = string_argument(algorithm, "algorithm", algorithm_names());
         request.algorithm = translating([&] { return integrator_or_usage_error(name).name; });
     }
-    if (spp) {
-        if (*spp == 0) throw py::value_error("spp must be a positive number of samples");
-        // As the command line: sample indices from 2^62 on are refused (such a render never ends).
-        if (*spp >= (uint64_t(1) << 62)) throw py::value_error(fmt::format("spp {} reaches past the last sample index, 2^62", *spp));
-        request.spp = *spp;
-    }
+    if (spp) request.spp = *spp;
     if (time < 0 || !std::isfinite(time)) throw py::value_error("time must be a positive number of seconds (0: none)");
     request.time_limit = time;
     request.seed = seed;
@@ -211,7 +228,6 @@ py::tuple py_render(const py::object& scene_obj, const py::object& algorithm, st
     // As the command line's --spectral, --rr-depth, --light-sampler and --ris-candidates (RenderJob
     // refuses what an estimator does not do, as there).
     request.spectral = spectral;
-    if (rr_depth && *rr_depth < 0) throw py::value_error("rr_depth must be zero or positive");
     request.rr_depth = rr_depth;
     if (!light_sampler.is_none()) {
         const std::string name = string_argument(light_sampler, "light_sampler", kLightSamplerNames);
@@ -231,7 +247,6 @@ py::tuple py_render(const py::object& scene_obj, const py::object& algorithm, st
     if (sampler_name != "independent" && sampler_name != "sobol")
         throw py::value_error(fmt::format("unknown sampler '{}'; valid: independent, sobol", sampler_name));
     request.sampler = sampler_name == "sobol" ? SamplerKind::Sobol : SamplerKind::Independent;
-    if (threads < 0) throw py::value_error("threads must be 0 (all cores) or positive");
 
     // The scene's BVH is built once and shared by its renders with the default light sampler in
     // RGB; another light sampler, or spectral mode (which checks the scene's materials first),
@@ -315,8 +330,8 @@ PYBIND11_MODULE(pathlab, m) {
     }, "The estimators' names (the values of algorithm=)");
     m.def("load", &py_load, py::arg("scene"), py::arg("defines") = std::map<std::string, std::string>{},
           "A built-in scene (course index, name or acronym) or a scene file, with values for its $name parameters");
-    m.def("render", &py_render, py::arg("scene"), py::arg("algorithm") = py::none(), py::arg("spp") = py::none(), py::arg("seed") = 1234,
-          py::arg("threads") = 0, py::kw_only(), py::arg("time") = 0.0, py::arg("resolution") = py::none(), py::arg("max_depth") = py::none(),
+    m.def("render", &py_render, py::arg("scene"), py::arg("algorithm") = py::none(), py::arg("spp") = py::none(), py::arg("seed") = py::int_(1234),
+          py::arg("threads") = py::int_(0), py::kw_only(), py::arg("time") = 0.0, py::arg("resolution") = py::none(), py::arg("max_depth") = py::none(),
           py::arg("sampler") = "independent", py::arg("spectral") = false, py::arg("rr_depth") = py::none(),
           py::arg("light_sampler") = py::none(), py::arg("ris_candidates") = py::none(),
           "Renders a scene (a pathlab.Scene, or what load() takes) and returns (image, standard_error), float32 arrays of shape\n"

@@ -111,8 +111,17 @@ def test_compare_gives_the_command_lines_statistics(tmp_path):
     with pytest.raises(ValueError, match="reference_se is 8x8 but the reference 16x16"):
         pathlab.rmse(a, b, np.zeros((8, 8, 3), dtype=np.float32))
     # A sample count past the last sample index is refused at once (it never returned).
-    with pytest.raises(ValueError, match="past the last sample index"):
+    with pytest.raises(ValueError, match=r"spp must be an int from 1 to 4611686018427387903 \(sample indices end at 2\^62\), not 9223372036854775808"):
         pathlab.render(2, spp=2**63, resolution=(4, 4))
+    # An int out of range is a ValueError naming the argument (pybind11 called it a wrong type);
+    # another type a TypeError.
+    for name, value in [("spp", -1), ("spp", 2**64), ("spp", 0), ("seed", -1), ("seed", 2**64), ("threads", -1),
+                        ("max_depth", -2), ("rr_depth", -1), ("ris_candidates", 0)]:
+        with pytest.raises(ValueError, match=f"{name} must be an int from .* not {value}"):
+            pathlab.render(2, resolution=(4, 4), **{name: value})
+    for name, value in [("spp", 1.5), ("spp", True), ("seed", "7"), ("threads", 2.0)]:
+        with pytest.raises(TypeError, match=f"{name} must be an int, not"):
+            pathlab.render(2, resolution=(4, 4), **{name: value})
 
 
 def test_write_and_read_round_trip(tmp_path):

@@ -217,15 +217,28 @@ std::vector<RenderJob> make_jobs(const RenderCommandOptions& o, bool check_paths
     if (o.no_merging && o.no_connections) throw UsageError("--no-merging and --no-connections together leave vcm no strategy");
 
     std::vector<RenderJob> jobs;
+    // -a all: every estimator that renders the scene; those that cannot (a medium, spectral mode,
+    // the sensor) are left out, with a note saying which and why.
+    const bool every = o.algorithm_given && o.algorithm == "all";
     for (SceneChoice& choice : resolve_scene_arguments(o.scenes)) {
         if (algorithms.empty()) {
             jobs.emplace_back(std::move(choice), request);
             continue;
         }
+        std::vector<std::string> left_out, reasons;
         for (const IntegratorInfo* info : algorithms) {
             request.algorithm = info->name;
+            if (every)
+                if (const std::string why = integrator_refusal(*info, choice.description, request); !why.empty()) {
+                    left_out.push_back(info->name), reasons.push_back(why);
+                    continue;
+                }
             jobs.emplace_back(choice, request);
         }
+        if (left_out.size() == algorithms.size()) throw UsageError(fmt::format("-a all: no estimator renders {}: {}", choice.name, reasons[0]));
+        if (!left_out.empty() && !o.quiet)
+            fmt::print(stderr, "pathlab: note: -a all on {}: {} left out, as they cannot render it (e.g. {})\n", choice.name,
+                       fmt::join(left_out, ", "), reasons[0]);
     }
     // Sample indices from 2^62 on are refused up front: first + spp must not wrap round (an image of
     // 0 samples after a minute's work), and no render reaches them.

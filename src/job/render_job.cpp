@@ -85,6 +85,33 @@ void apply_environment_caps(RenderSettings& s, const SceneDescription& d) {
 
 }  // namespace
 
+std::string integrator_refusal(const IntegratorInfo& info, const SceneDescription& d, const JobRequest& r) {
+    if (r.light_sampler && !info.samples_lights)
+        return fmt::format("{} does not choose lights at its shading points (its light paths start on a light chosen "
+                           "by power), so --light-sampler does not apply to it; the integrators it applies to: {}",
+                           info.name, light_sampling_integrator_names());
+    if ((r.spectral || d.spectral) && !info.spectral)
+        return fmt::format("{} does not render in spectral mode yet (--spectral, or the scene file's <default name=\"mode\" "
+                           "value=\"spectral\"/>); the integrators that do: {}",
+                           info.name, spectral_integrator_names());
+    if (!info.media)
+        if (const std::string medium = medium_in_use(d); !medium.empty())
+            return fmt::format("{0} does not render participating media, and this scene has the {1}: {0} would render "
+                               "the scene as if the medium were not there. The integrators that render media: {2}",
+                               info.name, medium, media_integrator_names());
+    if (!info.any_camera && d.camera.kind != CameraKind::Perspective)
+        return fmt::format("{} cannot render through a {} sensor: it connects light paths to a pinhole camera (or sizes "
+                           "its radii by the pinhole's pixels); use a camera-side integrator (path, direct, pt-naive, "
+                           "pm, eyelight) or a perspective sensor",
+                           info.name, d.camera.kind == CameraKind::ThinLens ? "thinlens" : "orthographic");
+    if (!info.any_filter && !(d.filter.is_box() && d.filter.radius == 0.5))
+        return fmt::format("{} adds its samples to the film without a reconstruction filter; the scene's rfilter '{}' "
+                           "works with the pixel integrators (path, direct, pt-naive, pm, ic, eyelight, ...); use "
+                           "<rfilter type=\"box\"/> for {}",
+                           info.name, d.filter.type, info.name);
+    return "";
+}
+
 RenderJob::RenderJob(SceneChoice scene, const JobRequest& r) : choice_(std::move(scene)) {
     const SceneDescription& d = choice_.description;
     if (!d.unknown_integrator.empty()) {
@@ -120,10 +147,7 @@ RenderJob::RenderJob(SceneChoice scene, const JobRequest& r) : choice_(std::move
     options_.pbgi_direct_samples = r.pbgi_direct_samples ? *r.pbgi_direct_samples : d.pbgi_direct_samples.value_or(options_.pbgi_direct_samples);
     options_.pbgi_spacing = r.pbgi_spacing ? *r.pbgi_spacing : d.pbgi_spacing.value_or(options_.pbgi_spacing);
     options_.hide_emitters = d.hide_emitters.value_or(false);
-    if (r.light_sampler && !info_->samples_lights)
-        throw UsageError(fmt::format("{} does not choose lights at its shading points (its light paths start on a light chosen "
-                                     "by power), so --light-sampler does not apply to it; the integrators it applies to: {}",
-                                     info_->name, light_sampling_integrator_names()));
+    if (const std::string why = integrator_refusal(*info_, d, r); !why.empty()) throw UsageError(why);
     options_.light_sampler = r.light_sampler.value_or(LightSamplerKind::Power);
     if (r.ris_candidates && options_.light_sampler != LightSamplerKind::Ris)
         throw UsageError("--ris-candidates is the number of light samples --light-sampler ris resamples; give --light-sampler ris");
@@ -131,25 +155,6 @@ RenderJob::RenderJob(SceneChoice scene, const JobRequest& r) : choice_(std::move
     if (options_.ris_candidates < 1 || options_.ris_candidates > kMaxRisCandidates)
         throw UsageError(fmt::format("--ris-candidates must be between 1 and {}, not {}", kMaxRisCandidates, options_.ris_candidates));
     options_.spectral = r.spectral || d.spectral;
-    if (options_.spectral && !info_->spectral)
-        throw UsageError(fmt::format("{} does not render in spectral mode yet (--spectral, or the scene file's <default name=\"mode\" "
-                                     "value=\"spectral\"/>); the integrators that do: {}",
-                                     info_->name, spectral_integrator_names()));
-    if (!info_->media)
-        if (const std::string medium = medium_in_use(d); !medium.empty())
-            throw UsageError(fmt::format("{0} does not render participating media, and this scene has the {1}: {0} would render "
-                                         "the scene as if the medium were not there. The integrators that render media: {2}",
-                                         info_->name, medium, media_integrator_names()));
-    // What the integrator cannot do with this scene's sensor and film.
-    if (!info_->any_camera && d.camera.kind != CameraKind::Perspective)
-        throw UsageError(fmt::format("{} cannot render through a {} sensor: it connects light paths to a pinhole camera (or sizes "
-                                     "its radii by the pinhole's pixels); use a camera-side integrator (path, direct, pt-naive, "
-                                     "pm, eyelight) or a perspective sensor",
-                                     info_->name, d.camera.kind == CameraKind::ThinLens ? "thinlens" : "orthographic"));
-    if (!info_->any_filter && !(d.filter.is_box() && d.filter.radius == 0.5))
-        throw UsageError(fmt::format("{} adds its samples to the film without a reconstruction filter; the scene's rfilter '{}' "
-                                     "works with the pixel integrators (path, direct, pt-naive, pm, ic, eyelight, ...); use "
-                                     "<rfilter type=\"box\"/> for {}", info_->name, d.filter.type, info_->name));
     if (options_.photons < 0) throw UsageError("--photons must be zero (the default count) or positive");
     if (!(options_.photon_radius >= 0) || !std::isfinite(options_.photon_radius))
         throw UsageError("--radius must be zero (from the scene's size) or a positive distance");

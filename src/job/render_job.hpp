@@ -66,6 +66,11 @@ const IntegratorInfo& integrator_or_usage_error(const std::string& name);
 // name for a debug view (eyelight).
 std::string integrator_family(const IntegratorInfo& info, int max_depth);
 
+// Why `info` cannot render scene `d` as `request` asks (empty: it can): a medium, spectral mode,
+// a sensor or reconstruction filter it does not handle, a light sampler it does not use. RenderJob
+// refuses such a job with it; `-a all` leaves such estimators out.
+std::string integrator_refusal(const IntegratorInfo& info, const SceneDescription& d, const JobRequest& request);
+
 class RenderJob {
 public:
     // Makes the integrator (the scene is built when first needed). Unknown algorithms and

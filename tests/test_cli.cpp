@@ -277,7 +277,8 @@ std::string write_scene(const std::string& file, const std::string& integrator =
 }
 
 // Scene files of one name in folders of their own (Bitterli's layout: DIR/scene.xml): {dir} is
-// the folder, and the default names take it when they would collide (they were refused).
+// the folder, and the default names take it when they would collide (they were refused), or
+// {path} where the folders' names collide too.
 TEST_F(Cli, ScenesOfOneNameInTheirOwnFoldersGetTheFolderInTheirNames) {
     fs::create_directories(path("kitchen")), fs::create_directories(path("bathroom"));
     const std::string a = write_scene(path("kitchen/scene.xml")), b = write_scene(path("bathroom/scene.xml"));
@@ -298,6 +299,16 @@ TEST_F(Cli, ScenesOfOneNameInTheirOwnFoldersGetTheFolderInTheirNames) {
     }
     EXPECT_EQ(kitchen, 2);  // .exr and .png
     EXPECT_EQ(bathroom, 2);
+    // Folders of one name too (a/k/scene.xml, b/k/scene.xml): the default names take the path
+    // ({dir} could not tell them apart, and the render was refused).
+    fs::create_directories(path("a/k")), fs::create_directories(path("b/k"));
+    const std::string ak = write_scene(path("a/k/scene.xml")), bk = write_scene(path("b/k/scene.xml"));
+    fs::current_path(path(""));
+    r = run({"-s", ak + "," + bk, "--spp", "1", "--resolution", "8x4", "-q"});
+    fs::current_path(before);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(fs::exists(path("out/scene-a-k-scene-direct-mis.exr")));
+    EXPECT_TRUE(fs::exists(path("out/scene-b-k-scene-direct-mis.png")));
     // One scene alone keeps the names it always had.
     r = run({"-s", a, "--spp", "1", "--resolution", "8x4", "-q", "-o", path("{scene}.pfm")});
     EXPECT_EQ(r.code, 0) << r.err;

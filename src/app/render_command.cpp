@@ -92,8 +92,8 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
     add_threads_option(app, o.threads);
     app.add_option("-o,--output", o.outputs,
                    "Output file, repeatable; format by extension: .exr .hdr .pfm .png. Placeholders {scene} {dir} (the scene file's "
-                   "folder) {index} {algorithm}. Default: out/{index}-{scene}-{algorithm}.exr and .png ({dir}-{scene} where scene "
-                   "files of one name in different folders would collide)");
+                   "folder) {path} (its path, folders joined by '-') {index} {algorithm}. Default: out/{index}-{scene}-{algorithm}.exr "
+                   "and .png ({dir}-{scene}, else {path}, where scene files of one name in different folders would collide)");
     app.add_option("--exposure", o.exposure, "Exposure in stops for .png output")->capture_default_str();
     app.add_option("--stats", o.stats_path, "Write render statistics as JSON (placeholders as for -o)");
     app.add_option_function<int>("--max-depth", [&o](const int& v) { o.max_depth = v, o.max_depth_given = true; },
@@ -262,14 +262,18 @@ std::vector<RenderJob> make_jobs(const RenderCommandOptions& o, bool check_paths
     std::vector<std::string> patterns(o.outputs.begin(), o.outputs.end());
     if (patterns.empty()) {
         patterns.assign(std::begin(kDefaultOutputs), std::end(kDefaultOutputs));
-        // Scene files of one name in different folders (DIR/scene.xml): the folder goes into the default names.
-        bool same_names = false;
-        for (size_t j = 0; j < jobs.size(); ++j)
-            for (size_t k = 0; k < j; ++k)
-                same_names |= jobs[j].scene_choice().name == jobs[k].scene_choice().name &&
-                              jobs[j].scene_choice().file != jobs[k].scene_choice().file;
-        if (same_names)
-            for (std::string& p : patterns) p.replace(p.find("{scene}"), 7, "{dir}-{scene}");
+        // Scene files of one name in different folders (DIR/scene.xml): the folder goes into the
+        // default names, or where folders of one name differ too (a/k/scene.xml, b/k/scene.xml), the path.
+        const auto collide = [&](const char* key) {
+            for (size_t j = 0; j < jobs.size(); ++j)
+                for (size_t k = 0; k < j; ++k)
+                    if (jobs[j].scene_choice().file != jobs[k].scene_choice().file && jobs[j].expand(key) == jobs[k].expand(key)) return true;
+            return false;
+        };
+        if (collide("{scene}")) {
+            const char* names = collide("{dir}-{scene}") ? "{path}" : "{dir}-{scene}";
+            for (std::string& p : patterns) p.replace(p.find("{scene}"), 7, names);
+        }
     }
     // Check every output before the first render starts: writable, not an input, not another output.
     OutputPaths paths;
@@ -294,7 +298,7 @@ std::vector<RenderJob> make_jobs(const RenderCommandOptions& o, bool check_paths
         for (size_t k = 0; k < j; ++k)
             for (const std::string& path : jobs[j].outputs)
                 if (std::find(jobs[k].outputs.begin(), jobs[k].outputs.end(), path) != jobs[k].outputs.end())
-                    throw UsageError(fmt::format("{} / {} and {} / {} would both write {}: add {{scene}}, {{dir}}, {{index}} or {{algorithm}} to -o",
+                    throw UsageError(fmt::format("{} / {} and {} / {} would both write {}: add {{scene}}, {{dir}}, {{path}}, {{index}} or {{algorithm}} to -o",
                                                  jobs[k].scene_choice().name, jobs[k].integrator_info().name,
                                                  jobs[j].scene_choice().name, jobs[j].integrator_info().name, path));
         if (check_paths) {

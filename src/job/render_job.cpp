@@ -211,14 +211,22 @@ RenderStats RenderJob::run_into(Film& film) { return render_into(scene(), integr
 std::string RenderJob::expand(const std::string& pattern) const {
     try {
         // {dir}: the scene file's folder (scenes laid out as DIR/scene.xml, Bitterli's way), or the
-        // built-in scene's name.
-        const std::string dir = choice_.file.empty()
-                                    ? choice_.name
-                                    : std::filesystem::absolute(choice_.file).lexically_normal().parent_path().filename().string();
+        // built-in scene's name (as {path}).
+        const std::filesystem::path file = std::filesystem::absolute(choice_.file).lexically_normal();
+        const std::string dir = choice_.file.empty() ? choice_.name : file.parent_path().filename().string();
+        // {path}: the scene file's path without its extension (from the current folder when the
+        // file is under it), its folders joined by '-': tells a/k/scene.xml from b/k/scene.xml.
+        std::string path = choice_.name;
+        if (!choice_.file.empty()) {
+            std::filesystem::path p = file.lexically_relative(std::filesystem::current_path());
+            if (p.empty() || *p.begin() == "..") p = file.relative_path();
+            path.clear();
+            for (const auto& part : p.replace_extension()) path += (path.empty() ? "" : "-") + part.string();
+        }
         return fmt::format(fmt::runtime(pattern), fmt::arg("scene", choice_.name), fmt::arg("index", choice_.index),
-                           fmt::arg("algorithm", info_->name), fmt::arg("dir", dir));
+                           fmt::arg("algorithm", info_->name), fmt::arg("dir", dir), fmt::arg("path", path));
     } catch (const fmt::format_error& e) {
-        throw UsageError(fmt::format("invalid output pattern '{}': {} (placeholders: {{scene}}, {{dir}}, {{index}}, {{algorithm}})",
+        throw UsageError(fmt::format("invalid output pattern '{}': {} (placeholders: {{scene}}, {{dir}}, {{path}}, {{index}}, {{algorithm}})",
                                      pattern, e.what()));
     }
 }

@@ -212,7 +212,8 @@ std::string RenderJob::expand(const std::string& pattern) const {
     try {
         // {dir}: the scene file's folder (scenes laid out as DIR/scene.xml, Bitterli's way), or the
         // built-in scene's name (as {path}).
-        const std::filesystem::path file = std::filesystem::absolute(choice_.file).lexically_normal();
+        const std::filesystem::path file =
+            choice_.file.empty() ? std::filesystem::path() : std::filesystem::absolute(choice_.file).lexically_normal();
         const std::string dir = choice_.file.empty() ? choice_.name : file.parent_path().filename().string();
         // {path}: the scene file's path without its extension (from the current folder when the
         // file is under it), its folders joined by '-': tells a/k/scene.xml from b/k/scene.xml.

@@ -204,6 +204,19 @@ TEST_F(Lab, AReferenceOfAnotherSceneSizeOrFamilyIsRefused) {
     EXPECT_EQ(r.code, 2);
     EXPECT_TRUE(contains(r.err, "is a reference of scene 2 ceiling-diffuse, not of scene 3 ceiling-glossy")) << r.err;
     EXPECT_FALSE(fs::exists(path("r.html")));
+    // A manifest whose entry gives one scene's index and another's name (it went by the index).
+    {
+        auto manifest = nlohmann::json::parse(std::ifstream(path("refs/manifest.json")));
+        for (auto& e : manifest["scenes"])
+            if (e.value("file", "") == "2-ceiling-diffuse.exr") e["scene"] = "ceiling-glossy";
+        std::ofstream(path("refs/manifest.json")) << manifest.dump(2);
+        r = run({"check", "2", "-a", "direct-mis", "--references", path("refs"), "--spp", "2"});
+        EXPECT_EQ(r.code, 2);
+        EXPECT_TRUE(contains(r.err, "is a reference of scene 2 by its manifest entry's index, but of ceiling-glossy by its name")) << r.err;
+        for (auto& e : manifest["scenes"])
+            if (e.value("file", "") == "2-ceiling-diffuse.exr") e["scene"] = "ceiling-diffuse";
+        std::ofstream(path("refs/manifest.json")) << manifest.dump(2);
+    }
     // The scene file with another parameter value, then the file changed.
     r = run({"check", ball(), "-D", "r=0.25", "-a", "3", "--references", path("refs"), "--spp", "2"});
     EXPECT_EQ(r.code, 2);

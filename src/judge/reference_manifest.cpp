@@ -165,6 +165,11 @@ std::string reference_mismatch(const ReferenceRecord& r, const std::string& imag
     // The scene: built-in by index; a scene file by its hash (every file it read, its parameters).
     const bool same_scene = scene.builtin ? (r.index && *r.index == *scene.builtin)
                                           : (!r.index && !r.scene_hash.empty() && r.scene_hash == scene.hash);
+    // A built-in scene's index and name must agree (an edited or mixed-up manifest).
+    if (same_scene && scene.builtin && !r.scene.empty() && r.scene != scene.name)
+        return fmt::format("{} is a reference of scene {} by its manifest entry's index, but of {} by its name: the manifest is "
+                           "inconsistent; {}",
+                           image_path, *r.index, r.scene, redo);
     if (!same_scene) {
         std::string why = fmt::format("{} is a reference of {}, not of {}", image_path, describe_scene(r), describe_scene(scene));
         if (!scene.builtin && !r.index && r.scene == scene.name) {

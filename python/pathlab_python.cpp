@@ -33,6 +33,10 @@
 #include "lights/light_sampler.hpp"
 #include "job/scene_choice.hpp"
 #include "job/usage_error.hpp"
+#include "diff/loss.hpp"
+#include "diff/optimization.hpp"
+#include "diff/parameters.hpp"
+#include "diff/path_replay.hpp"
 #include "judge/image_compare.hpp"
 #include "judge/image_compare_json.hpp"
 #include "scene/builtin_scenes.hpp"
@@ -286,6 +290,159 @@ py::object to_python(const nlohmann::json& j) {
 
 }  // namespace
 
+// ---- differentiable rendering: parameters by name, gradients, the optimisation loop ----------
+
+// A parameter's value as an array: (1,) for a float, (3,) for an rgb, (height, width, 3) texels.
+py::array_t<float> parameter_array(const SceneParameter& p, const std::vector<float>& v) {
+    std::vector<py::ssize_t> shape = {py::ssize_t(v.size())};
+    if (p.is_texels()) shape = {py::ssize_t(p.height), py::ssize_t(p.width), 3};
+    py::array_t<float> a(shape);
+    std::copy(v.begin(), v.end(), a.mutable_data());
+    return a;
+}
+
+py::array_t<float> gradient_array(const SceneParameter& p, const std::vector<double>& g, int offset) {
+    std::vector<float> v(size_t(p.size));
+    for (int k = 0; k < p.size; ++k) v[size_t(k)] = float(g[size_t(offset + k)]);
+    return parameter_array(p, v);
+}
+
+// A value for parameter p from a number, a sequence or an array: p.size floats, or (as the
+// command line's --set) one number for every component, one colour for every texel. It must be
+// finite and within the parameter's range (not clamped: another value would render another scene).
+std::vector<float> parameter_from(const SceneParameter& p, const py::object& value) {
+    py::array_t<float, py::array::c_style | py::array::forcecast> a;
+    try {
+        a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(value);
+    } catch (const py::error_already_set&) {
+        a = {};
+    }
+    if (!a || py::isinstance<py::str>(value))
+        throw py::type_error(fmt::format("{}: the value must be a number, a sequence or an array of numbers", p.name));
+    std::vector<float> v(a.data(), a.data() + a.size());
+    if (v.size() == 1 && p.size >= 3) v.assign(3, v[0]);
+    if (p.is_texels() && v.size() == 3)
+        for (int k = 1; k < p.width * p.height; ++k) v.insert(v.end(), {v[0], v[1], v[2]});
+    if (int(v.size()) != p.size)
+        throw py::value_error(fmt::format("{} takes {} values{}, not {}", p.name, p.size,
+                                          p.is_texels() ? fmt::format(" ({}x{}x3; or one value or one colour for every texel)", p.height, p.width) : "",
+                                          v.size()));
+    std::vector<float> clamped = v;
+    clamp_parameter_value(p, clamped);
+    for (size_t k = 0; k < v.size(); ++k)
+        if (!std::isfinite(v[k]) || clamped[k] != v[k])
+            throw py::value_error(fmt::format("{}: {} is outside its range {}", p.name, v[k], p.range()));
+    return v;
+}
+
+std::vector<std::string> name_list(const py::object& names) {
+    if (py::isinstance<py::str>(names)) return {names.cast<std::string>()};
+    std::vector<std::string> out;
+    for (const py::handle& n : names) {
+        if (!py::isinstance<py::str>(n)) throw py::type_error("parameters must be a name (str) or a list of names");
+        out.push_back(n.cast<std::string>());
+    }
+    if (out.empty()) throw py::value_error("parameters: give at least one name (pathlab.params(scene) lists them)");
+    return out;
+}
+
+DiffSettings diff_settings(int width, int height, const py::object& spp, const py::object& seed, const py::object& max_depth,
+                           const py::object& rr_depth) {
+    DiffSettings s;
+    s.width = width, s.height = height;
+    s.spp = *int_argument<int>(spp, "spp", 1, std::numeric_limits<int>::max());
+    s.seed = *int_argument<uint64_t>(seed, "seed", 0, std::numeric_limits<uint64_t>::max());
+    s.max_depth = int_argument<int>(max_depth, "max_depth", -1, std::numeric_limits<int>::max()).value_or(-1);
+    if (s.max_depth == 0) throw py::value_error("max_depth must be positive, or -1 for unlimited");
+    s.rr_depth = int_argument<int>(rr_depth, "rr_depth", 0, std::numeric_limits<int>::max()).value_or(3);
+    return s;
+}
+
+py::dict py_params(const py::object& scene_obj) {
+    const std::shared_ptr<PyScene> scene = scene_argument(scene_obj);
+    py::dict out;
+    for (const SceneParameter& p : scene_parameters(scene->choice.description))
+        out[py::str(p.name)] = parameter_array(p, parameter_value(scene->choice.description, p));
+    return out;
+}
+
+std::shared_ptr<PyScene> py_update(const py::object& scene_obj, const py::dict& values) {
+    const std::shared_ptr<PyScene> scene = scene_argument(scene_obj);
+    auto out = std::make_shared<PyScene>(PyScene{scene->choice, nullptr});
+    const std::vector<SceneParameter> all = scene_parameters(out->choice.description);
+    for (const auto& [name, value] : values) {
+        if (!py::isinstance<py::str>(name)) throw py::type_error("update: the keys are parameter names (str)");
+        const SceneParameter& p = find_parameter(all, name.cast<std::string>());
+        set_parameter_value(out->choice.description, p, parameter_from(p, py::reinterpret_borrow<py::object>(value)));
+    }
+    return out;
+}
+
+py::tuple py_loss(const py::object& image, const py::object& target, const std::string& kind) {
+    const Image a = to_image(image, "image"), t = to_image(target, "target");
+    if (a.width() != t.width() || a.height() != t.height())
+        throw py::value_error(fmt::format("image is {}x{} but target {}x{}", a.width(), a.height(), t.width(), t.height()));
+    Loss loss;
+    loss.kind = parse_loss_kind(kind);
+    return py::make_tuple(loss_value(a, t, loss), to_array(loss_adjoint(a, t, loss)));
+}
+
+py::dict py_gradient(const py::object& scene_obj, const py::object& names, const py::object& adjoint_obj, const py::object& spp,
+                     const py::object& seed, const py::object& max_depth, const py::object& rr_depth, const py::object& threads_arg) {
+    const std::shared_ptr<PyScene> scene = scene_argument(scene_obj);
+    const ParameterSet set = ParameterSet::choose(scene->choice.description, name_list(names));
+    const Image adjoint = to_image(adjoint_obj, "adjoint");
+    const DiffSettings s = diff_settings(adjoint.width(), adjoint.height(), spp, seed, max_depth, rr_depth);
+    const int threads = *int_argument<int>(threads_arg, "threads", 0, std::numeric_limits<int>::max());
+    std::optional<tbb::global_control> limit;
+    if (threads > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, size_t(threads));
+    const std::unique_ptr<Scene> built = Scene::build(scene->choice.description);
+    std::vector<double> g;
+    {
+        py::gil_scoped_release release;
+        g = gradient(*built, set, s, adjoint);
+    }
+    py::dict out;
+    for (size_t i = 0; i < set.params.size(); ++i) out[py::str(set.params[i].name)] = gradient_array(set.params[i], g, set.offsets[i]);
+    return out;
+}
+
+py::dict py_optimize(const py::object& scene_obj, const py::object& target_obj, const py::object& names, const py::object& iterations,
+                     double lr, const std::string& optimizer, const std::string& loss, const py::object& spp, const py::object& seed,
+                     bool seed_per_iteration, const py::object& max_depth, const py::object& rr_depth, const py::object& threads_arg) {
+    const std::shared_ptr<PyScene> scene = scene_argument(scene_obj);
+    const ParameterSet set = ParameterSet::choose(scene->choice.description, name_list(names));
+    const Image target = to_image(target_obj, "target");
+    OptimizationSettings s;
+    s.render = diff_settings(target.width(), target.height(), spp, seed, max_depth, rr_depth);
+    s.loss.kind = parse_loss_kind(loss);
+    s.optimizer = parse_optimizer_kind(optimizer);
+    if (!(lr > 0) || !std::isfinite(lr)) throw py::value_error("lr must be a positive number");
+    s.learning_rate = lr;
+    s.iterations = *int_argument<int>(iterations, "iterations", 0, std::numeric_limits<int>::max());
+    s.seed_per_iteration = seed_per_iteration;
+    const int threads = *int_argument<int>(threads_arg, "threads", 0, std::numeric_limits<int>::max());
+    std::optional<tbb::global_control> limit;
+    if (threads > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, size_t(threads));
+    py::list losses;
+    // Between iterations Python runs its signal handlers: Ctrl-C stops the loop and is raised.
+    const OptimizationResult r = optimize(scene->choice.description, set, target, s, [&](const OptimizationStep& step) {
+        losses.append(step.loss);
+        return PyErr_CheckSignals() == 0;
+    });
+    if (r.stopped) throw py::error_already_set();
+    py::dict params;
+    for (size_t i = 0; i < set.params.size(); ++i) {
+        const std::vector<float> v(r.theta.begin() + set.offsets[i], r.theta.begin() + set.offsets[i] + set.params[i].size);
+        params[py::str(set.params[i].name)] = parameter_array(set.params[i], v);
+    }
+    py::dict out;
+    out["params"] = params;
+    out["loss"] = losses;
+    out["best_loss"] = r.best_loss;
+    return out;
+}
+
 PYBIND11_MODULE(pathlab, m) {
     // Images come and go as NumPy arrays: without NumPy, say so at import, naming this
     // interpreter (a python3 first on PATH, pyenv's or a virtualenv's, often lacks it), not at
@@ -368,4 +525,25 @@ PYBIND11_MODULE(pathlab, m) {
           "Writes an (H, W, 3) array; the format follows the extension: .exr, .hdr, .pfm, .png (sRGB, with exposure in stops)");
     m.def("read", [](const std::string& path) { return to_array(translating([&] { return read_image(path); })); }, py::arg("path"),
           "Reads a linear image (.exr, .hdr, .pfm) as a float32 array of shape (height, width, 3)");
+    m.def("params", &py_params, py::arg("scene"),
+          "The scene's differentiable parameters, as `pathlab params` lists them (Mitsuba 3's names): a dict of name to value, a\n"
+          "float32 array of shape (1,) for a float, (3,) for an rgb, (height, width, 3) for a bitmap's texels");
+    m.def("update", &py_update, py::arg("scene"), py::arg("values"),
+          "A copy of the scene with parameters set: values is a dict of name to a number, a sequence or an array (one number for\n"
+          "every component, or one colour for every texel, as --set). A value outside the parameter's range is a ValueError.");
+    m.def("loss", &py_loss, py::arg("image"), py::arg("target"), py::arg("kind") = "l2",
+          "(loss, adjoint): the mean over pixels and channels of (image - target)^2 ('l2') or |image - target| ('l1'), and its\n"
+          "derivative with respect to each pixel, the adjoint image gradient() takes");
+    m.def("gradient", &py_gradient, py::arg("scene"), py::arg("parameters"), py::arg("adjoint"), py::kw_only(), py::arg("spp") = py::int_(4),
+          py::arg("seed") = py::int_(1234), py::arg("max_depth") = py::none(), py::arg("rr_depth") = py::none(), py::arg("threads") = py::int_(0),
+          "dLoss/dtheta by path replay for the named parameters, where adjoint (height, width, 3) is dLoss/dImage of pt-mis's image\n"
+          "of that size (render(scene, 'pt-mis', spp, seed) gives it; use another seed here, so the gradient is unbiased): a dict of\n"
+          "name to an array shaped as the parameter's value. As `pathlab gradient`.");
+    m.def("optimize", &py_optimize, py::arg("scene"), py::arg("target"), py::arg("parameters"), py::kw_only(),
+          py::arg("iterations") = py::int_(50), py::arg("lr") = 0.02, py::arg("optimizer") = "adam", py::arg("loss") = "l2",
+          py::arg("spp") = py::int_(4), py::arg("seed") = py::int_(1234), py::arg("seed_per_iteration") = false,
+          py::arg("max_depth") = py::none(), py::arg("rr_depth") = py::none(), py::arg("threads") = py::int_(0),
+          "Recovers the named parameters from a target image (array or file; its size is the render's) by gradient descent, as\n"
+          "`pathlab optimize`: returns {'params': name -> value after the last step, 'loss': per iteration, 'best_loss'}.\n"
+          "pathlab.update(scene, result['params']) gives the optimised scene.");
 }

@@ -205,3 +205,58 @@ def test_rmse_refuses_standard_errors_that_are_not_standard_errors():
         se[2, 1, 0] = bad
         with pytest.raises(ValueError, match=r"standard error at pixel \(1, 2\)"):
             pathlab.rmse(img, ref, reference_se=se)
+
+
+def test_params_update_and_their_errors():
+    scene = pathlab.load(2)
+    params = pathlab.params(scene)
+    red = params["red.reflectance.value"]
+    assert red.dtype == np.float32 and red.shape == (3,)
+    assert np.allclose(red, [0.803922, 0.152941, 0.152941])
+    darker = pathlab.update(scene, {"red.reflectance.value": [0.5, 0.1, 0.1]})
+    assert np.allclose(pathlab.params(darker)["red.reflectance.value"], [0.5, 0.1, 0.1])
+    assert np.array_equal(pathlab.params(scene)["red.reflectance.value"], red)  # a copy: the original is unchanged
+    assert np.allclose(pathlab.params(pathlab.update(scene, {"red.reflectance.value": 0.25}))["red.reflectance.value"], 0.25)
+    # The updated scene renders as the command line renders the scene file with that value.
+    a, _ = pathlab.render(darker, "pt-mis", spp=2, seed=3, resolution=(8, 8))
+    b, _ = pathlab.render(scene, "pt-mis", spp=2, seed=3, resolution=(8, 8))
+    assert a.mean() < b.mean()
+    with pytest.raises(ValueError, match=r"red.reflectance.value: 1.5 is outside its range \[0, 1\]"):
+        pathlab.update(scene, {"red.reflectance.value": 1.5})
+    with pytest.raises(ValueError, match="red.reflectance.value takes 3 values"):
+        pathlab.update(scene, {"red.reflectance.value": [0.1, 0.2]})
+    with pytest.raises(ValueError, match="(?s)unknown parameter 'rd.reflectance.value'.*red.reflectance.value"):
+        pathlab.update(scene, {"rd.reflectance.value": 0.5})
+    with pytest.raises(TypeError, match="must be a number"):
+        pathlab.update(scene, {"red.reflectance.value": "red"})
+
+
+def test_gradient_and_optimize_give_the_command_lines_numbers(tmp_path):
+    # pathlab gradient: the mean pixel value's adjoint, the replay with seed + 1.
+    out = cli("gradient", "--scene", "2", "--params", "red.reflectance.value,light.emitter.radiance.value", "--spp", "2",
+              "--seed", "5", "--resolution", "12x10", "--out", tmp_path / "g")
+    adjoint = np.full((10, 12, 3), 1.0 / (3 * 12 * 10), dtype=np.float32)
+    g = pathlab.gradient(2, ["red.reflectance.value", "light.emitter.radiance.value"], adjoint, spp=2, seed=6)
+    for name in g:
+        line = next(l for l in out.splitlines() if l.startswith(name + ": dLoss/dtheta = ["))
+        printed = [float(x) for x in line.split("[")[1].split("]")[0].split(",")]
+        assert np.allclose(g[name], printed, rtol=1e-5, atol=0), (name, g[name], printed)
+    assert g["red.reflectance.value"][0] > 0 and g["light.emitter.radiance.value"].shape == (3,)
+    # pathlab.loss: the L2 loss's value and adjoint.
+    img, target = np.full((2, 2, 3), 0.5, np.float32), np.zeros((2, 2, 3), np.float32)
+    value, adj = pathlab.loss(img, target)
+    assert value == pytest.approx(0.25) and np.allclose(adj, 2 * 0.5 / 12)
+    # pathlab optimize: the same loop, the same parameters after the last step.
+    truth = pathlab.update(2, {"red.reflectance.value": [0.3, 0.6, 0.2]})
+    target, _ = pathlab.render(truth, "pt-mis", spp=16, seed=9, resolution=(12, 10))
+    pathlab.write(str(tmp_path / "target.exr"), target)
+    cli("optimize", "--scene", "2", "--params", "red.reflectance.value", "--target", tmp_path / "target.exr", "--iterations", "12",
+        "--lr", "0.05", "--spp", "2", "--out", tmp_path / "o", "-q")
+    expected = json.load(open(tmp_path / "o" / "params.json"))["params"]["red.reflectance.value"]
+    r = pathlab.optimize(2, str(tmp_path / "target.exr"), "red.reflectance.value", iterations=12, lr=0.05, spp=2)
+    assert np.allclose(r["params"]["red.reflectance.value"], expected, rtol=1e-5, atol=1e-7), (r["params"], expected)
+    assert len(r["loss"]) == 12 and r["loss"][-1] < r["loss"][0]
+    with pytest.raises(ValueError, match="(?s)unknown parameter 'red'"):
+        pathlab.gradient(2, "red", adjoint)
+    with pytest.raises(ValueError, match="iterations must be an int from 0"):
+        pathlab.optimize(2, target, "red.reflectance.value", iterations=-1)

@@ -16,6 +16,7 @@
 #include "app/command_arguments.hpp"
 #include "app/interrupt.hpp"
 #include "diff/loss.hpp"
+#include "diff/optimization.hpp"
 #include "diff/optimizer.hpp"
 #include "diff/path_replay.hpp"
 #include "diff/scene_file_update.hpp"
@@ -381,59 +382,52 @@ int run_optimize_command(const OptimizeOptions& o) {
         loss.x0 = v[0], loss.y0 = v[1], loss.x1 = v[2], loss.y1 = v[3];
         usage_on_invalid([&] { return loss_value(target, target, loss); });
     }
-    Optimizer opt(usage_on_invalid([&] { return parse_optimizer_kind(o.optimizer); }), o.lr, size_t(set.size));
+    OptimizationSettings settings;
+    settings.render = base;
+    settings.loss = loss;
+    settings.optimizer = usage_on_invalid([&] { return parse_optimizer_kind(o.optimizer); });
+    settings.learning_rate = o.lr;
+    settings.iterations = o.iterations;
+    settings.seed_per_iteration = o.seed_per_iteration;
     if (o.iterations < 0) throw UsageError("--iterations must not be negative");
     if (!(o.lr > 0)) throw UsageError("--lr must be positive");
     refuse_out_dir_with_inputs(o.out_dir, scene, o.target, "optimize");
     std::filesystem::create_directories(o.out_dir);
     check_writable_path(o.out_dir + "/loss.json");
 
-    SceneDescription desc = scene.description;
-    std::vector<float> theta = set.values(desc), best = theta;
-    double best_loss = std::numeric_limits<double>::infinity();
     nlohmann::json history = nlohmann::json::array();
     PlotSeries series{"loss", series_colour(0), {}};
     InterruptGuard guard;
-    bool interrupted = false;
     const auto start = std::chrono::steady_clock::now();
-    int it = 0;
-    for (; it < o.iterations; ++it) {
-        if (InterruptGuard::flag().load()) {
-            interrupted = true;
-            break;
-        }
-        set.set_values(desc, theta);
-        const std::unique_ptr<Scene> built = Scene::build(desc);
-        DiffSettings s = base;
-        // The image of the loss and the gradient's replay use independent samples, so that the
-        // gradient of the L2 loss is unbiased (seeds 2i and 2i + 1 past --seed per iteration).
-        s.seed = base.seed + (o.seed_per_iteration ? 2 * uint64_t(it) : 0);
-        const Image image = render_primal(*built, s);
-        const double L = loss_value(image, target, loss);
-        if (L < best_loss) best_loss = L, best = theta;
-        DiffSettings gs = s;
-        gs.seed = s.seed + 1;
-        const std::vector<double> g = gradient(*built, set, gs, loss_adjoint(image, target, loss));
-        history.push_back({{"iteration", it}, {"loss", L}, {"params", parameters_json(set, theta, true)}, {"gradient", gradient_json(set, g)}});
-        series.points.push_back({double(it + 1), L});
+    const OptimizationResult run = optimize(scene.description, set, target, settings, [&](const OptimizationStep& step) {
+        const int it = step.iteration;
+        history.push_back({{"iteration", it},
+                           {"loss", step.loss},
+                           {"params", parameters_json(set, step.theta, true)},
+                           {"gradient", gradient_json(set, step.gradient)}});
+        series.points.push_back({double(it + 1), step.loss});
         if (o.save_every > 0 && it % o.save_every == 0) {
-            write_image(image, fmt::format("{}/iteration_{:04d}.png", o.out_dir, it));
+            write_image(step.image, fmt::format("{}/iteration_{:04d}.png", o.out_dir, it));
             for (size_t i = 0; i < set.params.size(); ++i)
                 if (set.params[i].is_texels())
-                    write_image(texel_image(set.params[i], slice(set, i, theta)), fmt::format("{}/{}_{:04d}.png", o.out_dir, set.params[i].name, it));
+                    write_image(texel_image(set.params[i], slice(set, i, step.theta)), fmt::format("{}/{}_{:04d}.png", o.out_dir, set.params[i].name, it));
         }
         if (!o.quiet) {
             std::string values;
             for (size_t i = 0; i < set.params.size(); ++i)
-                values += fmt::format("  {}=[{}]", set.params[i].name, value_text(set.params[i], slice(set, i, theta)));
-            fmt::print("iteration {:4d}  loss {:.6g}{}\n", it, L, values);
+                values += fmt::format("  {}=[{}]", set.params[i].name, value_text(set.params[i], slice(set, i, step.theta)));
+            fmt::print("iteration {:4d}  loss {:.6g}{}\n", it, step.loss, values);
         }
-        opt.step(theta, g);
-        set.clamp(theta);
-    }
+        return !InterruptGuard::flag().load();
+    });
+    const int it = run.iterations;
+    const bool interrupted = run.stopped;
+    const double best_loss = run.best_loss;
+    const std::vector<float>& best = run.best;
+    SceneDescription desc = scene.description;
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     // Interrupted: the parameters of the lowest loss seen; otherwise the last step's.
-    const std::vector<float>& result = interrupted ? best : theta;
+    const std::vector<float>& result = run.theta;
     set.set_values(desc, result);
     {
         const std::unique_ptr<Scene> built = Scene::build(desc);

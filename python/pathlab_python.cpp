@@ -206,10 +206,72 @@ RenderResult run_interruptibly(RenderJob& job) {
     return std::move(*result);
 }
 
+// The command line's estimator options by their names without dashes (mis="power", photons=...,
+// no_merging=True, ic_rays=..., pbgi_surfels=..., first_sample is not one: a render here is
+// whole). RenderJob refuses one the estimator does not take, as on the command line.
+void apply_estimator_options(JobRequest& r, const py::kwargs& options) {
+    constexpr int kIntMax = std::numeric_limits<int>::max();
+    static const char* const kNames =
+        "mis, photons, radius, alpha, volume_estimate, no_merging, no_connections, ic_rays, ic_error, ic_no_gradients, pbgi_surfels, "
+        "pbgi_cutoff, pbgi_bounces, pbgi_resolution, pbgi_direct_samples, pbgi_spacing";
+    const auto number = [](const py::handle& v, const std::string& name) {
+        if (!py::isinstance<py::int_>(v) && !py::isinstance<py::float_>(v))
+            throw py::type_error(fmt::format("{} must be a number, not {}", name, py::str(py::type::of(v).attr("__name__")).cast<std::string>()));
+        const double x = v.cast<double>();
+        if (!std::isfinite(x)) throw py::value_error(fmt::format("{} must be finite", name));
+        return x;
+    };
+    const auto flag = [](const py::handle& v, const std::string& name) {
+        if (!py::isinstance<py::bool_>(v)) throw py::type_error(fmt::format("{} must be True or False", name));
+        return v.cast<bool>();
+    };
+    for (const auto& [key, value] : options) {
+        const std::string name = py::str(key);
+        const py::object v = py::reinterpret_borrow<py::object>(value);
+        if (name == "mis") {
+            const std::string m = string_argument(v, "mis", "balance, power");
+            if (m != "balance" && m != "power") throw py::value_error(fmt::format("unknown mis '{}'; valid: balance, power", m));
+            r.mis_power = m == "power";
+        } else if (name == "photons") {
+            r.photons = *int_argument<int64_t>(v, "photons", 0, int64_t(1) << 40);
+        } else if (name == "radius") {
+            r.photon_radius = float(number(v, name));
+        } else if (name == "alpha") {
+            r.photon_alpha = number(v, name);
+        } else if (name == "volume_estimate") {
+            const std::string e = string_argument(v, "volume_estimate", "beam, points");
+            if (e != "beam" && e != "points") throw py::value_error(fmt::format("unknown volume_estimate '{}'; valid: beam, points", e));
+            r.volume_beam = e == "beam";
+        } else if (name == "no_merging") {
+            r.vcm_merging = !flag(v, name);
+        } else if (name == "no_connections") {
+            r.vcm_connections = !flag(v, name);
+        } else if (name == "ic_rays") {
+            r.ic_rays = *int_argument<int>(v, "ic_rays", 0, kIntMax);
+        } else if (name == "ic_error") {
+            r.ic_error = float(number(v, name));
+        } else if (name == "ic_no_gradients") {
+            if (flag(v, name)) r.ic_gradients = false;
+        } else if (name == "pbgi_cutoff") {
+            r.pbgi_cutoff = float(number(v, name));
+        } else if (name == "pbgi_surfels" || name == "pbgi_bounces" || name == "pbgi_resolution" || name == "pbgi_direct_samples" ||
+                   name == "pbgi_spacing") {
+            const int n = *int_argument<int>(v, name.c_str(), 0, kIntMax);
+            (name == "pbgi_surfels"     ? r.pbgi_surfels
+             : name == "pbgi_bounces"   ? r.pbgi_bounces
+             : name == "pbgi_resolution" ? r.pbgi_resolution
+             : name == "pbgi_spacing"   ? r.pbgi_spacing
+                                        : r.pbgi_direct_samples) = n;
+        } else {
+            throw py::type_error(fmt::format("render() got an unexpected keyword argument '{}'; the estimators' options: {}", name, kNames));
+        }
+    }
+}
+
 py::tuple py_render(const py::object& scene_obj, const py::object& algorithm, const py::object& spp_arg, const py::object& seed_arg,
                  const py::object& threads_arg, double time, const py::object& resolution, const py::object& max_depth_arg,
                  const py::object& sampler, bool spectral, const py::object& rr_depth_arg, const py::object& light_sampler,
-                 const py::object& ris_candidates_arg) {
+                 const py::object& ris_candidates_arg, const py::kwargs& estimator_options) {
     constexpr int kIntMax = std::numeric_limits<int>::max();
     // As the command line: sample indices from 2^62 on are refused (such a render never ends).
     const std::optional<uint64_t> spp = int_argument<uint64_t>(spp_arg, "spp", 1, (uint64_t(1) << 62) - 1, " (sample indices end at 2^62)");
@@ -239,6 +301,7 @@ py::tuple py_render(const py::object& scene_obj, const py::object& algorithm, co
         if (!request.light_sampler) throw py::value_error(fmt::format("unknown light sampler '{}'; valid: {}", name, kLightSamplerNames));
     }
     request.ris_candidates = ris_candidates;
+    apply_estimator_options(request, estimator_options);
     if (!resolution.is_none()) {
         const auto size = py::isinstance<py::tuple>(resolution) || py::isinstance<py::list>(resolution)
                               ? std::optional<std::vector<int>>(resolution.cast<std::vector<int>>())
@@ -496,7 +559,9 @@ PYBIND11_MODULE(pathlab, m) {
           "scene file's sample count, else 64 (unlimited with time=seconds); seed to 1234; threads=0 uses all cores. The same\n"
           "settings give the same bytes as `pathlab SCENE -a ALGORITHM --spp N --seed S -o out.exr`; spectral, rr_depth,\n"
           "light_sampler ('uniform', 'power', 'bvh', 'ris') and ris_candidates are --spectral, --rr-depth, --light-sampler and\n"
-          "--ris-candidates.");
+          "--ris-candidates. The estimators' own options go by their command-line names: mis='power', photons, radius, alpha,\n"
+          "volume_estimate='points', no_merging=True, no_connections=True, ic_rays, ic_error, ic_no_gradients=True, pbgi_surfels,\n"
+          "pbgi_cutoff, pbgi_bounces, pbgi_resolution, pbgi_direct_samples, pbgi_spacing (refused for another estimator).");
     m.def("compare", [](const py::object& a, const py::object& b) {
         const Image ia = to_image(a, "a"), ib = to_image(b, "b");
         if (ia.width() != ib.width() || ia.height() != ib.height())

@@ -63,6 +63,12 @@ def test_load_takes_indices_names_and_files_with_defines():
     ("scenes/example.xml", "direct-mis", ["-D", "spp=2"]),
     ("3", "pt-mis", ["--spectral", "--rr-depth", "1"]),
     ("scenes/many-lights.xml", "direct-mis", ["--light-sampler", "ris", "--ris-candidates", "3"]),
+    # The estimators' own options, by their command-line names.
+    ("3", "sppm", ["--photons", "300", "--radius", "0.05", "--alpha", "0.5"]),
+    ("3", "vcm", ["--no-merging", "--mis", "power"]),
+    ("3", "ic", ["--ic-rays", "16", "--ic-error", "0.5", "--ic-no-gradients"]),
+    ("3", "pbgi", ["--pbgi-surfels", "400", "--pbgi-bounces", "1", "--pbgi-cutoff", "0.1"]),
+    ("scenes/fog-box.xml", "pm", ["--volume-estimate", "points", "--photons", "200"]),
 ])
 def test_render_equals_the_command_line_bit_for_bit(tmp_path, scene, algorithm, extra):
     path = os.path.join(SOURCE, scene) if scene.endswith(".xml") else scene
@@ -74,7 +80,11 @@ def test_render_equals_the_command_line_bit_for_bit(tmp_path, scene, algorithm, 
     for i, word in enumerate(extra):
         if word.startswith("--"):
             value = extra[i + 1] if i + 1 < len(extra) and not extra[i + 1].startswith("-") else True
-            options[word[2:].replace("-", "_")] = int(value) if isinstance(value, str) and value.isdigit() else value
+            if isinstance(value, str) and value.isdigit():
+                value = int(value)
+            elif isinstance(value, str) and value.replace(".", "", 1).isdigit():
+                value = float(value)
+            options[word[2:].replace("-", "_")] = value
     img, stderr = pathlab.render(pathlab.load(path, defines=defines), algorithm=algorithm, spp=3, seed=77, resolution=(20, 14), **options)
     assert img.dtype == np.float32 and img.shape == (14, 20, 3) and stderr.shape == (14, 20, 3)
     assert same_bits(img, pathlab.read(str(out)))
@@ -82,6 +92,19 @@ def test_render_equals_the_command_line_bit_for_bit(tmp_path, scene, algorithm, 
     again, _ = pathlab.render(pathlab.load(path, defines=defines), algorithm=algorithm, spp=3, seed=77, resolution=(20, 14), threads=1,
                               **options)
     assert same_bits(img, again)
+
+
+def test_estimator_options_are_refused_as_on_the_command_line():
+    with pytest.raises(ValueError, match="--photons sets the light paths of sppm, ppm and pm; pt-mis has no such count"):
+        pathlab.render(3, "pt-mis", spp=1, resolution=(4, 4), photons=100)
+    with pytest.raises(ValueError, match="--ic-rays must be 4 to 65536, got 2"):
+        pathlab.render(3, "ic", spp=1, resolution=(4, 4), ic_rays=2)
+    with pytest.raises(ValueError, match="leave vcm no strategy"):
+        pathlab.render(3, "vcm", spp=1, resolution=(4, 4), no_merging=True, no_connections=True)
+    with pytest.raises(TypeError, match="unexpected keyword argument 'photon'; the estimators' options: mis, photons"):
+        pathlab.render(3, "sppm", spp=1, resolution=(4, 4), photon=100)
+    with pytest.raises(ValueError, match="unknown mis 'heuristic'; valid: balance, power"):
+        pathlab.render(3, "bdpt", spp=1, resolution=(4, 4), mis="heuristic")
 
 
 def test_a_scene_files_own_settings_as_on_the_command_line(tmp_path):

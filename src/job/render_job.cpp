@@ -112,6 +112,44 @@ std::string integrator_refusal(const IntegratorInfo& info, const SceneDescriptio
     return "";
 }
 
+// Options that belong to other estimators than `info` (the command line's names), and values out
+// of their range: why the request cannot be rendered (empty: it can). The command line and
+// Python's render() both come through here.
+std::string option_refusal(const IntegratorInfo& info, const JobRequest& r) {
+    const auto one_of = [&](std::initializer_list<const char*> names) {
+        for (const char* n : names)
+            if (info.name == n) return true;
+        return false;
+    };
+    const std::string& a = info.name;
+    if (r.photons && !one_of({"sppm", "ppm", "pm"})) return fmt::format("--photons sets the light paths of sppm, ppm and pm; {} has no such count", a);
+    if (r.photon_radius && !one_of({"sppm", "ppm", "pm", "vcm", "bpm"}))
+        return fmt::format("--radius sets the photon radius of sppm, ppm, pm, vcm and bpm; {} has none", a);
+    if (r.photon_alpha && !one_of({"sppm", "ppm", "vcm", "bpm"})) return fmt::format("--alpha is the radius reduction of sppm, ppm, vcm and bpm, not {}'s", a);
+    if (r.volume_beam && !one_of({"sppm", "ppm", "pm"}))
+        return fmt::format("--volume-estimate chooses how sppm, ppm and pm gather photons in media; {} has no such choice", a);
+    if (r.mis_power && !one_of({"bdpt", "vcm", "bpm"})) return fmt::format("--mis chooses the heuristic of bdpt, vcm and bpm; {} has its own", a);
+    if (!r.vcm_merging && !r.vcm_connections) return "--no-merging and --no-connections together leave vcm no strategy";
+    if ((!r.vcm_merging || !r.vcm_connections) && a != "vcm")
+        return fmt::format("--no-merging and --no-connections switch off vcm's strategies, not {}'s", a);
+    if ((r.ic_rays || r.ic_error || r.ic_gradients) && a != "ic")
+        return fmt::format("--ic-rays, --ic-error, --ic-no-gradients and --ic-records are ic's, not {}'s", a);
+    if ((r.pbgi_surfels || r.pbgi_cutoff || r.pbgi_bounces || r.pbgi_resolution || r.pbgi_direct_samples || r.pbgi_spacing) && a != "pbgi")
+        return fmt::format(
+            "--pbgi-surfels, --pbgi-cutoff, --pbgi-bounces, --pbgi-resolution, --pbgi-direct-samples and --pbgi-spacing are pbgi's, not {}'s", a);
+    const auto out_of = [](const char* name, const auto& v, double lo, double hi) -> std::string {
+        if (v && !(double(*v) >= lo && double(*v) <= hi)) return fmt::format("{} must be {:g} to {:g}, got {}", name, lo, hi, *v);
+        return "";
+    };
+    for (const std::string& why : {out_of("--ic-rays", r.ic_rays, 4, 65536), out_of("--ic-error", r.ic_error, 0, 10),
+                                   out_of("--pbgi-surfels", r.pbgi_surfels, 1, 1e7), out_of("--pbgi-cutoff", r.pbgi_cutoff, 0, 4 * kPi),
+                                   out_of("--pbgi-bounces", r.pbgi_bounces, 1, 64), out_of("--pbgi-resolution", r.pbgi_resolution, 2, 256),
+                                   out_of("--pbgi-direct-samples", r.pbgi_direct_samples, 1, 65536),
+                                   out_of("--pbgi-spacing", r.pbgi_spacing, 1, 64)})
+        if (!why.empty()) return why;
+    return "";
+}
+
 RenderJob::RenderJob(SceneChoice scene, const JobRequest& r) : choice_(std::move(scene)) {
     const SceneDescription& d = choice_.description;
     if (!d.unknown_integrator.empty()) {
@@ -148,6 +186,7 @@ RenderJob::RenderJob(SceneChoice scene, const JobRequest& r) : choice_(std::move
     options_.pbgi_spacing = r.pbgi_spacing ? *r.pbgi_spacing : d.pbgi_spacing.value_or(options_.pbgi_spacing);
     options_.hide_emitters = d.hide_emitters.value_or(false);
     if (const std::string why = integrator_refusal(*info_, d, r); !why.empty()) throw UsageError(why);
+    if (const std::string why = option_refusal(*info_, r); !why.empty()) throw UsageError(why);
     options_.light_sampler = r.light_sampler.value_or(LightSamplerKind::Power);
     if (r.ris_candidates && options_.light_sampler != LightSamplerKind::Ris)
         throw UsageError("--ris-candidates is the number of light samples --light-sampler ris resamples; give --light-sampler ris");

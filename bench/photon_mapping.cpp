@@ -49,7 +49,7 @@ std::vector<RgbPhoton> trace(const RenderContext& ctx, int paths, double& second
             walker.light_subpath(ctx, sampler, RgbWavelengths{}, path);
             for (size_t v = 2; v < path.size(); ++v)
                 if (path[v].kind == VertexKind::Surface && path[v].connectible())
-                    out[size_t(c)].push_back({path[v].p, path[v].sp.frame.to_world(path[v].sp.wi), path[v].beta, uint16_t(v)});
+                    out[size_t(c)].push_back({path[v].p, path[v].sp.frame.to_world(path[v].sp.wi), path[v].beta, uint16_t(v), 0});
         }
     });
     std::vector<RgbPhoton> photons;

@@ -320,7 +320,7 @@ std::vector<RenderJob> make_jobs(const RenderCommandOptions& o, bool check_paths
             // The depth bdpt writes is the lower of --strategies-depth and the paths' own limit.
             const IntegratorOptions& io = jobs[j].integrator_options();
             const bool unlimited = io.max_depth < 0;
-            const int depth = std::min(io.strategies_depth, unlimited ? kMaxBounces : io.max_depth), most = StrategyImages::kMaxLength;
+            const int depth = std::min(io.strategies_depth, bounce_limit(io.max_depth)), most = StrategyImages::kMaxLength;
             if (depth > most)
                 throw UsageError(fmt::format(
                     "--strategies images of paths up to {} bounces would be {} strategies and {} files; at most {} bounces are written "

@@ -57,7 +57,7 @@ float connection_survival(const Medium& m, const Vec3f& o, const Vec3f& d, float
 template <class T>
 Bdpt<T>::Bdpt(const IntegratorOptions& options, BdptFaults faults)
     : options_(limited_to_length(options)), faults_(faults),
-      max_bounces_(options_.max_depth < 0 ? kMaxBounces : std::min(options_.max_depth, kMaxBounces)) {
+      max_bounces_(bounce_limit(options_.max_depth)) {
     if (!options.strategies_dir.empty())
         strategies_ = std::make_unique<StrategyImages>(std::min(options.strategies_depth, max_bounces_), options.strategies_dir);
 }

@@ -17,6 +17,8 @@
 namespace pathlab {
 
 inline constexpr int kMaxBounces = 1024;
+// The bounces a path may make under a --max-depth (negative: unlimited, up to the cap).
+inline constexpr int bounce_limit(int max_depth) { return max_depth < 0 ? kMaxBounces : std::min(max_depth, kMaxBounces); }
 
 // The scene-file parameters of every path tracer. Mitsuba counts path segments, pathlab
 // bounces: max_depth 2 is direct illumination, one bounce (the reader converts).
@@ -46,7 +48,7 @@ inline bool length_counts(const IntegratorOptions& o, int length) {
 class PathRules {
 public:
     explicit PathRules(const IntegratorOptions& o)
-        : max_depth_(o.max_depth < 0 ? kMaxBounces : std::min(o.max_depth, kMaxBounces)), rr_depth_(o.rr_depth) {}
+        : max_depth_(bounce_limit(o.max_depth)), rr_depth_(o.rr_depth) {}
 
     // May a path that has made `bounces` bounces make one more?
     bool may_bounce(int bounces) const { return bounces < max_depth_; }

@@ -44,7 +44,7 @@ float gather_photons(const PhotonKdTree& map, const Vec3f& p, float radius, size
 template <class T>
 PhotonMapper<T>::PhotonMapper(const IntegratorOptions& options, PmFaults faults)
     : options_(limited_to_length(options)), faults_(faults),
-      max_bounces_(options_.max_depth < 0 ? kMaxBounces : std::min(options_.max_depth, kMaxBounces)), light_paths_(options_) {}
+      max_bounces_(bounce_limit(options_.max_depth)), light_paths_(options_) {}
 
 template <class T>
 void PhotonMapper<T>::prepare(const RenderContext& ctx, const PassProgress& progress) {

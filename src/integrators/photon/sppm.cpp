@@ -26,7 +26,7 @@ size_t paths_per_chunk(size_t paths) { return std::max<size_t>(64, paths / 256);
 template <class T>
 Sppm<T>::Sppm(const IntegratorOptions& options, SppmFaults faults, CameraRays rays)
     : options_(limited_to_length(options)), faults_(faults), rays_(rays),
-      max_bounces_(options_.max_depth < 0 ? kMaxBounces : std::min(options_.max_depth, kMaxBounces)), light_paths_(options_) {}
+      max_bounces_(bounce_limit(options_.max_depth)), light_paths_(options_) {}
 
 template <class T>
 double Sppm<T>::radius(double r1, double alpha, uint64_t i) { return progressive_radius(r1, alpha, i); }

@@ -432,6 +432,7 @@ py::dict py_params(const py::object& scene_obj) {
 std::shared_ptr<PyScene> py_update(const py::object& scene_obj, const py::dict& values) {
     const std::shared_ptr<PyScene> scene = scene_argument(scene_obj);
     auto out = std::make_shared<PyScene>(PyScene{scene->choice, nullptr});
+    out->choice.hash.clear();  // no longer the file's scene
     const std::vector<SceneParameter> all = scene_parameters(out->choice.description);
     for (const auto& [name, value] : values) {
         if (!py::isinstance<py::str>(name)) throw py::type_error("update: the keys are parameter names (str)");
@@ -595,7 +596,8 @@ PYBIND11_MODULE(pathlab, m) {
           "float32 array of shape (1,) for a float, (3,) for an rgb, (height, width, 3) for a bitmap's texels");
     m.def("update", &py_update, py::arg("scene"), py::arg("values"),
           "A copy of the scene with parameters set: values is a dict of name to a number, a sequence or an array (one number for\n"
-          "every component, or one colour for every texel, as --set). A value outside the parameter's range is a ValueError.");
+          "every component, or one colour for every texel, as --set). A value outside the parameter's range is a ValueError. The\n"
+          "copy's hash is empty: it is no longer the file's scene.");
     m.def("loss", &py_loss, py::arg("image"), py::arg("target"), py::arg("kind") = "l2",
           "(loss, adjoint): the mean over pixels and channels of (image - target)^2 ('l2') or |image - target| ('l1'), and its\n"
           "derivative with respect to each pixel, the adjoint image gradient() takes");

@@ -239,6 +239,7 @@ def test_params_update_and_their_errors():
     darker = pathlab.update(scene, {"red.reflectance.value": [0.5, 0.1, 0.1]})
     assert np.allclose(pathlab.params(darker)["red.reflectance.value"], [0.5, 0.1, 0.1])
     assert np.array_equal(pathlab.params(scene)["red.reflectance.value"], red)  # a copy: the original is unchanged
+    assert darker.hash == "" and darker.name == scene.name
     assert np.allclose(pathlab.params(pathlab.update(scene, {"red.reflectance.value": 0.25}))["red.reflectance.value"], 0.25)
     # The updated scene renders as the command line renders the scene file with that value.
     a, _ = pathlab.render(darker, "pt-mis", spp=2, seed=3, resolution=(8, 8))

@@ -115,7 +115,7 @@ std::string integrator_refusal(const IntegratorInfo& info, const SceneDescriptio
 // Options that belong to other estimators than `info` (the command line's names), and values out
 // of their range: why the request cannot be rendered (empty: it can). The command line and
 // Python's render() both come through here.
-std::string option_refusal(const IntegratorInfo& info, const JobRequest& r) {
+static std::string option_refusal(const IntegratorInfo& info, const JobRequest& r) {
     const auto one_of = [&](std::initializer_list<const char*> names) {
         for (const char* n : names)
             if (info.name == n) return true;

@@ -1,7 +1,7 @@
 // Writes the seed corpora of the reader fuzz targets, from files pathlab (and the libraries it
 // links) can make itself: small images in every format and variant the readers know, and OBJ
 // meshes, voxel grids. Usage: fuzz_make_seeds DIR  (creates DIR/exr, DIR/hdr, DIR/pfm, DIR/png,
-// DIR/jpeg, DIR/obj, DIR/vol).
+// DIR/jpeg, DIR/obj, DIR/vol, DIR/vdb).
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
@@ -76,7 +76,7 @@ int main(int argc, char** argv) {
         return 2;
     }
     const fs::path dir = argv[1];
-    for (const char* sub : {"exr", "hdr", "pfm", "png", "jpeg", "obj", "vol"}) fs::create_directories(dir / sub);
+    for (const char* sub : {"exr", "hdr", "pfm", "png", "jpeg", "obj", "vol", "vdb"}) fs::create_directories(dir / sub);
 
     // pathlab's own writers, at sizes around the readers' special cases (HDR run-length
     // encoding needs widths of 8 or more).
@@ -159,6 +159,14 @@ int main(int argc, char** argv) {
         g.channels = channels;
         for (size_t i = 0; i < g.voxel_count() * size_t(channels); ++i) g.data.push_back(float(i % 7) * 0.25f);
         pathlab::write_vol_file((dir / "vol" / ("grid" + std::to_string(channels) + ".vol")).string(), g);
+    }
+    // .vdb grids written by OpenVDB (through pathlab's module): a small one and one with a tile.
+    for (const int side : {3, 9}) {
+        pathlab::VoxelGrid g;
+        g.res = {side, side - 1, side - 2 > 0 ? side - 2 : 1};
+        g.channels = 1;
+        for (size_t i = 0; i < g.voxel_count(); ++i) g.data.push_back(i % 5 == 0 ? 0.0f : float(i % 7) * 0.25f);
+        pathlab::write_vdb_file((dir / "vdb" / ("grid" + std::to_string(side) + ".vdb")).string(), g, "density", 0.1);
     }
     return 0;
 }

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Fuzzes pathlab's readers of untrusted files with libFuzzer (clang, AddressSanitizer, UBSan).
-#   scripts/fuzz.sh TARGET [SECONDS]   TARGET: scene_xml, exr, hdr, pfm, png, jpeg, obj, vol, ies, or all
+#   scripts/fuzz.sh TARGET [SECONDS]   TARGET: scene_xml, exr, hdr, pfm, png, jpeg, obj, vol, vdb, ies, or all
 #                                      (all: each target in turn for SECONDS); default 660 s
 #   scripts/fuzz.sh [SECONDS]          the scene-file loader, as before (scene_xml)
 # Seeds: the shipped scenes, meshes and IES files, images and meshes written by fuzz_make_seeds
@@ -14,14 +14,14 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-all_targets=(scene_xml exr hdr pfm png jpeg obj vol ies)
+all_targets=(scene_xml exr hdr pfm png jpeg obj vol vdb ies)
 if [[ $# -eq 0 || $1 =~ ^[0-9]+$ ]]; then
     targets=(scene_xml)
     seconds=${1:-660}
 else
     case $1 in
         all) targets=("${all_targets[@]}") ;;
-        scene_xml | exr | hdr | pfm | png | jpeg | obj | vol | ies) targets=("$1") ;;
+        scene_xml | exr | hdr | pfm | png | jpeg | obj | vol | vdb | ies) targets=("$1") ;;
         *) echo "fuzz.sh: unknown target '$1' (valid: ${all_targets[*]}, all)" >&2; exit 2 ;;
     esac
     seconds=${2:-660}
@@ -57,6 +57,7 @@ make_seeds() {
 summaries=()
 for t in "${targets[@]}"; do
     max_len=16384
+    extra=()
     case $t in
         scene_xml)
             corpus=build-fuzz/corpus  # where the scene-file corpus has always been
@@ -81,6 +82,16 @@ for t in "${targets[@]}"; do
             cp -n build-fuzz/seeds/vol/* "$corpus"/ 2>/dev/null || true
             cp -n tests/data/vol_regressions/* "$corpus"/ 2>/dev/null || true
             ;;
+        vdb)
+            corpus=build-fuzz/corpus-vdb
+            mkdir -p "$corpus"
+            make_seeds
+            cp -n build-fuzz/seeds/vdb/* "$corpus"/ 2>/dev/null || true
+            # OpenVDB leaks the node it was reading when the file ends inside it (the stream
+            # throws; RootNode::readTopology holds it by a raw pointer): one node per refused
+            # file, theirs, so leaks are not reported for this target.
+            extra=(-detect_leaks=0)
+            ;;
         ies)
             corpus=build-fuzz/corpus-ies
             mkdir -p "$corpus"
@@ -100,7 +111,7 @@ for t in "${targets[@]}"; do
     echo "fuzz.sh: $t for $seconds s (corpus $corpus, dictionary $dict)"
     status=0
     build-fuzz/fuzz/fuzz_"$t" "$corpus" -dict="$dict" -max_total_time="$seconds" -max_len="$max_len" -timeout=10 \
-        -rss_limit_mb=2048 -artifact_prefix=build-fuzz/crashes/"$t"- -print_final_stats=1 2>&1 | tee build-fuzz/fuzz-"$t".log ||
+        -rss_limit_mb=2048 -artifact_prefix=build-fuzz/crashes/"$t"- -print_final_stats=1 "${extra[@]}" 2>&1 | tee build-fuzz/fuzz-"$t".log ||
         status=$?
     log=build-fuzz/fuzz-$t.log
     execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)

@@ -361,6 +361,22 @@ TEST_F(Hostile, NonRegularFilesAreRefusedAtOnce) {
     EXPECT_CLEAN(run_bounded([&] { read_image(path("missing.exr")); }, 5), path("missing.exr") + ": no such file");
 }
 
+// Grid files under a FIFO, device or folder name: refused at once, naming the file (the .vdb
+// reader's layout check opened a FIFO before checking it, and waited for a writer).
+TEST_F(Hostile, NonRegularGridFilesAreRefusedAtOnce) {
+    const std::string fifo = path("fifo.vdb"), zero = path("zero.vdb"), folder = path("folder.vdb"), fifo_vol = path("fifo.vol");
+    ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+    ASSERT_EQ(mkfifo(fifo_vol.c_str(), 0600), 0);
+    fs::create_symlink("/dev/zero", zero);
+    fs::create_directories(folder);
+    for (const std::string& file : {fifo, zero, folder, fifo_vol}) {
+        const BoundedResult r = run_bounded(
+            [&] { file.ends_with(".vol") ? (void)read_vol_file(file) : (void)read_vdb_file(file); }, 5);
+        EXPECT_EQ(r.outcome, Outcome::OtherException) << file << ": " << outcome_name(r.outcome) << ": " << r.message;
+        EXPECT_NE(r.message.find("grid file '" + file + "': not a regular file"), std::string::npos) << r.message;
+    }
+}
+
 // Through the command line: `compare` names the file and the problem, exit code 2, at once.
 TEST_F(Hostile, CompareRefusesHostileFilesWithExitCode2) {
     const std::string ok = path("ok.hdr");

@@ -39,6 +39,10 @@ VoxelGrid read_vol_file(const std::string& path);
 // Writes a grid as a .vol file (bounding box: the unit cube); throws GridFileError on failure.
 void write_vol_file(const std::string& path, const VoxelGrid& grid);
 
+// A GridFileError unless `path` names a regular file (checked before a reader opens it: opening
+// a named pipe waits for a writer).
+void require_regular_grid_file(const std::string& path);
+
 // A grid of a .vdb file and where it lies: `unit_to_world` maps pathlab's unit cube of the
 // grid (see voxel_grid.hpp) to the file's world space.
 struct VdbGrid {

@@ -7,7 +7,6 @@
 #include <openvdb/openvdb.h>
 
 #include <cmath>
-#include <filesystem>
 #include <fstream>
 #include <mutex>
 
@@ -79,10 +78,8 @@ VdbGrid densify(const GridT& grid, const std::string& path) {
     return out;
 }
 
+// (vdb_file.cpp's read_vdb_file, the only caller, checked that `path` is a regular file.)
 VdbGrid read_vdb(const std::string& path, const std::string& grid_name) {
-    std::error_code ec;
-    if (!std::filesystem::exists(path, ec)) throw GridFileError(fmt::format("grid file '{}': no such file", path));
-    if (!std::filesystem::is_regular_file(path, ec)) throw GridFileError(fmt::format("grid file '{}': not a regular file", path));
     initialise_openvdb();
     openvdb::GridPtrVecPtr grids;
     // OpenVDB's stream reader, from a stream that throws at the end of the file: its loops over

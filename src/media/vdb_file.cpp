@@ -102,8 +102,9 @@ uint32_t fixed_metadata_size(const std::string& type) {
 void check_vdb_layout(const std::string& path) {
     std::error_code ec;
     const uint64_t size = std::filesystem::file_size(path, ec);
+    if (ec) return;  // the module says why it cannot read it
     std::ifstream in(path, std::ios::binary);
-    if (ec || !in) return;  // the module says why it cannot read it
+    if (!in) return;
     uint64_t at = 0, limit = size;  // limit: the end of the part being read (the file, a grid's header)
     const auto fail = [&](const std::string& why) {
         return GridFileError(fmt::format("grid file '{}': not a readable OpenVDB file: {} (at byte {} of {})", path, why, at, size));
@@ -205,6 +206,7 @@ void check_vdb_layout(const std::string& path) {
 VdbGrid read_vdb_file(const std::string& path, const std::string& grid_name) {
     const OpenVdbModule& m = openvdb_module();
     if (!m.read) throw GridFileError(fmt::format("grid file '{}': {}", path, m.error));
+    require_regular_grid_file(path);  // before the layout check opens it (a named pipe: a hang)
     check_vdb_layout(path);
     VdbGrid out;
     std::string error;

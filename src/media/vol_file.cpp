@@ -79,10 +79,15 @@ VoxelGrid parse_vol(std::string_view bytes, const std::string& name) {
     return g;
 }
 
-VoxelGrid read_vol_file(const std::string& path) {
+void require_regular_grid_file(const std::string& path) {
     std::error_code ec;
     if (!std::filesystem::exists(path, ec)) throw GridFileError(fmt::format("grid file '{}': no such file", path));
     if (!std::filesystem::is_regular_file(path, ec)) throw GridFileError(fmt::format("grid file '{}': not a regular file", path));
+}
+
+VoxelGrid read_vol_file(const std::string& path) {
+    require_regular_grid_file(path);
+    std::error_code ec;
     const auto size = std::filesystem::file_size(path, ec);
     if (ec) throw GridFileError(fmt::format("grid file '{}': {}", path, ec.message()));
     // The header alone bounds what the data may take: refuse before reading a huge file.

@@ -420,14 +420,11 @@ int run_optimize_command(const OptimizeOptions& o) {
         }
         return !InterruptGuard::flag().load();
     });
-    const int it = run.iterations;
-    const bool interrupted = run.stopped;
-    const double best_loss = run.best_loss;
-    const std::vector<float>& best = run.best;
-    SceneDescription desc = scene.description;
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const bool interrupted = run.stopped;
     // Interrupted: the parameters of the lowest loss seen; otherwise the last step's.
     const std::vector<float>& result = run.theta;
+    SceneDescription desc = scene.description;
     set.set_values(desc, result);
     {
         const std::unique_ptr<Scene> built = Scene::build(desc);
@@ -448,7 +445,7 @@ int run_optimize_command(const OptimizeOptions& o) {
                                               {"spp", o.common.spp},
                                               {"loss", o.loss},
                                               {"iterations", history},
-                                              {"best", {{"loss", best_loss}, {"params", parameters_json(set, best)}}},
+                                              {"best", {{"loss", run.best_loss}, {"params", parameters_json(set, run.best)}}},
                                               {"final", {{"loss", final_loss}, {"params", parameters_json(set, result)}}},
                                               {"seconds", seconds}});
         LogLogPlot plot{"pathlab optimize: loss per iteration", "iteration", fmt::format("{} loss", o.loss)};
@@ -470,7 +467,7 @@ int run_optimize_command(const OptimizeOptions& o) {
                 fmt::print(stderr, "pathlab: {}\n", e.what());
             }
         }
-        fmt::print("{} iterations in {:.1f} s; final loss {:.6g}{}; written to {}/ (params.json, loss.json, loss.svg, final.exr{})\n", it,
+        fmt::print("{} iterations in {:.1f} s; final loss {:.6g}{}; written to {}/ (params.json, loss.json, loss.svg, final.exr{})\n", run.iterations,
                    seconds, final_loss, interrupted ? " (interrupted: the best parameters so far)" : "", o.out_dir,
                    scene.file.empty() ? "" : ", scene.xml");
     }

@@ -28,7 +28,7 @@ OptimizationResult optimize(const SceneDescription& d, const ParameterSet& set, 
         replay.seed = primal.seed + 1;
         const std::vector<double> g = gradient(*built, set, replay, loss_adjoint(image, target, s.loss));
         if (!each({it, r.theta, image, L, g})) {
-            r.stopped = true;
+            r.stopped = true, r.iterations = it + 1;  // this one was rendered and reported
             r.theta = r.best;
             break;
         }

@@ -35,7 +35,7 @@ struct OptimizationResult {
     std::vector<float> theta;  // after the last step (stopped early: of the lowest loss seen)
     std::vector<float> best;   // of the lowest loss seen
     double best_loss;
-    int iterations;  // done
+    int iterations;  // rendered and reported to `each` (the one it stopped at included)
     bool stopped;    // `each` asked to stop
 };
 

@@ -575,6 +575,11 @@ TEST(SceneFileMeshes, HostilePlyHeadersAreRefusedWithTheirProblem) {
     };
     refused("binary-list.ply", binary("uint", std::string("\x00\xca\x9a\x3b", 4)), "claims 1000000000 values, more than the file holds after it (12 bytes)");
     refused("binary-negative.ply", binary("int", "\xfd\xff\xff\xff"), "claims -1 values");
+    // A list whose values take the bytes of the elements after it (the file is as long as the
+    // header's smallest body, so only the walk finds it).
+    std::string eaten = "ply\nformat binary_little_endian 1.0\nelement face 1\nproperty list uchar int vertex_indices\n" + vertex + "end_header\n";
+    eaten += std::string("\x09", 1) + std::string(36, '\0');
+    refused("list-eats-vertices.ply", eaten, "the file ends inside element 'vertex' (3 items of 12 bytes)");
     EXPECT_EQ(load_ply_mesh((write_file(dir + "/binary.ply", binary("uchar", "\x03")), dir + "/binary.ply")).triangles.size(), 1u);
     // The smallest body the header allows is accepted (3 ASCII values need 5 bytes: "0 0 0").
     write_file(dir + "/tight.ply", "ply\nformat ascii 1.0\n" + vertex + "element face 1\nproperty list uchar int vertex_indices\nend_header\n"

@@ -203,10 +203,11 @@ void check_ply_file(const std::string& path) {
     std::string word;
     for (const PlyElement& e : elements) {
         const bool lists = std::any_of(e.properties.begin(), e.properties.end(), [](const PlyProperty& p) { return p.count_size > 0; });
-        if (binary && !lists) {  // fixed-size items: the size check above holds them
+        if (binary && !lists) {  // fixed-size items, skipped at once
             uint64_t item = 0;
             for (const PlyProperty& p : e.properties) item += p.size;
-            reader.skip(e.count * item);
+            if (!reader.skip(e.count * item))
+                throw MeshLoadError(fmt::format("mesh '{}': the file ends inside element '{}' ({} items of {} bytes)", path, e.name, e.count, item));
             continue;
         }
         for (uint64_t i = 0; i < e.count; ++i)

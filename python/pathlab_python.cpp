@@ -22,6 +22,7 @@
 #include <exception>
 #include <mutex>
 #include <limits>
+#include <map>
 #include <optional>
 #include <thread>
 
@@ -66,6 +67,9 @@ std::string algorithm_names() {
     return s;
 }
 
+// The name of a value's type, for TypeErrors ("float", "str").
+std::string type_name(const py::handle& v) { return py::str(py::type::of(v).attr("__name__")).cast<std::string>(); }
+
 // A usage problem from the C++ side is a ValueError (an unknown name, a malformed file).
 template <typename F>
 auto translating(F&& f) {
@@ -91,7 +95,7 @@ std::shared_ptr<PyScene> py_load(const py::object& what, const std::map<std::str
     } else {
         throw py::type_error(fmt::format("scene must be a course index (int 0-7), a scene name or a scene file (str or path), not {}; "
                                          "valid scenes: {}, or a scene file ending in .xml",
-                                         py::str(py::type::of(what).attr("__name__")).cast<std::string>(), scene_names()));
+                                         type_name(what), scene_names()));
     }
     if (spec.empty() || spec == "all" || spec.find(',') != std::string::npos)
         throw py::value_error("load() takes one scene: a course index, a name (" + scene_names() + ") or a scene file");
@@ -106,7 +110,7 @@ std::shared_ptr<PyScene> scene_argument(const py::object& scene) {
 
 std::string string_argument(const py::object& v, const char* name, const std::string& valid) {
     if (!py::isinstance<py::str>(v))
-        throw py::type_error(fmt::format("{} must be a str, not {}; valid: {}", name, py::str(py::type::of(v).attr("__name__")).cast<std::string>(),
+        throw py::type_error(fmt::format("{} must be a str, not {}; valid: {}", name, type_name(v),
                                          valid));
     return v.cast<std::string>();
 }
@@ -117,7 +121,7 @@ template <typename T>
 std::optional<T> int_argument(const py::object& v, const char* name, T lo, T hi, const char* why = "") {
     if (v.is_none()) return std::nullopt;
     if (!py::isinstance<py::int_>(v) || py::isinstance<py::bool_>(v))
-        throw py::type_error(fmt::format("{} must be an int, not {}", name, py::str(py::type::of(v).attr("__name__")).cast<std::string>()));
+        throw py::type_error(fmt::format("{} must be an int, not {}", name, type_name(v)));
     const py::int_ low(lo), high(hi);
     if (v < low || v > high) throw py::value_error(fmt::format("{} must be an int from {} to {}{}, not {}", name, lo, hi, why, py::str(v).cast<std::string>()));
     return v.cast<T>();
@@ -138,7 +142,7 @@ Image to_image(const py::object& v, const char* name) {
     }
     if (!py::isinstance<py::array>(v) && !py::isinstance<py::list>(v))
         throw py::type_error(fmt::format("{} must be a NumPy array of shape (height, width, 3) or an image file name (str), not {}", name,
-                                         py::str(py::type::of(v).attr("__name__")).cast<std::string>()));
+                                         type_name(v)));
     py::array_t<float, py::array::c_style | py::array::forcecast> a;
     try {
         a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(v);
@@ -216,7 +220,7 @@ void apply_estimator_options(JobRequest& r, const py::kwargs& options) {
         "pbgi_cutoff, pbgi_bounces, pbgi_resolution, pbgi_direct_samples, pbgi_spacing";
     const auto number = [](const py::handle& v, const std::string& name) {
         if (!py::isinstance<py::int_>(v) && !py::isinstance<py::float_>(v))
-            throw py::type_error(fmt::format("{} must be a number, not {}", name, py::str(py::type::of(v).attr("__name__")).cast<std::string>()));
+            throw py::type_error(fmt::format("{} must be a number, not {}", name, type_name(v)));
         const double x = v.cast<double>();
         if (!std::isfinite(x)) throw py::value_error(fmt::format("{} must be finite", name));
         return x;
@@ -225,6 +229,10 @@ void apply_estimator_options(JobRequest& r, const py::kwargs& options) {
         if (!py::isinstance<py::bool_>(v)) throw py::type_error(fmt::format("{} must be True or False", name));
         return v.cast<bool>();
     };
+    static const std::map<std::string, std::optional<int> JobRequest::*> pbgi_counts = {
+        {"pbgi_surfels", &JobRequest::pbgi_surfels},       {"pbgi_bounces", &JobRequest::pbgi_bounces},
+        {"pbgi_resolution", &JobRequest::pbgi_resolution}, {"pbgi_direct_samples", &JobRequest::pbgi_direct_samples},
+        {"pbgi_spacing", &JobRequest::pbgi_spacing}};
     for (const auto& [key, value] : options) {
         const std::string name = py::str(key);
         const py::object v = py::reinterpret_borrow<py::object>(value);
@@ -254,14 +262,8 @@ void apply_estimator_options(JobRequest& r, const py::kwargs& options) {
             if (flag(v, name)) r.ic_gradients = false;
         } else if (name == "pbgi_cutoff") {
             r.pbgi_cutoff = float(number(v, name));
-        } else if (name == "pbgi_surfels" || name == "pbgi_bounces" || name == "pbgi_resolution" || name == "pbgi_direct_samples" ||
-                   name == "pbgi_spacing") {
-            const int n = *int_argument<int>(v, name.c_str(), 0, kIntMax);
-            (name == "pbgi_surfels"     ? r.pbgi_surfels
-             : name == "pbgi_bounces"   ? r.pbgi_bounces
-             : name == "pbgi_resolution" ? r.pbgi_resolution
-             : name == "pbgi_spacing"   ? r.pbgi_spacing
-                                        : r.pbgi_direct_samples) = n;
+        } else if (const auto field = pbgi_counts.find(name); field != pbgi_counts.end()) {
+            r.*(field->second) = *int_argument<int>(v, name.c_str(), 0, kIntMax);
         } else {
             throw py::type_error(fmt::format("render() got an unexpected keyword argument '{}'; the estimators' options: {}", name, kNames));
         }

@@ -19,6 +19,7 @@ inline RenderResult render_scene(const SceneDescription& desc, const std::string
     request.spp = uint64_t(spp);
     request.max_depth = options.max_depth;
     request.rr_depth = options.rr_depth;
+    request.mis_power = options.mis_power;
     request.width = width;
     request.height = height;
     request.seed = seed;

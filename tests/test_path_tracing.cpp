@@ -111,6 +111,27 @@ TEST_P(GlobalAgreement, PathTracersConvergeToTheSameImage) {
 }
 INSTANTIATE_TEST_SUITE_P(Scenes, GlobalAgreement, ::testing::Range(0, 8));
 
+// --mis power weighs the light and BSDF samples of pt-mis, pt-mis3 and direct-mis by the power
+// heuristic: another estimator of the same image (the glossy ceiling, the glossy spheres under
+// the light box), not the balance heuristic's bytes.
+TEST(PathTracing, ThePowerHeuristicConvergesToTheBalanceHeuristicsImage) {
+    IntegratorOptions power;
+    power.mis_power = true;
+    for (int scene : {2, 5}) {
+        const RenderResult ref = render_scene(make_builtin_scene(scene), "pt-mis", 16, 16, 4096, 41);
+        for (const char* a : {"pt-mis", "pt-mis3"}) {
+            const RenderResult p = render_scene(make_builtin_scene(scene), a, 16, 16, 4096, 42, power);
+            const AgreementResult r = compare(p, ref);
+            EXPECT_TRUE(r.agree) << "scene " << scene << " " << a << ": " << r.describe();
+        }
+        const RenderResult balance = render_scene(make_builtin_scene(scene), "direct-mis", 16, 16, 4096, 43);
+        const RenderResult p = render_scene(make_builtin_scene(scene), "direct-mis", 16, 16, 4096, 43, power);
+        EXPECT_FALSE(bit_identical(p.film.mean(), balance.film.mean())) << "scene " << scene;
+        const AgreementResult r = compare(p, render_scene(make_builtin_scene(scene), "direct-mis", 16, 16, 4096, 44));
+        EXPECT_TRUE(r.agree) << "scene " << scene << " direct-mis: " << r.describe();
+    }
+}
+
 TEST(PathTracing, NaiveIsBlackWithOnlyAPointLight) {
     const Image img = render_scene(make_builtin_scene(0), "pt-naive", 16, 16, 16).film.mean();
     for (size_t i = 0; i < img.pixel_count(); ++i) ASSERT_EQ(img[i], Rgb(0.0f));

@@ -87,5 +87,15 @@ inline float area_to_solid_angle(float pdfA, float dist, float cos_at_surface) {
 inline float balance_heuristic(float pdf_a, float pdf_b) {
     return pdf_a > 0 ? pdf_a / (pdf_a + pdf_b) : 0.0f;
 }
+// Veach's power heuristic with beta = 2: pdf_a^2 / (pdf_a^2 + pdf_b^2).
+inline float power_heuristic(float pdf_a, float pdf_b) {
+    if (!(pdf_a > 0)) return 0.0f;
+    const float r = pdf_b / pdf_a;  // as a ratio, so that large densities do not overflow
+    return 1 / (1 + r * r);
+}
+// The weight of strategy a against b by one of the two.
+inline float mis_heuristic(bool power, float pdf_a, float pdf_b) {
+    return power ? power_heuristic(pdf_a, pdf_b) : balance_heuristic(pdf_a, pdf_b);
+}
 
 }  // namespace pathlab

@@ -52,7 +52,7 @@ struct IntegratorOptions {
     // Only paths of exactly this many bounces count (-1: all); pt-mis and bdpt honour it, so
     // that strategies can be compared with path tracing one length at a time.
     int only_length = -1;
-    bool mis_power = false;        // bdpt: the power heuristic (beta = 2) instead of the balance heuristic
+    bool mis_power = false;        // bdpt, vcm, bpm, the MIS path tracers, direct-mis: the power heuristic (beta = 2) instead of the balance heuristic
     std::string strategies_dir;    // bdpt: write one image per strategy (s, t) there ("" for none)
     int strategies_depth = 4;      // bdpt: ... for paths of up to this many bounces
     // Photon mapping (sppm): light paths per iteration (0: one per pixel), the first

@@ -128,7 +128,8 @@ static std::string option_refusal(const IntegratorInfo& info, const JobRequest& 
     if (r.photon_alpha && !one_of({"sppm", "ppm", "vcm", "bpm"})) return fmt::format("--alpha is the radius reduction of sppm, ppm, vcm and bpm, not {}'s", a);
     if (r.volume_beam && !one_of({"sppm", "ppm", "pm"}))
         return fmt::format("--volume-estimate chooses how sppm, ppm and pm gather photons in media; {} has no such choice", a);
-    if (r.mis_power && !one_of({"bdpt", "vcm", "bpm"})) return fmt::format("--mis chooses the heuristic of bdpt, vcm and bpm; {} has its own", a);
+    if (r.mis_power && !one_of({"bdpt", "vcm", "bpm", "pt-mis", "pt-mis3", "direct-mis"}))
+        return fmt::format("--mis chooses the heuristic of bdpt, vcm, bpm, pt-mis, pt-mis3 and direct-mis; {} has its own", a);
     if (!r.vcm_merging && !r.vcm_connections) return "--no-merging and --no-connections together leave vcm no strategy";
     if ((!r.vcm_merging || !r.vcm_connections) && a != "vcm")
         return fmt::format("--no-merging and --no-connections switch off vcm's strategies, not {}'s", a);

@@ -35,7 +35,7 @@ struct JobRequest {
     SamplerKind sampler = SamplerKind::Independent;
     bool spectral = false;  // --spectral (else the scene file's <default name="mode">, else RGB)
     uint64_t default_spp = 64;
-    bool mis_power = false;        // --mis power (bdpt)
+    bool mis_power = false;        // --mis power (bdpt, vcm, bpm, pt-mis, pt-mis3, direct-mis)
     std::string strategies_dir;    // --strategies DIR (bdpt)
     int strategies_depth = 4;      // --strategies-depth N (bdpt)
     std::optional<int64_t> photons;       // --photons N (sppm, pm)

@@ -16,9 +16,10 @@ namespace pathlab {
 // One light chosen by the scene's light sampler (Scene::choose_light), one point or direction
 // sampled on it (or, with ris, one of several such candidates: light_resampling.hpp), one shadow
 // ray. Returns f * Le * cos(theta) / (pmf * pdfW) (ris: / NeeSample::pdf) in the path's colour (wl:
-// transport.hpp). With `mis`, the result is weighted by the balance heuristic against BSDF
-// sampling of the same direction (both densities in solid angle, the light's including its
-// selection probability); delta lights cannot be found by BSDF sampling and keep weight 1.
+// transport.hpp). With `mis`, the result is weighted by the balance heuristic (the power heuristic
+// with `power`) against BSDF sampling of the same direction (both densities in solid angle, the
+// light's including its selection probability); delta lights cannot be found by BSDF sampling
+// and keep weight 1.
 // RIS's target at a surface (light_resampling.hpp): the luminance of the unshadowed
 // contribution f * Le * |cos theta| of a candidate light sample; 0 behind an opaque surface.
 inline float surface_target(const ShadingPoint& sp, const LightSample& c) {
@@ -37,7 +38,7 @@ int nee_candidates(const Scene& scene, const ShadingPoint* sp, const Wl& wl) {
 }
 
 template <class Wl>
-ColourAt<Wl> estimate_light_sample(const Scene& scene, const ShadingPoint& sp, Sampler& sampler, bool mis, Wl& wl) {
+ColourAt<Wl> estimate_light_sample(const Scene& scene, const ShadingPoint& sp, Sampler& sampler, bool mis, Wl& wl, bool power = false) {
     using Colour = ColourAt<Wl>;
     const bool dispersive = changes_wavelengths(*sp.material, wl);
     const bool transmits = sp.material->is_dielectric();
@@ -65,7 +66,7 @@ ColourAt<Wl> estimate_light_sample(const Scene& scene, const ShadingPoint& sp, S
                                                 : spawn_segment(sp.p, sp.ng, ls->point, ls->normal);
     if (scene.occluded(shadow)) return Colour(0.0f);
     if (!dispersive) f = bsdf_colour(sp, wo, f_rgb, wl);
-    const float weight = (mis && !ls->delta) ? balance_heuristic(nee->pdf_source, pdf_bsdf) : 1.0f;
+    const float weight = (mis && !ls->delta) ? mis_heuristic(power, nee->pdf_source, pdf_bsdf) : 1.0f;
     return f * light_colour(scene, choice.index, ls->Le, wl) * (std::abs(wo.z) * weight / nee->pdf);
 }
 
@@ -117,15 +118,16 @@ inline EmitterHit trace_to_emitter(const Scene& scene, const Ray& ray, const Vec
 }
 
 // The BSDF-sampled half of MIS direct lighting: traces the sampled direction and returns the
-// emission it finds weighted by the balance heuristic against light sampling (weight 1 for a
-// delta BSDF sample, which light sampling cannot produce); `f` is the sample's colour
-// (bsdf_sample_colour). `found` receives the hit, for path tracers that continue from it.
+// emission it finds weighted by the balance heuristic (the power heuristic with `power`) against
+// light sampling (weight 1 for a delta BSDF sample, which light sampling cannot produce); `f` is
+// the sample's colour (bsdf_sample_colour). `found` receives the hit, for path tracers that
+// continue from it.
 template <class Wl>
 ColourAt<Wl> estimate_bsdf_sample_mis(const Scene& scene, const ShadingPoint& sp, const BsdfSample& s, const ColourAt<Wl>& f,
-                                      EmitterHit& found, const Wl& wl) {
+                                      EmitterHit& found, const Wl& wl, bool power = false) {
     found = trace_to_emitter(scene, sp.spawn(s.wo), sp.p, sp.frame.n);
     if (is_black(found.Le)) return ColourAt<Wl>(0.0f);
-    const float weight = s.delta ? 1.0f : balance_heuristic(s.pdfW, found.pdf_light);
+    const float weight = s.delta ? 1.0f : mis_heuristic(power, s.pdfW, found.pdf_light);
     const int light = found.hit ? found.isect.light : scene.environment_light();
     return f * light_colour(scene, light, found.Le, wl) * (std::abs(s.wo.z) * weight / s.pdfW);
 }

@@ -48,7 +48,10 @@ inline bool length_counts(const IntegratorOptions& o, int length) {
 class PathRules {
 public:
     explicit PathRules(const IntegratorOptions& o)
-        : max_depth_(bounce_limit(o.max_depth)), rr_depth_(o.rr_depth) {}
+        : max_depth_(bounce_limit(o.max_depth)), rr_depth_(o.rr_depth), power_mis_(o.mis_power) {}
+
+    // The path tracers' MIS heuristic: the power heuristic (--mis power), else the balance one.
+    bool power_mis() const { return power_mis_; }
 
     // May a path that has made `bounces` bounces make one more?
     bool may_bounce(int bounces) const { return bounces < max_depth_; }
@@ -71,6 +74,7 @@ public:
 private:
     int max_depth_;
     int rr_depth_;
+    bool power_mis_;
 };
 
 }  // namespace pathlab

@@ -24,23 +24,24 @@ std::vector<ParamInfo> direct_params() {
 template <class T>
 class DirectMis final : public PixelIntegrator<T> {
 public:
-    explicit DirectMis(const IntegratorOptions& o) : hide_(o.hide_emitters) {}
+    explicit DirectMis(const IntegratorOptions& o) : hide_(o.hide_emitters), power_(o.mis_power) {}
     ColourOf<T> radiance(const Scene& scene, const Ray& ray, Sampler& sampler, WavelengthsOf<T>& wl) const override {
         ColourOf<T> L;
         const auto first = first_surface(scene, ray, hide_, wl, L);
         if (!first) return L;
         const ShadingPoint& sp = *first;
-        L += estimate_light_sample(scene, sp, sampler, /*mis=*/true, wl);
+        L += estimate_light_sample(scene, sp, sampler, /*mis=*/true, wl, power_);
         if (!scene.has_hittable_emitters()) return L;  // only delta lights: the BSDF ray finds nothing
         if (const auto s = bsdf_sample(sp, sampler.next2d(), wl)) {
             EmitterHit found;
-            L += estimate_bsdf_sample_mis(scene, sp, *s, bsdf_sample_colour(sp, *s, wl), found, wl);
+            L += estimate_bsdf_sample_mis(scene, sp, *s, bsdf_sample_colour(sp, *s, wl), found, wl, power_);
         }
         return L;
     }
 
 private:
     bool hide_;
+    bool power_;
 };
 
 }  // namespace

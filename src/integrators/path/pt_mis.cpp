@@ -1,6 +1,7 @@
 // Path tracing with next-event estimation combined by MIS (course assignments 4B and 4C).
 // At every surface x_k the path adds, times its throughput, what direct-mis adds there: a
-// light sample and a BSDF sample, each weighted by the balance heuristic. Emission seen
+// light sample and a BSDF sample, each weighted by the balance heuristic (--mis power: the power
+// heuristic, as Mitsuba's path tracer weighs them). Emission seen
 // directly by the camera is added once, at x_0.
 //
 //   pt-mis3 (4b): three rays per bounce. The MIS BSDF sample is one ray; a third, independent
@@ -25,14 +26,14 @@ ColourAt<Wl> pt_mis_from_hit(const Scene& scene, Intersection hit, Vec3f dir, in
         const ShadingPoint sp = make_shading_point(scene, hit, dir);
         if (sp.material->is_black()) break;
         // Paths of bounces + 1 bounces ending on a light: the MIS pair.
-        const Colour direct = estimate_light_sample(scene, sp, sampler, /*mis=*/true, wl);
+        const Colour direct = estimate_light_sample(scene, sp, sampler, /*mis=*/true, wl, rules.power_mis());
         if (counts(bounces + 1)) L += beta * direct;
         const auto s = bsdf_sample(sp, sampler.next2d(), wl);
         EmitterHit found;
         Colour f(0.0f);  // the continuation's BSDF value
         if (s) {
             f = bsdf_sample_colour(sp, *s, wl);
-            const Colour found_emission = estimate_bsdf_sample_mis(scene, sp, *s, f, found, wl);
+            const Colour found_emission = estimate_bsdf_sample_mis(scene, sp, *s, f, found, wl, rules.power_mis());
             if (counts(bounces + 1)) L += beta * found_emission;
         }
         if (!rules.may_bounce(bounces + 1)) break;

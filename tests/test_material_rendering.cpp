@@ -7,6 +7,7 @@
 
 #include "judge/image_statistics.hpp"
 #include "render_helpers.hpp"
+#include "scene_helpers.hpp"
 
 namespace pathlab::test {
 namespace {
@@ -15,30 +16,6 @@ const AgreementOptions kAgreement{1e-3, 1e-4};
 
 MicrofacetDistribution ggx(float au, float av = -1) { return {MicrofacetType::GGX, au, av < 0 ? au : av}; }
 MicrofacetDistribution beckmann(float a) { return {MicrofacetType::Beckmann, a, a}; }
-
-// Three spheres on a diffuse floor under a small area light and a dim sky. `sphere_materials`
-// are the spheres' materials (indices 2, 3, 4).
-SceneDescription material_scene(const std::vector<Material>& sphere_materials) {
-    SceneDescription d;
-    d.name = "materials";
-    d.camera = Camera::look_along({0, -4, 1.2f}, {0, 1, -0.3f}, {0, 0, 1}, 36.0f, FovAxis::EachAxis);
-    d.materials = {make_phong(Rgb(0.0f)), make_phong(Rgb(0.6f))};
-    for (const Material& m : sphere_materials) d.materials.push_back(m);
-    MeshDesc light;  // 2 x 2 at z = 3, facing down
-    light.positions = {{-1, -1, 3}, {1, -1, 3}, {1, 1, 3}, {-1, 1, 3}};
-    light.triangles = {{0, 2, 1}, {0, 3, 2}};
-    light.material = 0;
-    light.emission = Rgb(3.0f);
-    MeshDesc floor;
-    floor.positions = {{-3, -3, 0}, {3, -3, 0}, {3, 3, 0}, {-3, 3, 0}};
-    floor.triangles = {{0, 1, 2}, {2, 3, 0}};
-    floor.material = 1;
-    d.meshes = {light, floor};
-    for (size_t i = 0; i < sphere_materials.size(); ++i)
-        d.spheres.push_back(SphereDesc{{-1.1f + 1.1f * float(i), 0.2f * float(i), 0.5f}, 0.5f, uint32_t(2 + i)});
-    d.lights = {EnvironmentLight{Rgb(0.1f, 0.12f, 0.15f)}};
-    return d;
-}
 
 void expect_agreement(const SceneDescription& d, const std::string& reference, const std::vector<std::string>& algorithms,
                       int size, int spp) {

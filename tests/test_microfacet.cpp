@@ -182,6 +182,25 @@ std::vector<BsdfCase> sampling_cases() {
             out.push_back({"roughplastic_ggx_" + tag(a, theta), [=] { return make_rough_plastic(ggx(a), Rgb(0.5f, 0.3f, 0.2f)); }, theta, a});
     }
     out.push_back({"roughplastic_beckmann_" + tag(0.1f, 45), [=] { return make_rough_plastic(beckmann(0.1f), Rgb(0.5f)); }, 45, 0.1f});
+    // principled: the default, every reflection lobe at once (anisotropic, metallic, clearcoat,
+    // sheen), a nearly smooth one, and specular transmission from both sides, lobe by lobe.
+    const auto principled = [](float roughness, float metallic, float spec_trans, float clearcoat, float anisotropic) {
+        return [=] {
+            PrincipledMaterial p;
+            p.base_color = Rgb(0.6f, 0.4f, 0.3f);
+            p.roughness = roughness, p.metallic = metallic, p.spec_trans = spec_trans, p.transmits = spec_trans > 0;
+            p.clearcoat = clearcoat, p.clearcoat_gloss = 0.5f, p.anisotropic = anisotropic, p.sheen = 0.5f, p.spec_tint = 0.3f;
+            return Material{p, false};
+        };
+    };
+    for (float theta : {0.0f, 45.0f, 85.0f}) {
+        out.push_back({"principled_default_" + tag(0.25f, theta), principled(0.5f, 0, 0, 0, 0), theta, 0.25f});
+        out.push_back({"principled_all_lobes_" + tag(0.09f, theta), principled(0.3f, 0.4f, 0, 0.8f, 0.6f), theta, 0.05f});
+    }
+    out.push_back({"principled_smooth_" + tag(0.01f, 30), principled(0.1f, 0.5f, 0, 0, 0), 30, 0.01f});
+    both_lobes("principled_glass_" + tag(0.16f, 45), principled(0.4f, 0.1f, 0.7f, 0.5f, 0), 45, 0.16f);
+    both_lobes("principled_glass_inside_" + tag(0.16f, 30), principled(0.4f, 0.1f, 0.7f, 0, 0.5f), 30, 0.16f, true);
+    both_lobes("principled_glass_inside_" + tag(0.16f, 60), principled(0.4f, 0.1f, 0.7f, 0, 0), 60, 0.16f, true);
     return out;
 }
 
@@ -201,7 +220,9 @@ TEST_P(BsdfSampling, MatchesItsPdfAndEval) {
     const auto wrong_side = [&](const Vec3f& wo) { return c.side != 0 && (wo.z * wi.z > 0) != (c.side > 0); };
     if (c.side < 0) {
         const auto* d = std::get_if<RoughDielectricMaterial>(&m.model);
-        const float eta_i = wi.z > 0 ? d->ext_ior : d->int_ior, eta_o = wi.z > 0 ? d->int_ior : d->ext_ior;
+        const auto* p = std::get_if<PrincipledMaterial>(&m.model);
+        const float ext = d ? d->ext_ior : 1.0f, in = d ? d->int_ior : p->eta;
+        const float eta_i = wi.z > 0 ? ext : in, eta_o = wi.z > 0 ? in : ext;
         const float r2 = (eta_i / eta_o) * (eta_i / eta_o) * (1 - wi.z * wi.z);
         axis = r2 < 1 ? normalize(Vec3f(-wi.x * eta_i / eta_o, -wi.y * eta_i / eta_o, std::copysign(std::sqrt(1 - r2), -wi.z)))
                       : Vec3f(0, 0, -std::copysign(1.0f, wi.z));

@@ -59,6 +59,13 @@ std::vector<Case> cases() {
         {"roughplastic", [](const ColourLanes& L) { return make_rough_plastic(rough(0.3f), L({0.8f, 0.5f, 0.1f}), L({0.5f, 0.9f, 0.6f})); }},
         {"roughplastic nonlinear",
          [](const ColourLanes& L) { return make_rough_plastic(rough(0.2f), L({0.8f, 0.5f, 0.1f}), Rgb(1.0f), 1.5f, 1.000277f, true); }},
+        {"principled",  // without the tints, whose luminance is the RGB colour's (principled.hpp)
+         [](const ColourLanes& L) {
+             PrincipledMaterial p;
+             p.base_color = L({0.7f, 0.4f, 0.2f});
+             p.roughness = 0.4f, p.metallic = 0.3f, p.spec_trans = 0.4f, p.transmits = true, p.sheen = 0.5f, p.clearcoat = 0.6f;
+             return Material{p, false};
+         }},
         {"blendbsdf",
          [](const ColourLanes& L) {
              Material m{BlendMaterial{std::make_shared<const Material>(make_phong(L({0.7f, 0.2f, 0.2f}))),

@@ -132,12 +132,13 @@ TEST_F(TextureRendering, BlendWeightAndMaskOpacityFollowTheirTexturesAtTheHitsUv
     EXPECT_TRUE(blend.varies && mask.varies);
     EXPECT_TRUE(blend.lobes() & kLobeSpecular);  // the conductor's, whatever the weight
     const Vec3f wi = normalize(Vec3f(0.3f, -0.2f, 0.9f)), wo = normalize(Vec3f(-0.4f, 0.1f, 0.8f));
-    // color0 at [0, 1/2]^2 and [1/2, 1]^2, color1 elsewhere.
+    // A colour's color0 at [0, 1/2]^2 and [1/2, 1]^2, color1 elsewhere; a scalar's the other way
+    // round (Mitsuba 3's eval_1, checkerboard.hpp).
     const struct {
         Vec2f uv;
         float weight, opacity;
         Rgb rho;
-    } at[] = {{Vec2f(0.25f, 0.25f), 0.2f, 0.25f, Rgb(0.1f, 0.2f, 0.3f)}, {Vec2f(0.75f, 0.25f), 0.9f, 1.0f, Rgb(0.6f, 0.5f, 0.4f)}};
+    } at[] = {{Vec2f(0.25f, 0.25f), 0.9f, 1.0f, Rgb(0.1f, 0.2f, 0.3f)}, {Vec2f(0.75f, 0.25f), 0.2f, 0.25f, Rgb(0.6f, 0.5f, 0.4f)}};
     for (const auto& x : at) {
         const MaterialModel bm = blend.model_at(x.uv);
         EXPECT_FLOAT_EQ(std::get<BlendMaterial>(bm).weight, x.weight);

@@ -142,11 +142,12 @@ TEST(Textures, CheckerboardSquares) {
     c.to_uv = UvTransform::from(Transform::scale({4, 4, 1}));  // 8 x 8 squares
     EXPECT_EQ(c.eval({0.1f, 0.1f}), c.color0);
     EXPECT_EQ(c.eval({0.2f, 0.1f}), c.color1);
-    // Scalars: a grey colour's value, else its luminance.
+    // Scalars: a grey colour's value, else its luminance, with the colours' squares swapped as
+    // Mitsuba 3's eval_1 swaps them.
     CheckerboardTexture g;
     g.color0 = Rgb(0.3f), g.color1 = Rgb(0.2f, 0.4f, 0.6f);
-    EXPECT_EQ(g.eval_1({0.25f, 0.25f}), 0.3f);
-    EXPECT_EQ(g.eval_1({0.75f, 0.25f}), luminance(g.color1));
+    EXPECT_EQ(g.eval_1({0.75f, 0.25f}), 0.3f);
+    EXPECT_EQ(g.eval_1({0.25f, 0.25f}), luminance(g.color1));
 }
 
 // bumpmap's gradient: that of the bilinear interpolant, through the uv transform (against
@@ -301,9 +302,10 @@ TEST_F(TextureFiles, TexturesAreBoundToBsdfParameters) {
     const auto& rc = std::get<RoughConductorMaterial>(m.model);
     EXPECT_EQ(rc.distribution.alpha_u, 0.4f);
     EXPECT_EQ(rc.distribution.alpha_v, 0.2f);
-    // At a hit: the values there (uv (0.3, 0.1): checker square of color0).
+    // At a hit: the values there (uv (0.3, 0.1): a colour's color0 square, so a float's color1,
+    // as Mitsuba's eval_1 swaps them).
     const auto at = std::get<RoughConductorMaterial>(m.model_at({0.3f, 0.1f}));
-    EXPECT_EQ(at.distribution.alpha_u, 0.05f);
+    EXPECT_EQ(at.distribution.alpha_u, 0.4f);
     EXPECT_EQ(at.distribution.alpha_v, 0.2f);
     // uv' = (0.6, 0.3) -> clamped nearest texel (2, 1) of the raw image: (80, 60, 200) / 255.
     EXPECT_EQ(at.specular_reflectance, Rgb(80 / 255.0f, 60 / 255.0f, 200 / 255.0f));

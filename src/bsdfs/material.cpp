@@ -41,6 +41,11 @@ void Material::prepare() {
     if (d && textures)
         for (const TextureBinding& b : textures->bindings)
             anisotropic = anisotropic || b.slot == MicrofacetDistribution::kSlotAlphaU || b.slot == MicrofacetDistribution::kSlotAlphaV;
+    if (const auto* p = std::get_if<PrincipledMaterial>(&model)) {
+        anisotropic = p->anisotropic > 0;
+        if (textures)
+            for (const TextureBinding& b : textures->bindings) anisotropic = anisotropic || b.slot == PrincipledMaterial::kSlotAnisotropic;
+    }
     tangent_frame = anisotropic || perturbed();
     // blendbsdf and mask vary where their nested materials do, and take their tangent frames.
     const auto nested = [&](const Material& inner) {
@@ -189,6 +194,7 @@ float Material::importance_factor(const BsdfContext& ctx, const Vec3f& wi, const
         float int_ior = 1, ext_ior = 1;
         if (const auto* d = std::get_if<DielectricMaterial>(&model)) int_ior = d->int_ior, ext_ior = d->ext_ior;
         if (const auto* d = std::get_if<RoughDielectricMaterial>(&model)) int_ior = d->int_ior, ext_ior = d->ext_ior;
+        if (const auto* d = std::get_if<PrincipledMaterial>(&model)) int_ior = d->eta;
         const float eta_wi = wi.z > 0 ? ext_ior : int_ior, eta_wo = wo.z > 0 ? ext_ior : int_ior;
         k *= (eta_wo * eta_wo) / (eta_wi * eta_wi);
     }

@@ -32,6 +32,7 @@
 #include "bsdfs/material_textures.hpp"
 #include "bsdfs/phong.hpp"
 #include "bsdfs/plastic.hpp"
+#include "bsdfs/principled.hpp"
 #include "bsdfs/roughconductor.hpp"
 #include "bsdfs/roughdielectric.hpp"
 #include "bsdfs/roughplastic.hpp"
@@ -82,13 +83,13 @@ struct MaskMaterial {
 // One BSDF per header (parameters and defaults documented at the top of each).
 using MaterialModel = std::variant<PhongMaterial, ConductorMaterial, DielectricMaterial, RoughConductorMaterial,
                                    RoughDielectricMaterial, PlasticMaterial, RoughPlasticMaterial, ThinDielectricMaterial,
-                                   BlendMaterial, MaskMaterial>;
+                                   BlendMaterial, MaskMaterial, PrincipledMaterial>;
 
 // std::visit, as a switch that the compiler always inlines: the hot loop calls sample() at
 // several places, and an out-of-line dispatch there cost about 3% of pt-mis's time.
 template <typename F>
 [[gnu::always_inline]] inline decltype(auto) visit_model(const MaterialModel& model, F&& f) {
-    static_assert(std::variant_size_v<MaterialModel> == 10, "add the new model's case below");
+    static_assert(std::variant_size_v<MaterialModel> == 11, "add the new model's case below");
     switch (model.index()) {
         case 0: return f(*std::get_if<0>(&model));
         case 1: return f(*std::get_if<1>(&model));
@@ -99,7 +100,8 @@ template <typename F>
         case 6: return f(*std::get_if<6>(&model));
         case 7: return f(*std::get_if<7>(&model));
         case 8: return f(*std::get_if<8>(&model));
-        default: return f(*std::get_if<9>(&model));
+        case 9: return f(*std::get_if<9>(&model));
+        default: return f(*std::get_if<10>(&model));
     }
 }
 
@@ -217,6 +219,7 @@ struct Material {
     }
     // True for materials that transmit (both sides matter: never flipped, never twosided).
     bool is_dielectric() const {
+        if (const auto* p = std::get_if<PrincipledMaterial>(&model)) return p->transmits;
         return std::holds_alternative<DielectricMaterial>(model) || std::holds_alternative<RoughDielectricMaterial>(model);
     }
 
@@ -250,6 +253,9 @@ private:
     static uint32_t lobes_of(const ThinDielectricMaterial&) { return kLobeSpecular | kLobeReflection | kLobeTransmission; }
     static uint32_t lobes_of(const BlendMaterial& m) { return m.first->lobes() | m.second->lobes(); }
     static uint32_t lobes_of(const MaskMaterial& m) { return m.inner->lobes() | kLobeSpecular | kLobeTransmission; }
+    static uint32_t lobes_of(const PrincipledMaterial& m) {
+        return kLobeDiffuse | kLobeGlossy | kLobeReflection | (m.transmits ? kLobeTransmission : 0u);
+    }
 };
 
 // The diffuse reflectance (Mitsuba's aov "albedo"): Lambertian and Phong's rho_d, a coated
@@ -258,6 +264,7 @@ inline Rgb diffuse_albedo(const Material& m) {
     if (const auto* p = std::get_if<PhongMaterial>(&m.model)) return p->diffuse;
     if (const auto* p = std::get_if<PlasticMaterial>(&m.model)) return p->coat.diffuse_reflectance;
     if (const auto* p = std::get_if<RoughPlasticMaterial>(&m.model)) return p->coat.diffuse_reflectance;
+    if (const auto* p = std::get_if<PrincipledMaterial>(&m.model)) return p->base_color;  // as Mitsuba's eval_diffuse_reflectance
     if (const auto* b = std::get_if<BlendMaterial>(&m.model))
         return diffuse_albedo(*b->first) * (1 - b->weight) + diffuse_albedo(*b->second) * b->weight;
     if (const auto* k = std::get_if<MaskMaterial>(&m.model)) return diffuse_albedo(*k->inner) * k->opacity;

@@ -48,6 +48,7 @@ const std::vector<BsdfPlugin>& bsdf_plugins() {
         {roughdielectric_plugin, one_sided<RoughDielectricMaterial, read_roughdielectric>},
         {plastic_plugin, one_sided<PlasticMaterial, read_plastic>},
         {roughplastic_plugin, one_sided<RoughPlasticMaterial, read_roughplastic>},
+        {principled_plugin, one_sided<PrincipledMaterial, read_principled>},
         {thindielectric_plugin, [](Properties& p) { return Material{read_thindielectric(p), true}; }},
         {twosided_plugin, nullptr},
         {blendbsdf_plugin, nullptr},

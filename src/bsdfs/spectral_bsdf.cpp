@@ -11,7 +11,7 @@
 namespace pathlab {
 
 const char* spectral_material_names() {
-    return "diffuse, phong, conductor, roughconductor, dielectric, roughdielectric, thindielectric, plastic, roughplastic, "
+    return "diffuse, phong, conductor, roughconductor, dielectric, roughdielectric, thindielectric, plastic, roughplastic, principled, "
            "blendbsdf (at most one of its two with Dirac lobes), mask (of a non-dispersive material)";
 }
 
@@ -147,6 +147,12 @@ Spectrum4 model_value(const MaterialModel& model, const MaterialSpectra* spectra
             f += reflectance(p->coat.specular_reflectance, specular_of(spectra), wl) *
                  (p->coat.fresnel(c) * D * p->distribution.G2(wi, wo) / (4 * wi.z * wo.z));
         return f;
+    }
+    if (const auto* p = std::get_if<PrincipledMaterial>(&model)) {
+        // a + b c + c_sqrt sqrt(c) with the base colour c at the wavelengths, as principled.hpp.
+        float unused;
+        const Spectrum4 c = reflectance(p->base_color, nullptr, wl);
+        return p->terms(wi, wo, unused).value(c, sqrt(c));
     }
     const auto nested = [&](const Material& m, const Vec2f& uv) {
         return model_value(m.varies ? m.model_at(uv) : m.model, m.spectra.get(), wi, wo, wl);

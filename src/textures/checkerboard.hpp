@@ -7,8 +7,9 @@
 //   color1  rgb        the other squares                                         default 0.2
 //   to_uv   transform  applied to uv first (e.g. <scale x="8" y="8"/> for 8 x 8 squares)
 // So [0, 1]^2 holds 2 x 2 squares, color0 at its corners [0, 1/2]^2 and [1/2, 1]^2 (Mitsuba
-// 3's eval(); its scalar eval_1 swaps the colours, which pathlab does not copy). In Mitsuba the
-// colours may be textures themselves; here they are constants.
+// 3's eval()); the scalar value eval_1 swaps the colours, as Mitsuba 3's does
+// (src/textures/checkerboard.cpp there). In Mitsuba the colours may be textures themselves;
+// here they are constants.
 #pragma once
 
 #include "textures/texture_common.hpp"
@@ -24,7 +25,14 @@ struct CheckerboardTexture {
         const bool a = t.x - std::floor(t.x) > 0.5f, b = t.y - std::floor(t.y) > 0.5f;
         return a == b ? color0 : color1;
     }
-    float eval_1(const Vec2f& uv) const { return scalar_value(eval(uv)); }
+    // The scalar value swaps the colours, as Mitsuba 3's eval_1 does (its colour eval does not):
+    // a float parameter given a checkerboard (a roughness, a blend weight, principled's metallic)
+    // renders as in Mitsuba, whose principled render tests depend on it.
+    float eval_1(const Vec2f& uv) const {
+        const Vec2f t = to_uv.apply(uv);
+        const bool a = t.x - std::floor(t.x) > 0.5f, b = t.y - std::floor(t.y) > 0.5f;
+        return scalar_value(a != b ? color0 : color1);
+    }
     // Piecewise constant: no gradient (so a bump map of it is flat).
     Vec2f eval_1_grad(const Vec2f&) const { return {0.0f, 0.0f}; }
 };

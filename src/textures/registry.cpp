@@ -58,7 +58,7 @@ Texture read_bitmap(Properties& p, const TextureContext& ctx) {
 
 const PluginInfo& checkerboard_plugin() {
     static const PluginInfo info{"texture", "checkerboard", "two colours in a checker pattern, 2 x 2 squares per unit of uv",
-                                 {{"color0", ParamType::Rgb, "0.4", "the squares at [0, 1/2]^2 and [1/2, 1]^2"},
+                                 {{"color0", ParamType::Rgb, "0.4", "the squares at [0, 1/2]^2 and [1/2, 1]^2 (for a float parameter the other squares, as Mitsuba 3)"},
                                   {"color1", ParamType::Rgb, "0.2", "the other squares"},
                                   kToUv}};
     return info;

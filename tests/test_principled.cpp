@@ -1,0 +1,238 @@
+// principled (bsdfs/principled.hpp, Mitsuba 3's Disney BSDF): its lobes against closed forms
+// and against the BSDFs they reduce to (a white metal is the rough conductor of Fresnel 1, full
+// specular transmission is the rough dielectric), reciprocity, the scene-file reader, and
+// estimators agreeing on it (importance transport through its transmission included). Its
+// sampling is chi-square tested with the other rough BSDFs (test_microfacet.cpp), its spectral
+// values in test_spectral_materials.cpp.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "bsdfs/material.hpp"
+#include "core/sampling.hpp"
+#include "judge/image_statistics.hpp"
+#include "render_helpers.hpp"
+#include "scene_helpers.hpp"
+#include "samplers/sampler.hpp"
+#include "scenefile/scene_file.hpp"
+
+namespace pathlab::test {
+namespace {
+
+Material principled(const PrincipledMaterial& p) { return Material{p, false}; }
+
+PrincipledMaterial everything() {
+    PrincipledMaterial p;
+    p.base_color = Rgb(0.7f, 0.4f, 0.2f);
+    p.roughness = 0.4f, p.anisotropic = 0.5f, p.metallic = 0.3f, p.spec_tint = 0.4f, p.sheen = 0.6f, p.sheen_tint = 0.5f;
+    p.clearcoat = 0.7f, p.clearcoat_gloss = 0.6f, p.flatness = 0.3f, p.eta = 1.45f;
+    return p;
+}
+
+// The albedo of the reflection lobes for wi, by stratified cosine-weighted quadrature.
+double albedo(const Material& m, const Vec3f& wi, int n = 512) {
+    double sum = 0;
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+            const Vec3f wo = square_to_cosine_hemisphere(Vec2f(float((i + 0.5) / n), float((j + 0.5) / n)));
+            sum += m.eval(wi, wo).x * kPi;  // f cos / (cos / pi)
+        }
+    return sum / (double(n) * n);
+}
+
+// At normal incidence with eta = 1 (specular 0: no specular reflection) the diffuse lobe's
+// albedo is c (1 - 1/42 + 5 r / 84): (1 - Fo/2) loses 2 int (1 - mu)^5 mu dmu / 2 = 1/42, and
+// the retro-reflection Rr Fo, Rr = 2 r cos_d^2 = r (1 + mu), adds 2 r int (1 + mu)(1 - mu)^5 mu dmu
+// = 5 r / 84 (Burley's retro-reflection makes a rough surface reflect more than it receives).
+TEST(Principled, DiffuseAlbedoAtNormalIncidenceIsTheClosedForm) {
+    for (float r : {0.0f, 0.5f, 1.0f}) {
+        PrincipledMaterial p;
+        p.base_color = Rgb(0.8f);
+        p.roughness = r;
+        p.eta = 1;
+        const double want = 0.8 * (1 - 1.0 / 42 + 5.0 * r / 84);
+        EXPECT_NEAR(albedo(principled(p), Vec3f(0, 0, 1)), want, 2e-4) << "roughness " << r;
+    }
+}
+
+// metallic = 1 with a white base: F_p = Schlick(1) = 1, i.e. the rough conductor whose Fresnel
+// term is 1 (eta 0, k 1), with principled's GGX alphas.
+TEST(Principled, WhiteMetalIsTheRoughConductorOfFresnelOne) {
+    Sampler rng(7, 0, 0);
+    for (const auto& [r, a] : {std::pair(0.3f, 0.0f), std::pair(0.6f, 0.7f)}) {
+        PrincipledMaterial p;
+        p.base_color = Rgb(1.0f);
+        p.metallic = 1, p.roughness = r, p.anisotropic = a;
+        const MicrofacetDistribution d = p.specular_distribution();
+        const Material m = principled(p), twin = make_rough_conductor(d, {Rgb(0.0f), Rgb(1.0f)});
+        long nonzero = 0;
+        for (int i = 0; i < 5000; ++i) {
+            const Vec3f wi = square_to_cosine_hemisphere(rng.next2d()), wo = square_to_cosine_hemisphere(rng.next2d());
+            const float f = m.eval(wi, wo).x, g = twin.eval(wi, wo).x;
+            ASSERT_NEAR(f, g, 1e-5f * std::max(1.0f, g)) << r << " " << a;
+            nonzero += f > 0;
+        }
+        EXPECT_GT(nonzero, 4000);
+    }
+}
+
+// spec_trans = 1 with a white base: the rough dielectric of index eta in vacuum, on both sides
+// and for both lobes.
+TEST(Principled, FullTransmissionIsTheRoughDielectric) {
+    Sampler rng(8, 0, 0);
+    PrincipledMaterial p;
+    p.base_color = Rgb(1.0f);
+    p.spec_trans = 1, p.transmits = true, p.roughness = 0.45f, p.eta = 1.5f;
+    const Material m = principled(p), twin = make_rough_dielectric(p.specular_distribution(), 1.5f, 1.0f);
+    long reflected = 0, transmitted = 0;
+    for (int i = 0; i < 20000; ++i) {
+        const Vec3f wi = square_to_uniform_sphere(rng.next2d()), wo = square_to_uniform_sphere(rng.next2d());
+        const float f = m.eval(wi, wo).x, g = twin.eval(wi, wo).x;
+        ASSERT_NEAR(f, g, 2e-4f * std::max(1.0f, g)) << wi.z << " " << wo.z;
+        (wi.z * wo.z > 0 ? reflected : transmitted) += f > 0;
+    }
+    EXPECT_GT(reflected, 1000);
+    EXPECT_GT(transmitted, 1000);
+}
+
+// Reflection is reciprocal; transmission obeys f(wi, wo) / eta_i^2 = f(wo, wi) / eta_o^2.
+TEST(Principled, IsReciprocal) {
+    Sampler rng(9, 0, 0);
+    PrincipledMaterial glassy = everything();
+    glassy.spec_trans = 0.6f, glassy.transmits = true;
+    for (const PrincipledMaterial& p : {everything(), glassy}) {
+        const Material m = principled(p);
+        long nonzero = 0;
+        for (int i = 0; i < 20000; ++i) {
+            const Vec3f a = square_to_uniform_sphere(rng.next2d()), b = square_to_uniform_sphere(rng.next2d());
+            const float ea = a.z > 0 ? 1.0f : p.eta, eb = b.z > 0 ? 1.0f : p.eta;
+            const Rgb fab = m.eval(a, b) / (ea * ea), fba = m.eval(b, a) / (eb * eb);
+            for (int c = 0; c < 3; ++c) ASSERT_NEAR(fab[c], fba[c], 1e-4f * std::max(fab[c], fba[c]) + 1e-30f) << a.z << " " << b.z;
+            nonzero += fab.x > 0;
+        }
+        EXPECT_GT(nonzero, 4000);
+    }
+}
+
+// Without transmission the material is black from behind (Mitsuba's front-side lobes); with it,
+// light from behind is reflected and refracted.
+TEST(Principled, IsBlackFromBehindUnlessItTransmits) {
+    const Material opaque = principled(everything());
+    const Vec3f below = normalize(Vec3f(0.3f, 0.1f, -0.8f)), above = normalize(Vec3f(-0.2f, 0.3f, 0.9f));
+    EXPECT_EQ(opaque.eval(below, reflect(below, Vec3f(0, 0, 1))), Rgb(0.0f));
+    EXPECT_EQ(opaque.eval(below, above), Rgb(0.0f));
+    EXPECT_FALSE(opaque.sample(below, Vec2f(0.3f, 0.6f)).has_value());
+    EXPECT_FALSE(opaque.is_dielectric());
+    PrincipledMaterial p = everything();
+    p.spec_trans = 0.5f, p.transmits = true;
+    const Material glass = principled(p);
+    EXPECT_TRUE(glass.is_dielectric());
+    EXPECT_GT(glass.eval(below, above).x, 0.0f);
+    EXPECT_NE(glass.lobes() & kLobeTransmission, 0u);
+}
+
+// Without the diffuse lobe's retro-reflection and the sheen, the lobes together reflect and
+// transmit at most what they receive: a white metal with a clearcoat, and white glass from
+// outside (its transmitted energy counted as importance, without radiance's 1 / eta^2).
+TEST(Principled, SpecularLobesDoNotCreateEnergy) {
+    Sampler rng(10, 0, 0);
+    PrincipledMaterial metal;
+    metal.base_color = Rgb(1.0f), metal.metallic = 1, metal.roughness = 0.5f, metal.clearcoat = 1;
+    PrincipledMaterial glass;
+    glass.base_color = Rgb(1.0f), glass.spec_trans = 1, glass.transmits = true, glass.roughness = 0.5f;
+    for (const PrincipledMaterial& p : {metal, glass})
+        for (float theta : {0.0f, 45.0f, 80.0f}) {
+            const Material m = principled(p);
+            const Vec3f wi(std::sin(theta * kPi / 180), 0, std::cos(theta * kPi / 180));
+            double sum = 0, sum2 = 0;
+            const int n = 200000;
+            for (int i = 0; i < n; ++i) {
+                const auto s = m.sample(wi, rng.next2d());
+                if (!s) continue;
+                const double w = s->f.x * std::abs(s->wo.z) / s->pdfW * (s->wo.z < 0 ? p.eta * p.eta : 1.0f);
+                sum += w, sum2 += w * w;
+            }
+            const double mean = sum / n, se = std::sqrt((sum2 / n - mean * mean) / n);
+            EXPECT_LT(mean, 1 + 4 * se) << "theta " << theta << (p.transmits ? " glass" : " metal");
+            EXPECT_GT(mean, 0.7) << "theta " << theta << (p.transmits ? " glass" : " metal");
+        }
+}
+
+TEST(Principled, SceneFilesReadItAsMitsubaDoes) {
+    const SceneDescription d = load_scene_text(R"(<scene version="3.0.0">
+  <shape type="sphere"><bsdf type="principled">
+    <rgb name="base_color" value="0.2, 0.8, 0.1"/>
+    <float name="roughness" value="0.15"/>
+    <texture name="metallic" type="checkerboard"><float name="color0" value="0.7"/><float name="color1" value="0.1"/></texture>
+    <texture name="spec_trans" type="checkerboard"><float name="color0" value="0.7"/><float name="color1" value="0.1"/></texture>
+    <float name="specular" value="0.7"/>
+  </bsdf></shape>
+  <shape type="sphere"><bsdf type="principled"><float name="eta" value="1.33"/><float name="anisotropic" value="0.5"/></bsdf></shape>
+  <shape type="sphere"><bsdf type="principled"/></shape>
+</scene>)", "p.xml", ".");
+    const Material& textured = d.materials[d.spheres[0].material];
+    const auto& p = std::get<PrincipledMaterial>(textured.model);
+    EXPECT_TRUE(p.transmits);  // a texture's largest value
+    EXPECT_TRUE(textured.varies);
+    EXPECT_TRUE(textured.is_dielectric());
+    EXPECT_NEAR(p.eta, 2 / (1 - std::sqrt(0.08f * 0.7f)) - 1, 1e-6f);
+    Material aniso = d.materials[d.spheres[1].material];
+    EXPECT_FLOAT_EQ(std::get<PrincipledMaterial>(aniso.model).eta, 1.33f);
+    aniso.prepare();  // (as Scene::build does)
+    EXPECT_TRUE(aniso.tangent_frame);
+    const auto& plain = std::get<PrincipledMaterial>(d.materials[d.spheres[2].material].model);
+    EXPECT_FLOAT_EQ(plain.eta, 1.5f);  // specular 0.5
+    EXPECT_FALSE(plain.transmits);
+    EXPECT_FLOAT_EQ(plain.roughness, 0.5f);
+
+    const auto error_of = [](const std::string& bsdf) -> std::string {
+        try {
+            load_scene_text("<scene version=\"3.0.0\"><shape type=\"sphere\">" + bsdf + "</shape></scene>", "bad.xml", ".");
+        } catch (const SceneFileError& e) {
+            return e.what();
+        }
+        return "";
+    };
+    EXPECT_NE(error_of(R"(<bsdf type="principled"><float name="eta" value="1.3"/><float name="specular" value="0.3"/></bsdf>)")
+                  .find("either eta or specular"),
+              std::string::npos);
+    EXPECT_NE(error_of(R"(<bsdf type="principled"><float name="metallic" value="1.5"/></bsdf>)").find("between 0 and 1"), std::string::npos);
+    EXPECT_NE(error_of(R"(<bsdf type="principled"><float name="clearcoat_sampling_rate" value="0"/></bsdf>)").find("must be positive"),
+              std::string::npos);
+    EXPECT_NE(error_of(R"(<bsdf type="twosided"><bsdf type="principled"><float name="spec_trans" value="0.5"/></bsdf></bsdf>)")
+                  .find("cannot be wrapped in twosided"),
+              std::string::npos);
+    EXPECT_EQ(error_of(R"(<bsdf type="twosided"><bsdf type="principled"><float name="metallic" value="0.5"/></bsdf></bsdf>)"), "");
+}
+
+// Estimators see the same principled surfaces: light sampling and BSDF sampling at the first
+// hit, and bdpt against pt-mis, on an opaque sphere with every lobe, a glass-like one and a
+// metal, under a glass-like sheet that covers part of the light (a single interface: bdpt's
+// light subpaths cross it with importance's (eta_o / eta_i)^2, which a closed glass shape
+// would cancel). Per-pixel z-tests at a 1e-3 false-alarm rate.
+TEST(Principled, EstimatorsAgree) {
+    PrincipledMaterial glass = everything();
+    glass.spec_trans = 0.8f, glass.transmits = true, glass.clearcoat = 0, glass.anisotropic = 0;
+    PrincipledMaterial metal = everything();
+    metal.metallic = 0.9f, metal.roughness = 0.3f;
+    SceneDescription d = material_scene({principled(everything()), principled(glass), principled(metal)});
+    d.meshes.push_back(quad({0.5f, 0.5f, 2.2f}, {0.8f, 0, 0}, {0, 0.8f, 0}, 3));
+    for (Material& m : d.materials) m.prepare();
+    const auto agree = [&](const std::string& reference, const std::vector<std::string>& algorithms, int spp) {
+        const RenderResult ref = render_scene(d, reference, 12, 12, spp, 202);
+        EXPECT_EQ(ref.stats.invalid_samples, 0u) << reference;
+        for (const std::string& algorithm : algorithms) {
+            const RenderResult a = render_scene(d, algorithm, 12, 12, spp, 101);
+            const AgreementResult r =
+                test_agreement(a.film.mean(), a.film.standard_error(), ref.film.mean(), ref.film.standard_error(), AgreementOptions{1e-3, 1e-4});
+            ::testing::Test::RecordProperty(algorithm, r.describe());
+            EXPECT_TRUE(r.agree) << algorithm << " vs " << reference << ": " << r.describe();
+            EXPECT_EQ(a.stats.invalid_samples, 0u) << algorithm;
+        }
+    };
+    agree("direct-mis", {"direct-light", "direct-brdf"}, 4096);
+    agree("pt-mis", {"bdpt"}, 4096);
+}
+
+}  // namespace
+}  // namespace pathlab::test

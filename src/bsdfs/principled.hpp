@@ -6,8 +6,8 @@
 //   main specular   F_p(wi.h) D(h) G(wi, wo) / (4 cos_i cos_o)          (GGX, anisotropic)
 //     F_p = (1 - metallic)(1 - spec_tint) F_d + metallic Schlick(c) + (1 - metallic) spec_tint Schlick(R0(eta) c / lum(c))
 //   transmission    sqrt(c) bsdf (1 - F_d) D G |wi.h| |wo.h| / (cos_i |cos_o| (wi.h + eta wo.h)^2)   (radiance)
-//   clearcoat       clearcoat / 4 Schlick(0.04) D_GTR1(h) G_cc(wi, wo)   (not divided by 4 cos_i cos_o:
-//                   Mitsuba's clearcoat lobe, whose albedo is at most clearcoat Schlick(0.04) cos_i)
+//   clearcoat       clearcoat / 4 Schlick(0.04) D_GTR1(h) G_cc(wi, wo)   (Mitsuba's clearcoat lobe: not
+//                   divided by 4 cos_i cos_o as Burley's is)
 //   diffuse         brdf c / pi ((1 - Fi/2)(1 - Fo/2) + retro-reflection), lerped towards Hanrahan-
 //                   Krueger's flattened shape by `flatness`
 //   sheen           sheen (1 - metallic) Schlick_weight(wo.h) lerp(1, c / lum(c), sheen_tint)   (with brdf > 0)

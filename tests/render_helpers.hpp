@@ -6,8 +6,11 @@
 #include <cstring>
 #include <string>
 
+#include <gtest/gtest.h>
+
 #include "job/render_job.hpp"
 #include "job/renderer.hpp"
+#include "judge/image_statistics.hpp"
 #include "scene/builtin_scenes.hpp"
 
 namespace pathlab::test {
@@ -37,6 +40,22 @@ std::unique_ptr<PixelIntegrator<T>> make_pixel_integrator(const std::string& nam
     if (!p) throw std::invalid_argument(name + " is not a pixel integrator");
     i.release();
     return std::unique_ptr<PixelIntegrator<T>>(p);
+}
+
+// Each of `algorithms` against `reference` on scene d (size x size pixels, spp samples, seeds 101
+// and 202): per-pixel z-tests at a false-alarm rate of 1e-3 over the image, and no invalid samples.
+inline void expect_estimators_agree(const SceneDescription& d, const std::string& reference, const std::vector<std::string>& algorithms,
+                                    int size, int spp) {
+    const RenderResult ref = render_scene(d, reference, size, size, spp, 202);
+    EXPECT_EQ(ref.stats.invalid_samples, 0u) << reference;
+    for (const std::string& algorithm : algorithms) {
+        const RenderResult a = render_scene(d, algorithm, size, size, spp, 101);
+        const AgreementResult r = test_agreement(a.film.mean(), a.film.standard_error(), ref.film.mean(), ref.film.standard_error(),
+                                                 AgreementOptions{1e-3, 1e-4});
+        ::testing::Test::RecordProperty(algorithm, r.describe());
+        EXPECT_TRUE(r.agree) << algorithm << " vs " << reference << ": " << r.describe();
+        EXPECT_EQ(a.stats.invalid_samples, 0u) << algorithm;
+    }
 }
 
 inline std::string shared_dir() { return PATHLAB_SHARED_DIR; }

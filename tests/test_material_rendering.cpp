@@ -12,24 +12,8 @@
 namespace pathlab::test {
 namespace {
 
-const AgreementOptions kAgreement{1e-3, 1e-4};
-
 MicrofacetDistribution ggx(float au, float av = -1) { return {MicrofacetType::GGX, au, av < 0 ? au : av}; }
 MicrofacetDistribution beckmann(float a) { return {MicrofacetType::Beckmann, a, a}; }
-
-void expect_agreement(const SceneDescription& d, const std::string& reference, const std::vector<std::string>& algorithms,
-                      int size, int spp) {
-    const RenderResult ref = render_scene(d, reference, size, size, spp, 202);
-    EXPECT_EQ(ref.stats.invalid_samples, 0u) << reference;
-    for (const std::string& algorithm : algorithms) {
-        const RenderResult a = render_scene(d, algorithm, size, size, spp, 101);
-        const AgreementResult r =
-            test_agreement(a.film.mean(), a.film.standard_error(), ref.film.mean(), ref.film.standard_error(), kAgreement);
-        ::testing::Test::RecordProperty(algorithm, r.describe());
-        EXPECT_TRUE(r.agree) << algorithm << " vs " << reference << ": " << r.describe();
-        EXPECT_EQ(a.stats.invalid_samples, 0u) << algorithm;
-    }
-}
 
 // Light sampling, BSDF sampling and their MIS combination see the same rough reflections.
 // (Roughness from 0.2: for narrower lobes light sampling's per-pixel means are too heavy-tailed
@@ -38,7 +22,7 @@ TEST(MaterialRendering, DirectEstimatorsAgreeOnRoughConductorsAndRoughPlastic) {
     const SceneDescription d = material_scene({make_rough_conductor(ggx(0.3f), *named_conductor("Cu")),
                                                make_rough_plastic(ggx(0.2f), Rgb(0.6f, 0.2f, 0.2f)),
                                                make_rough_conductor(beckmann(0.25f), *named_conductor("Au"))});
-    expect_agreement(d, "direct-mis", {"direct-light", "direct-brdf"}, 16, 8192);
+    expect_estimators_agree(d, "direct-mis", {"direct-light", "direct-brdf"}, 16, 8192);
 }
 
 // Anisotropic GGX, a rough plastic whose coating is nearly smooth (alpha 0.02) and a rough
@@ -47,7 +31,7 @@ TEST(MaterialRendering, BsdfSamplingAgreesWithMisOnNarrowAndAnisotropicLobes) {
     const SceneDescription d = material_scene({make_rough_conductor(ggx(0.05f, 0.3f), *named_conductor("Al")),
                                                make_rough_plastic(ggx(0.02f), Rgb(0.2f, 0.3f, 0.6f)),
                                                make_rough_conductor(ggx(0.05f), *named_conductor("Ag"))});
-    expect_agreement(d, "direct-mis", {"direct-brdf"}, 16, 8192);
+    expect_estimators_agree(d, "direct-mis", {"direct-brdf"}, 16, 8192);
 }
 
 // Delta (smooth gold, smooth plastic's coating), mixed (smooth plastic) and transmitting
@@ -57,7 +41,7 @@ TEST(MaterialRendering, BsdfSamplingAgreesWithMisOnNarrowAndAnisotropicLobes) {
 TEST(MaterialRendering, PathTracersAgreeOnEveryNewMaterial) {
     const SceneDescription d = material_scene({make_conductor(*named_conductor("Au")), make_plastic(Rgb(0.2f, 0.5f, 0.2f)),
                                                make_rough_dielectric(ggx(0.2f), 1.5f, 1.0f)});
-    expect_agreement(d, "pt-mis", {"pt-naive", "pt-mis3"}, 12, 8192);
+    expect_estimators_agree(d, "pt-mis", {"pt-naive", "pt-mis3"}, 12, 8192);
 }
 
 // Energy-conserving materials in a constant environment are invisible (L = Le everywhere):

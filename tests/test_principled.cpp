@@ -218,20 +218,8 @@ TEST(Principled, EstimatorsAgree) {
     SceneDescription d = material_scene({principled(everything()), principled(glass), principled(metal)});
     d.meshes.push_back(quad({0.5f, 0.5f, 2.2f}, {0.8f, 0, 0}, {0, 0.8f, 0}, 3));
     for (Material& m : d.materials) m.prepare();
-    const auto agree = [&](const std::string& reference, const std::vector<std::string>& algorithms, int spp) {
-        const RenderResult ref = render_scene(d, reference, 12, 12, spp, 202);
-        EXPECT_EQ(ref.stats.invalid_samples, 0u) << reference;
-        for (const std::string& algorithm : algorithms) {
-            const RenderResult a = render_scene(d, algorithm, 12, 12, spp, 101);
-            const AgreementResult r =
-                test_agreement(a.film.mean(), a.film.standard_error(), ref.film.mean(), ref.film.standard_error(), AgreementOptions{1e-3, 1e-4});
-            ::testing::Test::RecordProperty(algorithm, r.describe());
-            EXPECT_TRUE(r.agree) << algorithm << " vs " << reference << ": " << r.describe();
-            EXPECT_EQ(a.stats.invalid_samples, 0u) << algorithm;
-        }
-    };
-    agree("direct-mis", {"direct-light", "direct-brdf"}, 4096);
-    agree("pt-mis", {"bdpt"}, 4096);
+    expect_estimators_agree(d, "direct-mis", {"direct-light", "direct-brdf"}, 12, 4096);
+    expect_estimators_agree(d, "pt-mis", {"bdpt"}, 12, 4096);
 }
 
 }  // namespace

@@ -52,6 +52,7 @@
 #include "bsdfs/bsdf_sample.hpp"
 #include "bsdfs/fresnel.hpp"
 #include "bsdfs/microfacet.hpp"
+#include "bsdfs/roughdielectric.hpp"
 
 namespace pathlab {
 
@@ -95,8 +96,10 @@ struct PrincipledMaterial {
     struct LobeChoice {
         float specular = 0, transmission = 0, clearcoat = 0, diffuse = 0;
     };
+    // The weight of the transmission, bsdf = (1 - metallic) spec_trans (0 without spec_trans).
+    float transmission_weight() const { return transmits ? (1 - metallic) * spec_trans : 0.0f; }
     LobeChoice lobe_choice(float cos_i, bool front) const {
-        const float bsdf = transmits ? (1 - metallic) * spec_trans : 0.0f;
+        const float bsdf = transmission_weight();
         LobeChoice p;
         if (front) {
             const float F = fresnel_dielectric(cos_i, eta);
@@ -154,10 +157,8 @@ private:
         return d * cos_h > 1e-20f ? d : 0.0f;
     }
     static float clearcoat_g1(const Vec3f& v) {
-        const float c2 = v.z * v.z;
-        if (c2 >= 1) return 1.0f;
-        const float tan2 = (1 - c2) / c2;
-        return 2 / (1 + std::sqrt(1 + 0.0625f * tan2));
+        static const MicrofacetDistribution masking(MicrofacetType::GGX, 0.25f, 0.25f);
+        return masking.G1(v);
     }
     float clearcoat_alpha() const { return 0.1f + (0.001f - 0.1f) * clearcoat_gloss; }
 };
@@ -172,7 +173,7 @@ inline PrincipledMaterial::Terms PrincipledMaterial::terms(const Vec3f& wi_in, c
     const Vec3f wi = front ? wi_in : Vec3f(wi_in.x, wi_in.y, -wi_in.z);
     const Vec3f wo = front ? wo_in : Vec3f(wo_in.x, wo_in.y, -wo_in.z);
     const float e = front ? eta : 1 / eta;
-    const float bsdf = transmits ? (1 - metallic) * spec_trans : 0.0f, brdf = (1 - metallic) * (1 - spec_trans);
+    const float bsdf = transmission_weight(), brdf = (1 - metallic) * (1 - spec_trans);
     const LobeChoice p = lobe_choice(wi.z, front);
     const MicrofacetDistribution dist = specular_distribution();
     const float lum = luminance(base_color);
@@ -221,26 +222,10 @@ inline PrincipledMaterial::Terms PrincipledMaterial::terms(const Vec3f& wi_in, c
         }
         return t;
     }
-    // Transmission, as roughdielectric.hpp with the indices eta_i and eta_o on the sides of wi
-    // and wo (1 and eta, or eta and 1 from behind): the generalised half vector on the normal's
-    // side, and F from the side of the lower index (so that f(wi, wo) and f(wo, wi) use the
-    // same cosine).
+    // Transmission: roughdielectric's refraction lobe between the indices 1 and eta (eta and 1
+    // from behind), times bsdf sqrt(c).
     if (!(bsdf > 0)) return t;
-    const float eta_i = front ? 1.0f : eta, eta_o = front ? eta : 1.0f;
-    Vec3f h = wi * eta_i + wo * eta_o;
-    const float len = length(h);
-    if (!(len > 0)) return t;
-    h = h / len;
-    if (h.z < 0) h = -h;
-    const float ci = dot(wi, h), co = dot(wo, h);
-    if (!(ci > 0) || !(co < 0)) return t;  // wi sees the facet's front, wo its back
-    const float F_d = e >= 1 ? fresnel_dielectric(ci, e) : fresnel_dielectric(-co, 1 / e);
-    if (!(F_d < 1)) return t;
-    const float den = eta_i * ci + eta_o * co, den2 = den * den;
-    if (!(den2 > 0)) return t;
-    const float D = dist.D(h);
-    t.c_sqrt = bsdf * (1 - F_d) * D * dist.G2(wi, wo) * ci * -co * eta_i * eta_i / (wi.z * -wo.z * den2);
-    pdf = p.transmission * dist.pdf(wi, h) * eta_o * eta_o * -co / den2;
+    t.c_sqrt = bsdf * microfacet_refraction(dist, wi, wo, front ? 1.0f : eta, front ? eta : 1.0f, p.transmission, pdf);
     return t;
 }
 
@@ -276,11 +261,7 @@ inline std::optional<BsdfSample> PrincipledMaterial::sample(const Vec3f& wi_in, 
         if (lobe == 3) {
             wo = reflect(wi, m);
         } else {
-            float cos_t;
-            const float e = front ? eta : 1 / eta;
-            if (fresnel_dielectric(c, e, &cos_t) >= 1) return std::nullopt;  // total internal reflection at m
-            const float r = 1 / e;
-            wo = normalize(-wi * r + m * (r * c - cos_t));
+            if (!refract_about(wi, m, front ? eta : 1 / eta, wo)) return std::nullopt;  // total internal reflection at m
             flags = kLobeGlossy | kLobeTransmission;
         }
     }

@@ -39,6 +39,44 @@
 
 namespace pathlab {
 
+// The refraction term above for wi above the surface and wo below it, with the indices eta_i on
+// wi's side and eta_o on wo's, and in `pdf` its density when wo is sampled with probability
+// `lobe_probability` by refracting wi about a normal drawn from D_wi (both 0 where no normal
+// refracts wi into wo). Also principled's transmission (principled.hpp).
+inline float microfacet_refraction(const MicrofacetDistribution& distribution, const Vec3f& wi, const Vec3f& wo, float eta_i,
+                                   float eta_o, float lobe_probability, float& pdf) {
+    pdf = 0;
+    Vec3f h = wi * eta_i + wo * eta_o;
+    const float len = length(h);
+    if (!(len > 0)) return 0.0f;
+    h = h / len;
+    if (h.z < 0) h = -h;
+    const float ci = dot(wi, h), co = dot(wo, h);
+    if (!(ci > 0) || !(co < 0)) return 0.0f;  // wi must see the facet's front, wo its back
+    const float D = distribution.D(h);
+    if (!(D > 0)) return 0.0f;
+    // F from the side of the lower index, where it is well conditioned, so that eval()
+    // gives the same value whichever of wi and wo comes first (the same cosine is used).
+    const float eta = eta_o / eta_i;
+    const float F = eta >= 1 ? fresnel_dielectric(ci, eta) : fresnel_dielectric(-co, 1 / eta);
+    const float den = eta_i * ci + eta_o * co;
+    if (!(den * den > 0)) return 0.0f;
+    const float den2 = den * den;
+    pdf = lobe_probability * distribution.pdf(wi, h) * eta_o * eta_o * -co / den2;
+    return (1 - F) * D * distribution.G2(wi, wo) * ci * -co * eta_i * eta_i / (wi.z * -wo.z * den2);
+}
+
+// wi (above the surface) refracted about the microfacet normal m (wi.m > 0) into the side of
+// relative index eta = eta_o / eta_i; false at total internal reflection.
+inline bool refract_about(const Vec3f& wi, const Vec3f& m, float eta, Vec3f& wo) {
+    const float c = dot(wi, m);
+    float cos_t;
+    if (fresnel_dielectric(c, eta, &cos_t) >= 1) return false;
+    const float r = 1 / eta;
+    wo = normalize(-wi * r + m * (r * c - cos_t));
+    return true;
+}
+
 struct RoughDielectricMaterial {
     MicrofacetDistribution distribution;
     float int_ior = 1.5046f;
@@ -79,23 +117,7 @@ struct RoughDielectricMaterial {
             pdf = p_reflect * distribution.pdf(wi, h) / (4 * c);
             return Rgb(F * D * distribution.G2(wi, wo) / (4 * wi.z * wo.z));
         }
-        Vec3f h = wi * eta_i + wo * eta_o;
-        const float len = length(h);
-        if (!(len > 0)) return Rgb(0.0f);
-        h = h / len;
-        if (h.z < 0) h = -h;
-        const float ci = dot(wi, h), co = dot(wo, h);
-        if (!(ci > 0) || !(co < 0)) return Rgb(0.0f);  // wi must see the facet's front, wo its back
-        const float D = distribution.D(h);
-        if (!(D > 0)) return Rgb(0.0f);
-        // F from the side of the lower index, where it is well conditioned, so that eval()
-        // gives the same value whichever of wi and wo comes first (the same cosine is used).
-        const float F = eta >= 1 ? fresnel_dielectric(ci, eta) : fresnel_dielectric(-co, 1 / eta);
-        const float den = eta_i * ci + eta_o * co;
-        if (!(den * den > 0)) return Rgb(0.0f);
-        const float den2 = den * den;
-        pdf = (1 - p_reflect) * distribution.pdf(wi, h) * eta_o * eta_o * -co / den2;
-        return Rgb((1 - F) * D * distribution.G2(wi, wo) * ci * -co * eta_i * eta_i / (wi.z * -wo.z * den2));
+        return Rgb(microfacet_refraction(distribution, wi, wo, eta_i, eta_o, 1 - p_reflect, pdf));
     }
 
     std::optional<BsdfSample> sample(const Vec3f& wi_in, Vec2f u) const {
@@ -115,10 +137,7 @@ struct RoughDielectricMaterial {
             wo = reflect(wi, h);
             if (wo.z <= 0) return std::nullopt;
         } else {
-            float cos_t;
-            if (fresnel_dielectric(c, eta, &cos_t) >= 1) return std::nullopt;  // total internal reflection at h
-            const float r = 1 / eta;
-            wo = normalize(-wi * r + h * (r * c - cos_t));
+            if (!refract_about(wi, h, eta, wo)) return std::nullopt;  // total internal reflection at h
             if (wo.z >= 0) return std::nullopt;
         }
         if (!outside) wo.z = -wo.z;

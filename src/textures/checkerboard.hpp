@@ -20,18 +20,15 @@ struct CheckerboardTexture {
     Rgb color0{0.4f}, color1{0.2f};
     UvTransform to_uv;
 
-    Rgb eval(const Vec2f& uv) const {
-        const Vec2f t = to_uv.apply(uv);
-        const bool a = t.x - std::floor(t.x) > 0.5f, b = t.y - std::floor(t.y) > 0.5f;
-        return a == b ? color0 : color1;
-    }
+    Rgb eval(const Vec2f& uv) const { return on_color0(uv) ? color0 : color1; }
     // The scalar value swaps the colours, as Mitsuba 3's eval_1 does (its colour eval does not):
     // a float parameter given a checkerboard (a roughness, a blend weight, principled's metallic)
     // renders as in Mitsuba, whose principled render tests depend on it.
-    float eval_1(const Vec2f& uv) const {
+    float eval_1(const Vec2f& uv) const { return scalar_value(on_color0(uv) ? color1 : color0); }
+    // Whether uv lies on a colour0 square: both fractional parts of uv' on the same side of 1/2.
+    bool on_color0(const Vec2f& uv) const {
         const Vec2f t = to_uv.apply(uv);
-        const bool a = t.x - std::floor(t.x) > 0.5f, b = t.y - std::floor(t.y) > 0.5f;
-        return scalar_value(a != b ? color0 : color1);
+        return (t.x - std::floor(t.x) > 0.5f) == (t.y - std::floor(t.y) > 0.5f);
     }
     // Piecewise constant: no gradient (so a bump map of it is flat).
     Vec2f eval_1_grad(const Vec2f&) const { return {0.0f, 0.0f}; }

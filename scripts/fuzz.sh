@@ -39,6 +39,7 @@ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=
 build_targets=()
 for t in "${targets[@]}"; do build_targets+=("fuzz_$t"); done
 [[ ${targets[*]} != scene_xml && ${targets[*]} != ies ]] && build_targets+=(fuzz_make_seeds)
+[[ " ${targets[*]} " == *" vdb "* ]] && build_targets+=(fuzz_vdb_fixtures)
 cmake --build build-fuzz -j "$(nproc)" --target "${build_targets[@]}"
 mkdir -p build-fuzz/crashes
 
@@ -86,6 +87,7 @@ for t in "${targets[@]}"; do
             corpus=build-fuzz/corpus-vdb
             mkdir -p "$corpus"
             make_seeds
+            build-fuzz/fuzz/fuzz_vdb_fixtures build-fuzz/seeds/vdb
             cp -n build-fuzz/seeds/vdb/* "$corpus"/ 2>/dev/null || true
             # OpenVDB leaks the node it was reading when the file ends inside it (the stream
             # throws; RootNode::readTopology holds it by a raw pointer): one node per refused

@@ -19,6 +19,7 @@
 
 #include "geometry/shape_meshes.hpp"
 #include "image/image_io.hpp"
+#include "media/grid_files.hpp"
 
 namespace pathlab::test {
 
@@ -50,8 +51,8 @@ inline size_t current_address_space() {
 }
 
 // Runs fn() in a child process that may take `seconds` and allocate `extra_bytes` more address
-// space than this process has. fn returning is Loaded, an ImageIoError or MeshLoadError is a
-// CleanError, any other exception (std::bad_alloc when the memory limit is hit) is an
+// space than this process has. fn returning is Loaded, an ImageIoError, MeshLoadError or GridFileError
+// is a CleanError, any other exception (std::bad_alloc when the memory limit is hit) is an
 // OtherException, a signal is Crashed, running out of time is TimedOut (the child is killed).
 inline BoundedResult run_bounded(const std::function<void()>& fn, double seconds = 10, size_t extra_bytes = size_t(512) << 20) {
     int pipe_fds[2];
@@ -71,6 +72,8 @@ inline BoundedResult run_bounded(const std::function<void()>& fn, double seconds
         } catch (const ImageIoError& e) {
             kind = 'E', message = e.what();
         } catch (const MeshLoadError& e) {
+            kind = 'E', message = e.what();
+        } catch (const GridFileError& e) {
             kind = 'E', message = e.what();
         } catch (const std::exception& e) {
             kind = 'X', message = e.what();

@@ -5,7 +5,9 @@
 
 #include <unistd.h>
 
+#include <array>
 #include <cmath>
+#include <cstdlib>
 #include <functional>
 #include <cstring>
 #include <filesystem>
@@ -461,7 +463,8 @@ TEST_F(GridFiles, VdbFilesWithABrokenLayoutAreRefusedBeforeOpenVdbReadsThem) {
         {with32(grid + 8, 1u << 30), "its grid metadata name claims 1073741824 bytes"},
         {with32(after("vec3i"), 500), "(vec3i) has 500 bytes, not 12"},  // (out of step: gigabytes)
         {with32(after("__delayedload") + 4, 0x7fffffff), "claims 2147483647 leaf nodes"},
-        {with32(map + 15 + 120 + 12, 1u << 30), "its grid data runs past the end of the file"},  // (gigabytes)
+        {with32(map + 15 + 120 + 12, 1u << 30), "ends inside its grid 'density''s internal node's child mask"},  // (gigabytes)
+        {with32(map + 15 + 120, 2), "tree has 2 buffers, not 1"},
         {with(at + 8, int64_t(1) << 40), "not within its part of the file"},
         {with(at + 16, int64_t(good.size()) + 1), "not within its part of the file"},
         {good.substr(0, 40), "it ends inside its UUID"},                // (it looped forever)
@@ -476,6 +479,48 @@ TEST_F(GridFiles, VdbFilesWithABrokenLayoutAreRefusedBeforeOpenVdbReadsThem) {
         EXPECT_NE(m.find(cases[i].second), std::string::npos) << i << ": " << m;
     }
     EXPECT_NO_THROW(read_vdb_file(path("good.vdb")));
+}
+
+// .vdb files as other programs write them (OpenVDB itself, tests/tools/vdb_fixture_writer.cpp):
+// half floats, zip and no compression, vec3s values, several grids (one of a type pathlab does
+// not read: only the chosen grid is read), an instance sharing another grid's tree with its own
+// transform, tiles and inactive values. Each reads back to the writer's values at their world
+// positions, through the same checks of every count and size as pathlab's own files.
+TEST_F(GridFiles, VdbFilesOfOtherWritersReadBack) {
+    ASSERT_EQ(std::system(fmt::format("'{}' '{}'", PATHLAB_VDB_FIXTURE_WRITER, dir_.string()).c_str()), 0);
+    const auto value = [](int i, int j, int k) { return 0.25f * float((i + 5) + 2 * (j + 3) + 3 * (k + 2)) + 0.25f; };
+    // Voxel (i, j, k) of a grid of voxels `voxel` wide is at world (i, j, k) * voxel.
+    const auto expect_values = [&](const std::string& file, const std::string& grid, double voxel, int channels) {
+        SCOPED_TRACE(file + " " + grid);
+        const VdbGrid v = read_vdb_file(path(file), grid);
+        ASSERT_EQ(v.grid.channels, channels);
+        EXPECT_EQ(v.grid.res, (std::array<int, 3>{20, 12, 8}));
+        const Volume vol = Volume::of_grid(v.grid, v.unit_to_world);
+        for (int k = -2; k <= 5; ++k)
+            for (int j = -3; j <= 8; ++j)
+                for (int i = -5; i <= 14; i += 3) {
+                    const Vec3f world = Vec3f(float(i), float(j), float(k)) * float(voxel);
+                    const Vec3f got = vol.eval(world);
+                    EXPECT_NEAR(got.x, value(i, j, k), 1e-4) << i << " " << j << " " << k;
+                    if (channels == 3) EXPECT_NEAR(got.z, 3 * value(i, j, k), 1e-4) << i << " " << j << " " << k;
+                }
+    };
+    expect_values("half.vdb", "", 0.5, 1);
+    expect_values("zip.vdb", "", 0.5, 3);
+    expect_values("raw.vdb", "", 0.5, 1);
+    expect_values("multi.vdb", "", 0.5, 1);
+    expect_values("multi.vdb", "smoke", 1.0, 1);
+    const std::string labels = expect_grid_error([&] { read_vdb_file(path("multi.vdb"), "labels"); });
+    EXPECT_NE(labels.find("grid 'labels' holds int32 values; pathlab reads float and vec3s grids"), std::string::npos) << labels;
+    // The tiles file: a 16^3 tile of 2 from the origin and one active voxel of 5 at (20, 1, 1);
+    // the inactive voxels between (-1 and 3 in the file) read as 0.
+    const VdbGrid t = read_vdb_file(path("tiles.vdb"));
+    EXPECT_EQ(t.grid.res, (std::array<int, 3>{21, 16, 16}));
+    EXPECT_EQ(t.grid.at(0, 0, 0, 0), 2.0f);
+    EXPECT_EQ(t.grid.at(15, 15, 15, 0), 2.0f);
+    EXPECT_EQ(t.grid.at(20, 1, 1, 0), 5.0f);
+    EXPECT_EQ(t.grid.at(17, 0, 0, 0), 0.0f);
+    EXPECT_EQ(t.grid.at(18, 0, 0, 0), 0.0f);
 }
 
 }  // namespace

@@ -78,18 +78,49 @@ VdbGrid densify(const GridT& grid, const std::string& path) {
     return out;
 }
 
-// (vdb_file.cpp's read_vdb_file, the only caller, checked that `path` is a regular file.)
-VdbGrid read_vdb(const std::string& path, const std::string& grid_name) {
+// Reads one grid of a file as OpenVDB's stream reader reads each (io/Stream.cc): the header,
+// then, at the grid's descriptor, the descriptor and the grid; an instance gets its parent's tree.
+// Only that grid is read (the stream reader reads every grid, of any type, which vdb_file.cpp
+// could not check).
+class OneGridReader : public openvdb::io::Archive {
+public:
+    openvdb::GridBase::Ptr read(std::istream& is, int64_t descriptor, int64_t parent_descriptor) {
+        readHeader(is);
+        openvdb::io::setStreamMetadataPtr(is, metadata_, /*transfer=*/false);
+        openvdb::io::setVersion(is, libraryVersion(), fileVersion());
+        openvdb::io::setDataCompression(is, compression());
+        openvdb::GridBase::Ptr grid = read_at(is, descriptor);
+        if (parent_descriptor >= 0) grid->setTree(read_at(is, parent_descriptor)->baseTreePtr());
+        openvdb::io::clearStreamMetadataPtr(is);
+        return grid;
+    }
+
+private:
+    // The stream's metadata (format, compression, ...): OpenVDB keeps a pointer to this pointer.
+    openvdb::io::StreamMetadata::Ptr metadata_ = std::make_shared<openvdb::io::StreamMetadata>();
+
+    static openvdb::GridBase::Ptr read_at(std::istream& is, int64_t descriptor) {
+        is.seekg(descriptor);
+        openvdb::io::GridDescriptor gd;
+        gd.read(is);
+        openvdb::GridBase::Ptr grid = openvdb::GridBase::createGrid(gd.gridType());
+        grid->setSaveFloatAsHalf(gd.saveFloatAsHalf());
+        Archive::readGrid(grid, gd, is);
+        return grid;
+    }
+};
+
+// vdb_file.cpp's read_vdb_file, the only caller, checked that `path` is a regular file and, for
+// the grid at `descriptor` (and its parent's at `parent_descriptor`, or -1), every count and size
+// OpenVDB reads from it, and chose it by name.
+VdbGrid read_vdb(const std::string& path, int64_t descriptor, int64_t parent_descriptor) {
     initialise_openvdb();
-    openvdb::GridPtrVecPtr grids;
-    // OpenVDB's stream reader, from a stream that throws at the end of the file: its loops over
-    // counts read from the file (tiles, children, metadata) do not run on past the file's bytes.
-    // (vdb_file.cpp checked the layout it trusts, grid by grid, before.)
+    openvdb::GridBase::Ptr grid;
+    // From a stream that throws at the end of the file too.
     try {
         std::ifstream in(path, std::ios::binary);
         in.exceptions(std::ios::failbit | std::ios::badbit);
-        openvdb::io::Stream stream(in, /*delayLoad=*/false);
-        grids = stream.getGrids();
+        grid = OneGridReader().read(in, descriptor, parent_descriptor);
     } catch (const std::ios_base::failure&) {
         throw GridFileError(fmt::format("grid file '{}': not a readable OpenVDB file: its grid data runs past the end of the file", path));
     } catch (const std::bad_alloc&) {
@@ -97,21 +128,10 @@ VdbGrid read_vdb(const std::string& path, const std::string& grid_name) {
     } catch (const std::exception& e) {
         throw GridFileError(fmt::format("grid file '{}': not a readable OpenVDB file: {}", path, e.what()));
     }
-    std::vector<std::string> names;
-    openvdb::GridBase::Ptr chosen;
-    for (const auto& g : *grids) names.push_back(g->getName());
-    for (const auto& g : *grids)
-        if (g->getName() == (grid_name.empty() ? "density" : grid_name)) chosen = g;
-    if (!chosen && grid_name.empty() && grids->size() == 1) chosen = grids->front();
-    if (!chosen)
-        throw GridFileError(fmt::format("grid file '{}': {}; its grids: {}", path,
-                                        grid_name.empty() ? "no grid named 'density' (choose one with the 'grid' parameter)"
-                                                          : fmt::format("no grid named '{}'", grid_name),
-                                        names.empty() ? "none" : fmt::format("{}", fmt::join(names, ", "))));
-    if (const auto f = openvdb::gridPtrCast<openvdb::FloatGrid>(chosen)) return densify<openvdb::FloatGrid, 1>(*f, path);
-    if (const auto v = openvdb::gridPtrCast<openvdb::Vec3SGrid>(chosen)) return densify<openvdb::Vec3SGrid, 3>(*v, path);
+    if (const auto f = openvdb::gridPtrCast<openvdb::FloatGrid>(grid)) return densify<openvdb::FloatGrid, 1>(*f, path);
+    if (const auto v = openvdb::gridPtrCast<openvdb::Vec3SGrid>(grid)) return densify<openvdb::Vec3SGrid, 3>(*v, path);
     throw GridFileError(fmt::format("grid file '{}': grid '{}' holds {} values; pathlab reads float and vec3s grids", path,
-                                    chosen->getName(), chosen->valueType()));
+                                    grid->getName(), grid->valueType()));
 }
 
 void write_vdb(const std::string& path, const VoxelGrid& g, const std::string& grid_name, double voxel_size) {
@@ -140,10 +160,10 @@ void write_vdb(const std::string& path, const VoxelGrid& g, const std::string& g
 
 // The module's entry points (vdb_file.cpp declares their types): true on success; otherwise
 // `error` holds the message.
-extern "C" bool pathlab_openvdb_read(const std::string* path, const std::string* grid_name, pathlab::VdbGrid* out,
-                                     std::string* error) {
+extern "C" bool pathlab_openvdb_read_grid(const std::string* path, int64_t descriptor, int64_t parent_descriptor,
+                                          pathlab::VdbGrid* out, std::string* error) {
     try {
-        *out = pathlab::read_vdb(*path, *grid_name);
+        *out = pathlab::read_vdb(*path, descriptor, parent_descriptor);
         return true;
     } catch (const std::exception& e) {
         *error = e.what();

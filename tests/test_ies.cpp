@@ -346,7 +346,7 @@ TEST(IesBadFiles, SceneFilesWithBrokenIesFilesExitWithCode2) {
     std::ofstream(dir / "typeb.ies", std::ios::binary) << with_line(good, 11, "2 1500 0.5 10 5 2 2 0.1 0.1 0.02");
     for (const auto& [file, message] : {std::pair{"cut.ies", "cut.ies:16: the file ends after 25 of the 65 numbers"},
                                         {"typeb.ies", "typeb.ies:11: photometric type 2"},
-                                        {"missing.ies", "missing.ies: cannot read the IES file: it does not exist"},
+                                        {"missing.ies", "missing.ies: cannot read the IES file: no such file"},
                                         {".", "not a regular file"}}) {
         const std::string scene = (dir / "scene.xml").string();
         std::ofstream(scene) << "<scene version=\"3.0.0\"><shape type=\"sphere\"/>\n<emitter type=\"ies\"><string name=\"filename\" value=\""

@@ -11,9 +11,12 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <sstream>
 
 #include <fmt/format.h>
+
+#include "core/input_file.hpp"
 
 namespace pathlab {
 namespace {
@@ -22,9 +25,11 @@ namespace {
 constexpr uint64_t kMaxElements = uint64_t(1) << 28;
 
 void require_regular_file(const std::string& path) {
-    std::error_code ec;
-    if (!std::filesystem::exists(path, ec)) throw MeshLoadError(fmt::format("cannot read mesh '{}': no such file", path));
-    if (!std::filesystem::is_regular_file(path, ec)) throw MeshLoadError(fmt::format("cannot read mesh '{}': not a regular file", path));
+    try {
+        require_input_file(path);
+    } catch (const InputFileError& e) {
+        throw MeshLoadError(fmt::format("cannot read mesh '{}': {}", path, e.what()));
+    }
 }
 
 void check_finite(const MeshDesc& m, const std::string& path) {
@@ -331,10 +336,12 @@ enum SerializedFlags : uint32_t {
 }  // namespace
 
 MeshDesc load_serialized_mesh(const std::string& path, int shape_index) {
-    require_regular_file(path);
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw MeshLoadError(fmt::format("cannot read mesh '{}': cannot open the file", path));
-    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::string bytes;
+    try {
+        bytes = read_input_file(path, std::numeric_limits<uint64_t>::max());
+    } catch (const InputFileError& e) {
+        throw MeshLoadError(fmt::format("cannot read mesh '{}': {}", path, e.what()));
+    }
     const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
     const size_t size = bytes.size();
     const auto bad = [&](const std::string& why) { return MeshLoadError(fmt::format("mesh '{}' is not a valid serialized file: {}", path, why)); };

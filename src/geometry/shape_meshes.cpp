@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 
 #include <tiny_obj_loader.h>
 
@@ -15,6 +16,8 @@
 #include <vector>
 
 #include <fmt/format.h>
+
+#include "core/input_file.hpp"
 
 namespace pathlab {
 
@@ -178,17 +181,15 @@ MeshDesc load_obj_mesh(const std::string& path) {
     config.triangulate = true;
     config.vertex_color = false;
     config.mtl_search_path = "";
-    // Devices and directories would hang or confuse the parser (/dev/zero never ends).
-    std::error_code ec;
-    if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
-        throw MeshLoadError(fmt::format("cannot read mesh '{}': not a regular file", path));
     // The file is parsed from memory with no material library: ParseFromFile would open any
     // file a `mtllib` line names (`mtllib ../../dev/zero` hung the loader), and pathlab takes
     // materials from the scene file, never from .mtl files.
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw MeshLoadError(fmt::format("cannot read mesh '{}': cannot open the file", path));
-    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (in.bad()) throw MeshLoadError(fmt::format("cannot read mesh '{}': read error", path));
+    std::string text;
+    try {
+        text = read_input_file(path, std::numeric_limits<uint64_t>::max());
+    } catch (const InputFileError& e) {
+        throw MeshLoadError(fmt::format("cannot read mesh '{}': {}", path, e.what()));
+    }
     prepare_obj_text(text, path);
     tinyobj::ObjReader reader;
     if (!reader.ParseFromString(text, "", config)) {

@@ -80,47 +80,25 @@ void MemorySource::read(uint64_t offset, void* dst, size_t n) const {
 
 namespace {
 
-int open_for_reading(const std::string& path) {
-    // O_NONBLOCK: opening a FIFO would otherwise wait for a writer.
-    const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-    if (fd < 0) {
-        const int e = errno;
-        if (e == ENOENT) throw ImageIoError(fmt::format("{}: no such file", path));
-        throw ImageIoError(fmt::format("{}: cannot open: {}", path, errno_text(e)));
+std::unique_ptr<InputFile> open_image_file(const std::string& path) {
+    try {
+        return std::make_unique<InputFile>(path);
+    } catch (const InputFileError& e) {
+        throw ImageIoError(fmt::format("{}: {}", path, e.what()));
     }
-    struct stat st {};
-    if (::fstat(fd, &st) != 0) {
-        const int e = errno;
-        ::close(fd);
-        throw ImageIoError(fmt::format("{}: cannot open: {}", path, errno_text(e)));
-    }
-    if (!S_ISREG(st.st_mode)) {
-        ::close(fd);
-        if (S_ISDIR(st.st_mode)) throw ImageIoError(fmt::format("{}: is a directory, not an image file", path));
-        throw ImageIoError(fmt::format("{}: not a regular file (a device, FIFO or socket); only regular files are read", path));
-    }
-    return fd;
-}
-
-uint64_t file_size(int fd) {
-    struct stat st {};
-    ::fstat(fd, &st);
-    return uint64_t(st.st_size);
 }
 
 }  // namespace
 
-FileSource::FileSource(const std::string& path) : FileSource(path, open_for_reading(path)) {}
+FileSource::FileSource(const std::string& path) : FileSource(path, open_image_file(path)) {}
 
-FileSource::FileSource(const std::string& path, int fd) : ByteSource(path, file_size(fd)), fd_(fd) {}
-
-FileSource::~FileSource() { ::close(fd_); }
+FileSource::FileSource(const std::string& path, std::unique_ptr<InputFile> file) : ByteSource(path, file->size()), file_(std::move(file)) {}
 
 void FileSource::read(uint64_t offset, void* dst, size_t n) const {
     if (offset > size() || n > size() - offset) throw_truncated(offset, n);
     auto* out = static_cast<char*>(dst);
     while (n > 0) {
-        const ssize_t got = ::pread(fd_, out, std::min<size_t>(n, size_t(1) << 30), off_t(offset));
+        const ssize_t got = ::pread(file_->fd(), out, std::min<size_t>(n, size_t(1) << 30), off_t(offset));
         if (got < 0 && errno == EINTR) continue;
         if (got < 0) throw ImageIoError(fmt::format("{}: read error: {}", name(), errno_text(errno)));
         if (got == 0) throw ImageIoError(fmt::format("{}: the file ended at byte {} while being read (it is {} bytes long)", name(), offset, size()));

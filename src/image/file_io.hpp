@@ -8,8 +8,11 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
+
+#include "core/input_file.hpp"
 
 namespace pathlab::io {
 
@@ -47,14 +50,11 @@ private:
 class FileSource final : public ByteSource {
 public:
     explicit FileSource(const std::string& path);
-    ~FileSource() override;
-    FileSource(const FileSource&) = delete;
-    FileSource& operator=(const FileSource&) = delete;
     void read(uint64_t offset, void* dst, size_t n) const override;
 
 private:
-    FileSource(const std::string& path, int fd);
-    int fd_;
+    FileSource(const std::string& path, std::unique_ptr<InputFile> file);
+    std::unique_ptr<InputFile> file_;
 };
 
 // The first min(size, max_bytes) bytes of a source, in memory (without a copy for a MemorySource).

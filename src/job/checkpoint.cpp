@@ -1,5 +1,6 @@
 #include "job/checkpoint.hpp"
 
+#include <unistd.h>
 #include <xxhash.h>
 
 #include <cmath>
@@ -10,6 +11,7 @@
 
 #include <fmt/format.h>
 
+#include "core/input_file.hpp"
 #include "image/file_io.hpp"
 #include "image/image_io.hpp"
 
@@ -184,11 +186,13 @@ Checkpoint read_checkpoint(const std::string& path) {
 }
 
 bool is_checkpoint_file(const std::string& path) {
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(path, ec)) return false;
-    std::ifstream in(path, std::ios::binary);
-    char magic[sizeof kCheckpointMagic] = {};
-    return in.read(magic, sizeof magic) && std::memcmp(magic, kCheckpointMagic, sizeof magic) == 0;
+    try {
+        const InputFile file(path);
+        char magic[sizeof kCheckpointMagic] = {};
+        return ::pread(file.fd(), magic, sizeof magic, 0) == ssize_t(sizeof magic) && std::memcmp(magic, kCheckpointMagic, sizeof magic) == 0;
+    } catch (const InputFileError&) {
+        return false;
+    }
 }
 
 }  // namespace pathlab

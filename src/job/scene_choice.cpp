@@ -7,9 +7,11 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 
 #include <fmt/format.h>
 
+#include "core/input_file.hpp"
 #include "job/usage_error.hpp"
 #include "scene/builtin_scenes.hpp"
 
@@ -72,8 +74,12 @@ std::string scene_hash(const SceneChoice& c) {
     const uint64_t count = files.size();
     h.bytes(&count, sizeof count);
     for (const std::string& f : files) {
-        std::ifstream in(f, std::ios::binary);
-        h.text(std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()));
+        std::string text;
+        try {
+            text = read_input_file(f, std::numeric_limits<uint64_t>::max());
+        } catch (const InputFileError&) {
+        }
+        h.text(text);
     }
     for (const auto& [name, value] : c.parameters) h.text(name + "=" + value);
     const SceneDescription& d = c.description;

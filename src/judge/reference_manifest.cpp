@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "core/input_file.hpp"
 #include "image/image_io.hpp"
 #include "job/render_job.hpp"
 
@@ -19,12 +20,15 @@ nlohmann::json read_manifest(const fs::path& path) {
     const auto fail = [&](const std::string& why) {
         return ManifestError(fmt::format("{}: {} (fix it, or remove it and render the references again)", path.string(), why));
     };
-    if (!fs::is_regular_file(path, ec)) throw fail("not a regular file");
-    std::ifstream in(path);
-    if (!in) throw fail("cannot read it");
+    std::string text;
+    try {
+        text = read_input_file(path.string(), uint64_t(1) << 28);
+    } catch (const InputFileError& e) {
+        throw fail(e.what());
+    }
     nlohmann::json j;
     try {
-        j = nlohmann::json::parse(in);
+        j = nlohmann::json::parse(text);
     } catch (const nlohmann::json::exception& e) {
         throw fail(fmt::format("not valid JSON: {}", e.what()));
     }

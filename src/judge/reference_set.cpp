@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "core/input_file.hpp"
 #include "scene/builtin_scenes.hpp"
 
 namespace pathlab {
@@ -60,10 +61,12 @@ std::string stderr_path_for(const std::string& image_path) {
 }
 
 std::map<int, std::string> read_reference_mapping(const std::string& path) {
-    std::error_code ec;  // checked before it is opened: a named pipe would wait for a writer
-    if (!fs::is_regular_file(path, ec)) throw ReferenceMappingError(fmt::format("{}: cannot read the mapping file: not a regular file", path));
-    std::ifstream in(path);
-    if (!in) throw ReferenceMappingError(fmt::format("{}: cannot read the mapping file", path));
+    std::istringstream in;
+    try {
+        in.str(read_input_file(path, uint64_t(1) << 20));
+    } catch (const InputFileError& e) {
+        throw ReferenceMappingError(fmt::format("{}: cannot read the mapping file: {}", path, e.what()));
+    }
     std::map<int, std::string> mapping;
     std::string line;
     for (int number = 1; std::getline(in, line); ++number) {

@@ -9,6 +9,8 @@
 
 #include <fmt/format.h>
 
+#include "core/input_file.hpp"
+
 namespace pathlab {
 namespace {
 
@@ -223,17 +225,12 @@ IesProfile parse_ies(const std::string& text, const std::string& name) {
 }
 
 IesProfile read_ies_file(const std::string& path) {
-    std::error_code ec;
-    if (!std::filesystem::exists(path, ec)) throw IesError(fmt::format("{}: cannot read the IES file: it does not exist", path));
-    if (!std::filesystem::is_regular_file(path, ec)) throw IesError(fmt::format("{}: cannot read the IES file: not a regular file", path));
-    const auto size = std::filesystem::file_size(path, ec);
-    if (ec) throw IesError(fmt::format("{}: cannot read the IES file: {}", path, ec.message()));
-    if (size > kMaxFileBytes)
-        throw IesError(fmt::format("{}: an IES file of {} bytes; pathlab reads at most {} MiB", path, size, kMaxFileBytes >> 20));
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw IesError(fmt::format("{}: cannot open the IES file", path));
-    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (in.bad()) throw IesError(fmt::format("{}: read error", path));
+    std::string text;
+    try {
+        text = read_input_file(path, kMaxFileBytes);
+    } catch (const InputFileError& e) {
+        throw IesError(fmt::format("{}: cannot read the IES file: {}", path, e.what()));
+    }
     return parse_ies(text, path);
 }
 

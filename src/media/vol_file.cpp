@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "core/input_file.hpp"
 #include "media/grid_files.hpp"
 
 namespace pathlab {
@@ -80,24 +81,21 @@ VoxelGrid parse_vol(std::string_view bytes, const std::string& name) {
 }
 
 void require_regular_grid_file(const std::string& path) {
-    std::error_code ec;
-    if (!std::filesystem::exists(path, ec)) throw GridFileError(fmt::format("grid file '{}': no such file", path));
-    if (!std::filesystem::is_regular_file(path, ec)) throw GridFileError(fmt::format("grid file '{}': not a regular file", path));
+    try {
+        require_input_file(path);
+    } catch (const InputFileError& e) {
+        throw GridFileError(fmt::format("grid file '{}': {}", path, e.what()));
+    }
 }
 
 VoxelGrid read_vol_file(const std::string& path) {
-    require_regular_grid_file(path);
-    std::error_code ec;
-    const auto size = std::filesystem::file_size(path, ec);
-    if (ec) throw GridFileError(fmt::format("grid file '{}': {}", path, ec.message()));
     // The header alone bounds what the data may take: refuse before reading a huge file.
-    if (size > kHeaderBytes + 4 * kMaxGridValues)
-        throw GridFileError(fmt::format("grid file '{}': {} bytes is more than pathlab loads", path, size));
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw GridFileError(fmt::format("grid file '{}': cannot open it: {}", path, std::strerror(errno)));
-    std::string bytes(size_t(size), '\0');
-    in.read(bytes.data(), std::streamsize(size));
-    if (in.gcount() != std::streamsize(size)) throw GridFileError(fmt::format("grid file '{}': read error", path));
+    std::string bytes;
+    try {
+        bytes = read_input_file(path, kHeaderBytes + 4 * kMaxGridValues);
+    } catch (const InputFileError& e) {
+        throw GridFileError(fmt::format("grid file '{}': {}", path, e.what()));
+    }
     return parse_vol(bytes, path);
 }
 

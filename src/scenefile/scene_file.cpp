@@ -10,6 +10,7 @@
 
 #include <fmt/format.h>
 
+#include "core/input_file.hpp"
 #include "scenefile/readers.hpp"
 
 namespace pathlab {
@@ -152,12 +153,12 @@ void Loader::include(XmlSource& xml, const pugi::xml_node& n) {
     if (chain.size() >= 64) xml.fail(n, "includes nested more than 64 deep");
     if (++includes > kMaxIncludes)
         xml.fail(n, fmt::format("more than {} includes in all (files included many times over, nested?)", kMaxIncludes));
-    if (!std::filesystem::is_regular_file(path, ec)) xml.fail(n, fmt::format("included file '{}' is not a regular file", path));
-    std::ifstream in(path, std::ios::binary);
-    if (!in) xml.fail(n, fmt::format("cannot open the included file '{}'", path));
-    std::ostringstream text;
-    text << in.rdbuf();
-    const std::string content = text.str();
+    std::string content;
+    try {
+        content = read_input_file(path, kMaxIncludedBytes);
+    } catch (const InputFileError& e) {
+        xml.fail(n, fmt::format("cannot read the included file '{}': {}", path, e.what()));
+    }
     included_bytes += content.size();
     if (included_bytes > kMaxIncludedBytes)
         xml.fail(n, fmt::format("the includes bring more than {} MiB of scene text in all (files included many times over, nested?)",
@@ -202,15 +203,14 @@ SceneDescription load_scene_text(const std::string& text, const std::string& fil
 }
 
 SceneDescription load_scene_file(const std::string& path, const SceneDefines& defines, SceneFileInputs* inputs) {
-    std::error_code ec;
-    if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
-        throw SceneFileError(path, 0, 0, "not a regular file");
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw SceneFileError(path, 0, 0, fmt::format("cannot open the scene file: {}", std::strerror(errno)));
-    std::ostringstream text;
-    text << in.rdbuf();
+    std::string text;
+    try {
+        text = read_input_file(path, Loader::kMaxIncludedBytes);  // as much as its includes may bring
+    } catch (const InputFileError& e) {
+        throw SceneFileError(path, 0, 0, fmt::format("cannot open the scene file: {}", e.what()));
+    }
     const std::filesystem::path p(path);
-    SceneDescription d = load_scene_text(text.str(), path, p.has_parent_path() ? p.parent_path().string() : ".", defines, true, inputs);
+    SceneDescription d = load_scene_text(text, path, p.has_parent_path() ? p.parent_path().string() : ".", defines, true, inputs);
     if (inputs) inputs->files.insert(inputs->files.begin(), path);
     return d;
 }

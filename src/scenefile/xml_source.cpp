@@ -9,6 +9,7 @@
 
 #include <fmt/format.h>
 
+#include "core/input_file.hpp"
 #include "core/spectrum.hpp"
 
 namespace pathlab {
@@ -350,20 +351,14 @@ std::string XmlSource::spectrum_value(const pugi::xml_node& c, const PluginInfo&
     if (c.attribute("filename")) {
         if (c.attribute("value")) fail(c, "a <spectrum> has a value or a filename, not both");
         const std::string path = find_file(c, attr(c, "filename"), "spectrum file");
-        // Checked before it is opened: opening a named pipe waits for a writer (a hang).
-        std::error_code ec;
-        if (!std::filesystem::is_regular_file(path, ec)) fail(c, fmt::format("cannot read the spectrum file '{}': not a regular file", path));
-        std::ifstream in(path, std::ios::binary);
-        if (!in) fail(c, fmt::format("cannot read the spectrum file '{}'", path));
         // A spectrum of more than 16 MiB of text is no measured spectrum (it was read cut short,
         // silently: the spectrum of its first 16 MiB).
-        const uint64_t bytes = std::filesystem::file_size(path, ec);
-        if (ec) fail(c, fmt::format("cannot read the spectrum file '{}': {}", path, ec.message()));
-        if (bytes > (uint64_t(1) << 24))
-            fail(c, fmt::format("spectrum file '{}' is {} bytes, more than the 16 MiB a spectrum file may have", path, bytes));
-        std::string text(bytes, '\0');
-        in.read(text.data(), std::streamsize(text.size()));
-        if (!in) fail(c, fmt::format("cannot read the spectrum file '{}'", path));
+        std::string text;
+        try {
+            text = read_input_file(path, uint64_t(1) << 24);
+        } catch (const InputFileError& e) {
+            fail(c, fmt::format("cannot read the spectrum file '{}': {}", path, e.what()));
+        }
         const std::string why = parse_spectrum_file(text, s);
         if (!why.empty()) fail(c, fmt::format("spectrum file '{}': {}", path, why));
         return convert(s);

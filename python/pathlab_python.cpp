@@ -9,17 +9,22 @@
 //   pathlab.write("out.exr", img)
 //
 // While rendering, the GIL is released (other Python threads run) and Ctrl-C is honoured: the
-// render stops after its current batch of passes and KeyboardInterrupt is raised.
+// render stops after its current batch of passes and KeyboardInterrupt is raised. A render takes
+// the command line's --first-sample, --checkpoint, --checkpoint-every and --resume too (the job
+// layer's checks and files: job/job_checkpoint.hpp), so renders of disjoint sample ranges merge
+// with `pathlab merge`, and `pathlab --resume FILE` continues a Python render's checkpoint.
 #include <pybind11/pybind11.h>
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <exception>
+#include <functional>
 #include <mutex>
 #include <limits>
 #include <map>
@@ -28,8 +33,11 @@
 
 #include <fmt/format.h>
 
+#include "app/resumed_command.hpp"
 #include "image/image_io.hpp"
 #include "integrators/integrator.hpp"
+#include "job/job_checkpoint.hpp"
+#include "job/render_identity.hpp"
 #include "job/render_job.hpp"
 #include "lights/light_sampler.hpp"
 #include "job/scene_choice.hpp"
@@ -80,6 +88,14 @@ auto translating(F&& f) {
     } catch (const ImageIoError& e) {
         throw py::value_error(e.what());
     }
+}
+
+// A file name given as a str or a path (os.PathLike); None: "".
+std::string path_argument(const py::object& v, const char* name) {
+    if (v.is_none()) return "";
+    if (py::isinstance<py::str>(v)) return v.cast<std::string>();
+    if (py::hasattr(v, "__fspath__")) return py::str(v.attr("__fspath__")()).cast<std::string>();
+    throw py::type_error(fmt::format("{} must be a file name (str or path), not {}", name, type_name(v)));
 }
 
 std::shared_ptr<PyScene> py_load(const py::object& what, const std::map<std::string, std::string>& defines) {
@@ -137,7 +153,7 @@ py::array_t<float> to_array(const Image& img) {
 // An (H, W, 3) array of numbers (any float or int dtype, converted to float32), or an image file.
 Image to_image(const py::object& v, const char* name) {
     if (py::isinstance<py::str>(v) || py::hasattr(v, "__fspath__")) {
-        const std::string path = py::isinstance<py::str>(v) ? v.cast<std::string>() : py::str(v.attr("__fspath__")()).cast<std::string>();
+        const std::string path = path_argument(v, name);
         return translating([&] { return read_image(path); });
     }
     if (!py::isinstance<py::array>(v) && !py::isinstance<py::list>(v))
@@ -158,23 +174,23 @@ Image to_image(const py::object& v, const char* name) {
     return img;
 }
 
-// Runs the job on a worker thread while this (Python's) thread, with the GIL released, waits and
-// every 20 ms lets Python run its signal handlers: a KeyboardInterrupt (or any exception a
-// handler raises) cancels the render after its current batch of passes and is raised here.
-RenderResult run_interruptibly(RenderJob& job) {
+// Runs `work` (the job's render) on a worker thread while this (Python's) thread, with the GIL
+// released, waits and every 20 ms lets Python run its signal handlers: a KeyboardInterrupt (or
+// any exception a handler raises) cancels the render after its current batch of passes and is
+// raised here.
+void run_interruptibly(RenderJob& job, const std::function<void()>& work) {
     std::atomic<bool> cancel{false};
     job.settings.cancel = &cancel;
     std::mutex m;
     std::condition_variable cv;
     bool done = false;
-    std::optional<RenderResult> result;
     std::exception_ptr failure;
     bool python_error = false;
     {
         py::gil_scoped_release release;
         std::thread worker([&] {
             try {
-                result = job.run();
+                work();
             } catch (...) {
                 failure = std::current_exception();
             }
@@ -205,14 +221,16 @@ RenderResult run_interruptibly(RenderJob& job) {
             std::rethrow_exception(failure);
         } catch (const UsageError& e) {
             throw py::value_error(e.what());
+        } catch (const CheckpointError& e) {
+            throw py::value_error(e.what());
         }
     }
-    return std::move(*result);
 }
 
 // The command line's estimator options by their names without dashes (mis="power", photons=...,
-// no_merging=True, ic_rays=..., pbgi_surfels=..., first_sample is not one: a render here is
-// whole). RenderJob refuses one the estimator does not take, as on the command line.
+// no_merging=True, ic_rays=..., pbgi_surfels=...; --first-sample, --checkpoint and --resume are
+// render()'s own keyword arguments). RenderJob refuses one the estimator does not take, as on the
+// command line.
 void apply_estimator_options(JobRequest& r, const py::kwargs& options) {
     constexpr int kIntMax = std::numeric_limits<int>::max();
     static const char* const kNames =
@@ -270,13 +288,51 @@ void apply_estimator_options(JobRequest& r, const py::kwargs& options) {
     }
 }
 
+// The command line's options for a render's arguments, which its checkpoints record (with its
+// scene) so that `pathlab --resume FILE` alone continues it (app/resumed_command.hpp).
+OptionGroups command_options(const RenderJob& job, const JobRequest& r, bool algorithm_given, bool resolution_given, int threads,
+                             const py::kwargs& estimator_options) {
+    OptionGroups given;
+    const auto option = [&](const char* name, const std::string& value) { given.push_back({name, value}); };
+    for (const auto& [name, value] : job.scene_choice().parameters) option("--define", name + "=" + value);
+    if (algorithm_given) option("--algorithm", job.integrator_info().name);
+    if (r.spp) option("--spp", fmt::format("{}", *r.spp));
+    if (r.time_limit > 0) option("--time", fmt::format("{}", r.time_limit));
+    if (resolution_given) option("--resolution", fmt::format("{}x{}", r.width, r.height));
+    option("--seed", fmt::format("{}", r.seed));
+    option("--sampler", r.sampler == SamplerKind::Sobol ? "sobol" : "independent");
+    if (r.spectral) given.push_back({"--spectral"});
+    if (r.max_depth) option("--max-depth", fmt::format("{}", *r.max_depth));
+    if (r.rr_depth) option("--rr-depth", fmt::format("{}", *r.rr_depth));
+    if (r.light_sampler) option("--light-sampler", light_sampler_name(*r.light_sampler));
+    if (r.ris_candidates) option("--ris-candidates", fmt::format("{}", *r.ris_candidates));
+    if (threads > 0) option("--threads", fmt::format("{}", threads));
+    // The estimators' options by their command-line names (checked by apply_estimator_options).
+    for (const auto& [key, value] : estimator_options) {
+        std::string name = "--" + py::str(key).cast<std::string>();
+        std::replace(name.begin(), name.end(), '_', '-');
+        if (py::isinstance<py::bool_>(value)) {
+            if (value.cast<bool>()) given.push_back({name});
+        } else {
+            option(name.c_str(), py::str(value).cast<std::string>());
+        }
+    }
+    if (r.first_sample > 0) option("--first-sample", fmt::format("{}", r.first_sample));
+    if (r.checkpoint_every != kDefaultCheckpointEvery) option("--checkpoint-every", fmt::format("{}", r.checkpoint_every));
+    return given;
+}
+
 py::tuple py_render(const py::object& scene_obj, const py::object& algorithm, const py::object& spp_arg, const py::object& seed_arg,
                  const py::object& threads_arg, double time, const py::object& resolution, const py::object& max_depth_arg,
                  const py::object& sampler, bool spectral, const py::object& rr_depth_arg, const py::object& light_sampler,
-                 const py::object& ris_candidates_arg, const py::kwargs& estimator_options) {
+                 const py::object& ris_candidates_arg, const py::object& first_sample_arg, const py::object& checkpoint_arg,
+                 double checkpoint_every, const py::object& resume_arg, const py::kwargs& estimator_options) {
     constexpr int kIntMax = std::numeric_limits<int>::max();
-    // As the command line: sample indices from 2^62 on are refused (such a render never ends).
-    const std::optional<uint64_t> spp = int_argument<uint64_t>(spp_arg, "spp", 1, (uint64_t(1) << 62) - 1, " (sample indices end at 2^62)");
+    // As the command line: sample indices from 2^62 on are refused (such a render never ends);
+    // first_sample + spp past them are refused by RenderJob, with the command line's message.
+    const std::optional<uint64_t> spp = int_argument<uint64_t>(spp_arg, "spp", 1, kMaxSampleIndex - 1, " (sample indices end at 2^62)");
+    const uint64_t first_sample = *int_argument<uint64_t>(first_sample_arg, "first_sample", 0, std::numeric_limits<uint64_t>::max());
+    const std::string checkpoint_pattern = path_argument(checkpoint_arg, "checkpoint"), resume_pattern = path_argument(resume_arg, "resume");
     const uint64_t seed = *int_argument<uint64_t>(seed_arg, "seed", 0, std::numeric_limits<uint64_t>::max());
     const int threads = *int_argument<int>(threads_arg, "threads", 0, kIntMax);
     const std::optional<int> max_depth = int_argument<int>(max_depth_arg, "max_depth", -1, kIntMax);
@@ -316,6 +372,9 @@ py::tuple py_render(const py::object& scene_obj, const py::object& algorithm, co
     if (sampler_name != "independent" && sampler_name != "sobol")
         throw py::value_error(fmt::format("unknown sampler '{}'; valid: independent, sobol", sampler_name));
     request.sampler = sampler_name == "sobol" ? SamplerKind::Sobol : SamplerKind::Independent;
+    // --first-sample and --checkpoint-every: RenderJob checks them, as for the command line.
+    request.first_sample = first_sample;
+    request.checkpoint_every = checkpoint_every;
 
     // The scene's BVH is built once and shared by its renders with the default light sampler in
     // RGB; another light sampler, or spectral mode (which checks the scene's materials first),
@@ -328,10 +387,60 @@ py::tuple py_render(const py::object& scene_obj, const py::object& algorithm, co
         if (!scene->built) scene->built = std::shared_ptr<const Scene>(Scene::build(scene->choice.description));
         job.emplace(scene->choice, request, scene->built);
     });
+    // --checkpoint and --resume: the files (placeholders expanded) checked as the command line
+    // checks them. A scene changed by update() hashes as the file's scene (its materials are not
+    // in the hash), so its checkpoints would mix with the file's: refused.
+    std::string checkpoint, resume;
+    translating([&] {
+        resume = resume_pattern.empty() ? "" : job->expand(resume_pattern);
+        const std::string given = checkpoint_pattern.empty() ? "" : job->expand(checkpoint_pattern);
+        checkpoint = checkpoint_file(given, resume);
+        if (!checkpoint.empty() && scene->choice.hash.empty())
+            throw UsageError("checkpoint and resume take a scene as loaded: a scene changed by pathlab.update() has the file's "
+                             "identity, so its checkpoints would be taken for the file's (give the values to the file as $parameters, "
+                             "with load(..., defines=))");
+        OutputPaths paths;
+        paths.scene_inputs(scene->choice);
+        add_resume_input(paths, given, resume);
+        add_checkpoint_output(paths, given, resume);
+    });
+    CheckpointInfo info;
+    if (!checkpoint.empty()) {
+        const OptionGroups given = command_options(*job, request, !algorithm.is_none(), !resolution.is_none(), threads, estimator_options);
+        info.command = checkpoint_command(scene->choice, algorithm.is_none() ? "" : job->integrator_info().name, given);
+        info.writer = PATHLAB_VERSION;
+    }
     std::optional<tbb::global_control> limit;
     if (threads > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, size_t(threads));
-    const RenderResult r = run_interruptibly(*job);
-    return py::make_tuple(to_array(r.film.mean()), to_array(r.film.standard_error()));
+    // As the command line: a fresh film, or the checkpoint resumed (of this render, within its
+    // passes); the checkpoints are written every checkpoint_every seconds, at the end, and when
+    // Ctrl-C stops the render.
+    Film film;
+    RenderStats stats;
+    run_interruptibly(*job, [&] {
+        const Scene& built = job->scene();
+        const int width = job->settings.width > 0 ? job->settings.width : built.default_width();
+        const int height = job->settings.height > 0 ? job->settings.height : built.default_height();
+        if (!checkpoint.empty() || !resume.empty()) info.identity = render_identity(*job, width, height);
+        if (resume.empty()) {
+            film = make_film(width, height);
+        } else {
+            ResumedRender resumed = resume_checkpoint(resume, *job, info.identity);
+            film = std::move(resumed.film);
+            job->settings.done = resumed.done;
+            info.seconds = resumed.seconds;
+        }
+        if (!checkpoint.empty()) {
+            info.width = width, info.height = height;
+            checkpoint_job(*job, checkpoint, info, job->scene_choice().name);
+        }
+        stats = job->run_into(film);
+    });
+    if (const std::string why = final_checkpoint_failure(checkpoint, stats); !why.empty()) {
+        PyErr_SetString(PyExc_OSError, why.c_str());
+        throw py::error_already_set();
+    }
+    return py::make_tuple(to_array(film.mean()), to_array(film.standard_error()));
 }
 
 // nlohmann::json -> Python objects.
@@ -556,7 +665,8 @@ PYBIND11_MODULE(pathlab, m) {
     m.def("render", &py_render, py::arg("scene"), py::arg("algorithm") = py::none(), py::arg("spp") = py::none(), py::arg("seed") = py::int_(1234),
           py::arg("threads") = py::int_(0), py::kw_only(), py::arg("time") = 0.0, py::arg("resolution") = py::none(), py::arg("max_depth") = py::none(),
           py::arg("sampler") = "independent", py::arg("spectral") = false, py::arg("rr_depth") = py::none(),
-          py::arg("light_sampler") = py::none(), py::arg("ris_candidates") = py::none(),
+          py::arg("light_sampler") = py::none(), py::arg("ris_candidates") = py::none(), py::arg("first_sample") = py::int_(0),
+          py::arg("checkpoint") = py::none(), py::arg("checkpoint_every") = kDefaultCheckpointEvery, py::arg("resume") = py::none(),
           "Renders a scene (a pathlab.Scene, or what load() takes) and returns (image, standard_error), float32 arrays of shape\n"
           "(height, width, 3). As the command line: algorithm defaults to the scene file's integrator, else pt-mis; spp to the\n"
           "scene file's sample count, else 64 (unlimited with time=seconds); seed to 1234; threads=0 uses all cores. The same\n"
@@ -564,7 +674,13 @@ PYBIND11_MODULE(pathlab, m) {
           "light_sampler ('uniform', 'power', 'bvh', 'ris') and ris_candidates are --spectral, --rr-depth, --light-sampler and\n"
           "--ris-candidates. The estimators' own options go by their command-line names: mis='power', photons, radius, alpha,\n"
           "volume_estimate='points', no_merging=True, no_connections=True, ic_rays, ic_error, ic_no_gradients=True, pbgi_surfels,\n"
-          "pbgi_cutoff, pbgi_bounces, pbgi_resolution, pbgi_direct_samples, pbgi_spacing (refused for another estimator).");
+          "pbgi_cutoff, pbgi_bounces, pbgi_resolution, pbgi_direct_samples, pbgi_spacing (refused for another estimator).\n"
+          "first_sample is --first-sample: the index of the first sample (pass), so that renders of disjoint ranges add up, with\n"
+          "`pathlab merge`, to one render (give them checkpoint= files: merge takes checkpoints, exactly). checkpoint=FILE saves\n"
+          "the render's whole state every checkpoint_every seconds (default 300; 0: only at the end), at the end and on Ctrl-C;\n"
+          "resume=FILE continues such a checkpoint (the same scene and settings; spp may be raised) and goes on checkpointing\n"
+          "to it. The files are the command line's: `pathlab --resume FILE` continues a checkpoint written here, and resume=\n"
+          "one the command line wrote, to the bytes of the render never interrupted.");
     m.def("compare", [](const py::object& a, const py::object& b) {
         const Image ia = to_image(a, "a"), ib = to_image(b, "b");
         if (ia.width() != ib.width() || ia.height() != ib.height())

@@ -7,10 +7,12 @@ the valid values.
 import json
 import os
 import signal
+import struct
 import subprocess
 import sys
 import threading
 import time
+import zlib
 
 import numpy as np
 import pytest
@@ -29,6 +31,68 @@ def cli(*args):
 
 def same_bits(a, b):
     return a.shape == b.shape and a.dtype == b.dtype and np.array_equal(a.view(np.uint32), b.view(np.uint32))
+
+
+def read_exr_channels(path):
+    """Every channel of a scanline EXR as pathlab writes them (float, uncompressed or ZIP), by name
+    ("R", "stderr.R"): NumPy has no EXR reader, and pathlab.read returns the RGB image only."""
+    data = open(path, "rb").read()
+    assert data[:4] == b"\x76\x2f\x31\x01", path
+    pos, attributes = 8, {}
+    while data[pos] != 0:
+        name_end = data.index(b"\0", pos)
+        type_end = data.index(b"\0", name_end + 1)
+        size = struct.unpack_from("<i", data, type_end + 1)[0]
+        attributes[data[pos:name_end].decode()] = data[type_end + 5:type_end + 5 + size]
+        pos = type_end + 5 + size
+    pos += 1
+    names, listing, p = [], attributes["channels"], 0
+    while listing[p] != 0:  # name, pixel type (2: float), pLinear, reserved, x and y sampling
+        end = listing.index(b"\0", p)
+        assert struct.unpack_from("<i", listing, end + 1)[0] == 2, "not a float channel"
+        names.append(listing[p:end].decode())
+        p = end + 17
+    x0, y0, x1, y1 = struct.unpack("<4i", attributes["dataWindow"])
+    width, height = x1 - x0 + 1, y1 - y0 + 1
+    compression = attributes["compression"][0]
+    lines = {0: 1, 2: 1, 3: 16}[compression]  # none, ZIPS, ZIP
+    chunks = (height + lines - 1) // lines
+    out = {name: np.zeros((height, width), np.float32) for name in names}
+    for offset in struct.unpack_from(f"<{chunks}Q", data, pos):
+        y, size = struct.unpack_from("<ii", data, offset)
+        n = min(lines, y1 + 1 - y)
+        raw = data[offset + 8:offset + 8 + size]
+        if compression and size < n * width * 4 * len(names):
+            t = np.frombuffer(zlib.decompress(raw), np.uint8).astype(np.int64)
+            t[1:] -= 128
+            t = (np.cumsum(t) % 256).astype(np.uint8)  # the predictor undone
+            half = (len(t) + 1) // 2
+            raw = np.empty_like(t)
+            raw[0::2], raw[1::2] = t[:half], t[half:]  # the two halves interleaved again
+            raw = raw.tobytes()
+        rows = np.frombuffer(raw, "<f4").reshape(n, len(names), width)
+        for c, name in enumerate(names):
+            out[name][y - y0:y - y0 + n] = rows[:, c]
+    return out
+
+
+def read_render(path):
+    """(mean, standard_error) of a render's EXR, as (height, width, 3) float32 arrays."""
+    ch = read_exr_channels(path)
+    return (np.stack([ch["R"], ch["G"], ch["B"]], axis=-1), np.stack([ch["stderr.R"], ch["stderr.G"], ch["stderr.B"]], axis=-1))
+
+
+def same_render(a, b):
+    """The CLI tests' criterion (tests/test_distributed.cpp): the means and the standard errors bit for bit."""
+    return same_bits(a[0], b[0]) and same_bits(a[1], b[1])
+
+
+def checkpoint_header(path):
+    """A checkpoint's header lines (job/checkpoint.hpp) as a dict: passes, command, ..."""
+    data = open(path, "rb").read()
+    assert data[:8] == b"PLCKPT\r\n"
+    size = struct.unpack_from("<I", data, 12)[0]
+    return dict(line.split("=", 1) for line in data[16:16 + size].decode().splitlines())
 
 
 def test_import_without_numpy_says_which_python_lacks_it():
@@ -284,3 +348,114 @@ def test_gradient_and_optimize_give_the_command_lines_numbers(tmp_path):
         pathlab.gradient(2, "red", adjoint)
     with pytest.raises(ValueError, match="iterations must be an int from 0"):
         pathlab.optimize(2, target, "red.reflectance.value", iterations=-1)
+
+
+# ---- the command line's --first-sample, --checkpoint, --checkpoint-every and --resume -----------
+
+SMALL = dict(seed=5, resolution=(16, 12))
+SMALL_CLI = ["--seed", 5, "--resolution", "16x12", "-q"]
+
+
+def test_the_exr_reader_of_these_tests_reads_what_pathlab_reads(tmp_path):
+    cli("3", "--spp", 2, *SMALL_CLI, "-o", tmp_path / "a.exr")
+    mean, se = read_render(str(tmp_path / "a.exr"))
+    assert same_bits(mean, pathlab.read(str(tmp_path / "a.exr")))
+    assert se.min() >= 0 and se.max() > 0
+
+
+@pytest.mark.parametrize("algorithm", ["pt-mis", "bdpt"])
+def test_first_sample_equals_the_command_line_bit_for_bit(tmp_path, algorithm):
+    out = tmp_path / "cli.exr"
+    cli("3", "-a", algorithm, "--spp", 3, "--first-sample", 5, "--seed", 77, "--resolution", "20x14", "-q", "-o", out)
+    img, se = pathlab.render(3, algorithm, spp=3, seed=77, resolution=(20, 14), first_sample=5)
+    assert same_render((img, se), read_render(str(out)))
+    # Other samples than those of the first 3 passes.
+    first, _ = pathlab.render(3, algorithm, spp=3, seed=77, resolution=(20, 14))
+    assert not same_bits(img, first)
+
+
+def test_renders_of_disjoint_ranges_merge_into_the_one_shot_render(tmp_path):
+    # As the command line's MergeOfTwoHalvesEqualsTheOneShotRender: merged from checkpoints, the
+    # one-shot render's mean and standard errors bit for bit.
+    cli("3", "--spp", 10, *SMALL_CLI, "-o", tmp_path / "whole.exr")
+    pathlab.render(3, spp=4, **SMALL, checkpoint=tmp_path / "a.ckpt")
+    img, _ = pathlab.render(3, spp=6, first_sample=4, **SMALL, checkpoint=str(tmp_path / "b.ckpt"))
+    assert checkpoint_header(tmp_path / "a.ckpt")["passes"] == "0-3"
+    assert checkpoint_header(tmp_path / "b.ckpt")["passes"] == "4-9"
+    cli("merge", tmp_path / "m.exr", tmp_path / "b.ckpt", tmp_path / "a.ckpt")
+    assert same_render(read_render(str(tmp_path / "m.exr")), read_render(str(tmp_path / "whole.exr")))
+    # The part alone is samples 4-9 of the same render, as the command line renders them.
+    cli("3", "--spp", 6, "--first-sample", 4, *SMALL_CLI, "-o", tmp_path / "b.exr")
+    assert same_bits(img, pathlab.read(str(tmp_path / "b.exr")))
+
+
+@pytest.mark.parametrize("scene,algorithm,defines,options", [
+    ("3", "pt-mis", {}, {}),
+    ("scenes/example.xml", "sppm", {"spp": "2"}, {"photons": 300, "radius": 0.05, "spectral": True}),
+])
+def test_the_command_line_continues_a_python_checkpoint(tmp_path, scene, algorithm, defines, options):
+    path = os.path.join(SOURCE, scene) if scene.endswith(".xml") else scene
+    flags = [w for k, v in options.items() for w in (["--" + k] if v is True else ["--" + k, v])]
+    cli(path, "-a", algorithm, *[w for k, v in defines.items() for w in ("-D", f"{k}={v}")], *flags, "--spp", 9, *SMALL_CLI,
+        "-o", tmp_path / "whole.exr")
+    ckpt = tmp_path / "c.ckpt"
+    pathlab.render(pathlab.load(path, defines=defines), algorithm, spp=4, **SMALL, checkpoint=ckpt, checkpoint_every=0, **options)
+    assert checkpoint_header(ckpt)["passes"] == "0-3"
+    # `pathlab --resume FILE` alone: the checkpoint records the Python render as a command.
+    cli("--resume", ckpt, "--spp", 9, "-q", "-o", tmp_path / "resumed.exr")
+    assert same_render(read_render(str(tmp_path / "resumed.exr")), read_render(str(tmp_path / "whole.exr")))
+    assert checkpoint_header(ckpt)["passes"] == "0-8"
+
+
+def test_python_continues_a_command_line_checkpoint(tmp_path):
+    cli("3", "--spp", 9, *SMALL_CLI, "-o", tmp_path / "whole.exr")
+    ckpt = tmp_path / "c.ckpt"
+    cli("3", "--spp", 4, *SMALL_CLI, "--checkpoint", ckpt, "-o", tmp_path / "part.exr")
+    # Another render's checkpoint, or more passes than asked for: refused as on the command line.
+    with pytest.raises(ValueError, match="seed: 5 in the checkpoint, 6 in this render"):
+        pathlab.render(3, spp=9, seed=6, resolution=(16, 12), resume=ckpt)
+    with pytest.raises(ValueError, match=r"holds passes 0-3, more than this render's 0-1 \(raise --spp to continue it\)"):
+        pathlab.render(3, spp=2, **SMALL, resume=ckpt)
+    # A checkpoint that exists is not replaced by a render that does not resume it.
+    with pytest.raises(ValueError, match="c.ckpt exists: continue that render with --resume"):
+        pathlab.render(3, spp=9, **SMALL, checkpoint=ckpt)
+    assert checkpoint_header(ckpt)["passes"] == "0-3"
+    # resume= continues it to the bytes of the render never interrupted, and goes on
+    # checkpointing to it.
+    resumed = pathlab.render(3, spp=9, **SMALL, resume=str(ckpt))
+    assert same_render(resumed, read_render(str(tmp_path / "whole.exr")))
+    assert checkpoint_header(ckpt)["passes"] == "0-8"
+
+
+def test_first_sample_and_checkpoint_values_are_refused_as_on_the_command_line(tmp_path):
+    for value in (-1, 2**64):
+        with pytest.raises(ValueError, match=f"first_sample must be an int from 0 to 18446744073709551615, not {value}"):
+            pathlab.render(2, spp=1, resolution=(4, 4), first_sample=value)
+    # Sample indices end at 2^62: the command line's check and message.
+    with pytest.raises(ValueError, match=r"--first-sample 4611686018427387903 with 2 samples per pixel reaches past the last sample index"):
+        pathlab.render(2, spp=2, resolution=(4, 4), first_sample=2**62 - 1)
+    with pytest.raises(ValueError, match="--first-sample .* with --time and no --spp may reach past the last sample index"):
+        pathlab.render(2, time=1, resolution=(4, 4), first_sample=2**62 - 4)
+    with pytest.raises(TypeError, match="first_sample must be an int, not float"):
+        pathlab.render(2, spp=1, resolution=(4, 4), first_sample=1.5)
+    for value in (-1, float("nan"), float("inf")):
+        with pytest.raises(ValueError, match=r"--checkpoint-every must be zero \(only at the end\) or a positive number of seconds"):
+            pathlab.render(2, spp=1, resolution=(4, 4), checkpoint_every=value)
+    missing = tmp_path / "missing.ckpt"
+    with pytest.raises(ValueError, match=f"{missing}: cannot read the checkpoint"):
+        pathlab.render(2, spp=1, resolution=(4, 4), resume=missing)
+    (tmp_path / "not.ckpt").write_bytes(b"an image")
+    with pytest.raises(ValueError, match="not.ckpt: not a pathlab checkpoint"):
+        pathlab.render(2, spp=1, resolution=(4, 4), resume=tmp_path / "not.ckpt")
+    with pytest.raises(TypeError, match="checkpoint must be a file name \\(str or path\\), not int"):
+        pathlab.render(2, spp=1, resolution=(4, 4), checkpoint=3)
+    with pytest.raises(TypeError, match="resume must be a file name"):
+        pathlab.render(2, spp=1, resolution=(4, 4), resume=b"c.ckpt")
+    # A file that exists (here the scene file) is not a checkpoint to write over.
+    scene_file = os.path.join(SOURCE, "scenes/example.xml")
+    with pytest.raises(ValueError, match="example.xml exists: continue that render with --resume"):
+        pathlab.render(pathlab.load(scene_file), spp=1, resolution=(4, 4), checkpoint=scene_file)
+    # A scene changed by update() hashes as the file's: its checkpoints would be taken for the file's.
+    with pytest.raises(ValueError, match="checkpoint and resume take a scene as loaded"):
+        pathlab.render(pathlab.update(2, {"red.reflectance.value": 0.5}), spp=1, resolution=(4, 4), checkpoint=tmp_path / "u.ckpt")
+    assert not (tmp_path / "u.ckpt").exists()

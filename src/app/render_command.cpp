@@ -18,6 +18,7 @@
 #include "integrators/common/path_rules.hpp"
 #include "job/output_paths.hpp"
 #include "job/checkpoint.hpp"
+#include "job/job_checkpoint.hpp"
 #include "job/rank_group.hpp"
 #include "job/render_identity.hpp"
 #include "job/render_job.hpp"
@@ -203,6 +204,8 @@ std::vector<RenderJob> make_jobs(const RenderCommandOptions& o, bool check_paths
     request.pbgi_resolution = o.pbgi_resolution;
     request.pbgi_direct_samples = o.pbgi_direct_samples;
     request.pbgi_spacing = o.pbgi_spacing;
+    request.first_sample = o.first_sample;
+    request.checkpoint_every = o.checkpoint_every;
 
     std::vector<RenderJob> jobs;
     // -a all: every estimator that renders the scene; those that cannot (a medium, spectral mode,
@@ -228,25 +231,6 @@ std::vector<RenderJob> make_jobs(const RenderCommandOptions& o, bool check_paths
             fmt::print(stderr, "pathlab: note: -a all on {}: {} left out, as they cannot render it (e.g. {})\n", choice.name,
                        fmt::join(left_out, ", "), reasons[0]);
     }
-    // Sample indices from 2^62 on are refused up front: first + spp must not wrap round (an image of
-    // 0 samples after a minute's work), and no render reaches them.
-    constexpr uint64_t kMaxSampleIndex = uint64_t(1) << 62;
-    for (RenderJob& job : jobs) {
-        job.settings.first_sample = o.first_sample;
-        if (o.first_sample >= kMaxSampleIndex || job.settings.spp > kMaxSampleIndex - o.first_sample)
-            throw UsageError(fmt::format("--first-sample {} with {} samples per pixel reaches past the last sample index, 2^62 = {}",
-                                         o.first_sample, job.settings.spp, kMaxSampleIndex));
-        // A render bounded by --time alone (no spp) could run past 2^62: it must start 2^40
-        // samples before it (more than any render reaches: 10^12 passes).
-        constexpr uint64_t kTimedMargin = uint64_t(1) << 40;
-        if (job.settings.spp == 0 && o.first_sample > kMaxSampleIndex - kTimedMargin)
-            throw UsageError(fmt::format("--first-sample {} with --time and no --spp may reach past the last sample index, 2^62 = {}: "
-                                         "give --spp, or a first sample at most 2^62 - 2^40 = {}",
-                                         o.first_sample, kMaxSampleIndex, kMaxSampleIndex - kTimedMargin));
-    }
-    if (!(o.checkpoint_every >= 0) || !std::isfinite(o.checkpoint_every))
-        throw UsageError("--checkpoint-every must be zero (only at the end) or a positive number of seconds");
-
     std::vector<std::string> patterns(o.outputs.begin(), o.outputs.end());
     if (patterns.empty()) {
         patterns.assign(std::begin(kDefaultOutputs), std::end(kDefaultOutputs));
@@ -268,9 +252,10 @@ std::vector<RenderJob> make_jobs(const RenderCommandOptions& o, bool check_paths
     for (const RenderJob& job : jobs)
         paths.scene_inputs(job.scene_choice());
     for (RenderJob& job : jobs) {
+        const std::string checkpoint = o.checkpoint.empty() ? "" : job.expand(o.checkpoint);
         resumes.push_back(o.resume.empty() ? "" : job.expand(o.resume));
-        checkpoints.push_back(!o.checkpoint.empty() ? job.expand(o.checkpoint) : resumes.back());
-        if (!resumes.back().empty() && resumes.back() != checkpoints.back()) paths.input(resumes.back(), "--resume");
+        checkpoints.push_back(checkpoint_file(checkpoint, resumes.back()));
+        add_resume_input(paths, checkpoint, resumes.back());
     }
     for (size_t j = 0; j < jobs.size(); ++j) {
         // Notes of the scene loader: what it accepted and ignored, or changed.
@@ -299,10 +284,7 @@ std::vector<RenderJob> make_jobs(const RenderCommandOptions& o, bool check_paths
                                                      "{{algorithm}} to it",
                                                      jobs[k].scene_choice().name, jobs[k].integrator_info().name,
                                                      jobs[j].scene_choice().name, jobs[j].integrator_info().name, checkpoints[j]));
-                if (resumes[j].empty() && std::filesystem::exists(checkpoints[j]))
-                    throw UsageError(fmt::format("{} exists: continue that render with --resume {}, or remove it first", checkpoints[j],
-                                                 checkpoints[j]));
-                paths.output(checkpoints[j], "--checkpoint", /*image=*/false);
+                add_checkpoint_output(paths, checkpoints[j], resumes[j]);
             }
         }
         // (The options of other estimators are refused by RenderJob; --ic-records is the command line's.)
@@ -439,20 +421,10 @@ int run_render_command(const RenderCommandOptions& o, RankGroup* ranks) {
                 height = job.settings.height > 0 ? job.settings.height : scene.default_height();
                 identity = render_identity(job, width, height);
                 if (root && !resumes[j].empty()) {
-                    Checkpoint c = read_checkpoint(resumes[j]);
-                    const std::string diff = c.info.identity.differences(identity, kIdentityFields, "the checkpoint", "this render");
-                    if (!diff.empty())
-                        throw CheckpointError(fmt::format("{} is a checkpoint of another render; they differ in\n{}", resumes[j], diff));
-                    const uint64_t first = job.settings.first_sample;
-                    if (job.settings.spp > 0 && !PassSet::range(first, first + job.settings.spp).contains(c.info.passes))
-                        throw CheckpointError(fmt::format("{} holds passes {}, more than this render's {} (raise --spp to continue it)",
-                                                          resumes[j], c.info.passes.to_string(),
-                                                          PassSet::range(first, first + job.settings.spp).to_string()));
-                    if (c.info.passes.begin() < first)
-                        throw CheckpointError(fmt::format("{} holds passes {}, before --first-sample {}", resumes[j], c.info.passes.to_string(), first));
-                    result.film = std::move(c.film);
-                    done_text = c.info.passes.to_string();
-                    seconds_before = c.info.seconds;
+                    ResumedRender resumed = resume_checkpoint(resumes[j], job, identity);
+                    result.film = std::move(resumed.film);
+                    done_text = resumed.done.to_string();
+                    seconds_before = resumed.seconds;
                 } else {
                     result.film = make_film(width, height);
                 }
@@ -478,20 +450,9 @@ int run_render_command(const RenderCommandOptions& o, RankGroup* ranks) {
         group.broadcast_text(done_text);
         job.settings.done = *PassSet::parse(done_text);
         if (!checkpoints[j].empty()) {
-            job.settings.checkpoint_every = o.checkpoint_every;
             const std::string command =
                 checkpoint_command(job.scene_choice(), o.algorithm_given ? job.integrator_info().name : "", o.given);
-            job.settings.checkpoint = [&, j, command](RankGroup& parts, const Film& film, const PassSet& done, const RenderStats& st) {
-                CheckpointInfo info{identity, done, width, height, seconds_before + st.seconds, PATHLAB_VERSION, command};
-                try {
-                    write_checkpoint(checkpoints[j], parts, film, info);
-                    return true;
-                } catch (const std::exception& e) {
-                    // The render goes on; the file keeps the last complete checkpoint.
-                    fmt::print(stderr, "pathlab: warning: {}: checkpoint not written: {}\n", name, e.what());
-                    return false;
-                }
-            };
+            checkpoint_job(job, checkpoints[j], CheckpointInfo{identity, {}, width, height, seconds_before, PATHLAB_VERSION, command}, name);
         }
         try {
             result.stats = job.run_into(result.film);
@@ -512,10 +473,9 @@ int run_render_command(const RenderCommandOptions& o, RankGroup* ranks) {
                 continue;
             }
             if (!o.quiet) print_summary(job, name, s);
-            if (s.last_checkpoint_failed) {
+            if (const std::string why = final_checkpoint_failure(checkpoints[j], s); !why.empty()) {
                 // The image is written, but the checkpoint asked for does not hold this render's end.
-                fmt::print(stderr, "pathlab: error: {}: the final checkpoint {} could not be written; it holds {}\n", name, checkpoints[j],
-                           s.checkpoints > 0 ? "an earlier checkpoint of this render" : "what it held before");
+                fmt::print(stderr, "pathlab: error: {}: {}\n", name, why);
                 ++failed;
                 if (s.interrupted) return 1;
                 continue;

@@ -10,6 +10,7 @@
 
 #include "app/command_arguments.hpp"
 #include "app/resumed_command.hpp"
+#include "job/render_job.hpp"
 
 namespace pathlab {
 
@@ -55,7 +56,7 @@ struct RenderCommandOptions {
     std::optional<int> pbgi_direct_samples;
     std::optional<int> pbgi_spacing;
     std::string checkpoint;          // --checkpoint FILE
-    double checkpoint_every = 300;   // --checkpoint-every SECONDS
+    double checkpoint_every = kDefaultCheckpointEvery;  // --checkpoint-every SECONDS
     std::string resume;              // --resume FILE
     uint64_t first_sample = 0;       // --first-sample N
     OptionGroups given;              // the options given, which checkpoints record (resumed_command.hpp)

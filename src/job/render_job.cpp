@@ -211,6 +211,23 @@ RenderJob::RenderJob(SceneChoice scene, const JobRequest& r) : choice_(std::move
     settings.sampler = r.sampler;
     settings.spectral = options_.spectral;
     apply_environment_caps(settings, d);
+    // Sample indices from 2^62 on are refused up front: first + spp must not wrap round (an image
+    // of 0 samples after a minute's work), and no render reaches them (after the caps, which may
+    // lower spp).
+    settings.first_sample = r.first_sample;
+    if (r.first_sample >= kMaxSampleIndex || settings.spp > kMaxSampleIndex - r.first_sample)
+        throw UsageError(fmt::format("--first-sample {} with {} samples per pixel reaches past the last sample index, 2^62 = {}",
+                                     r.first_sample, settings.spp, kMaxSampleIndex));
+    // A render bounded by --time alone (no spp) could run past 2^62: it must start 2^40 samples
+    // before it (more than any render reaches: 10^12 passes).
+    constexpr uint64_t kTimedMargin = uint64_t(1) << 40;
+    if (settings.spp == 0 && r.first_sample > kMaxSampleIndex - kTimedMargin)
+        throw UsageError(fmt::format("--first-sample {} with --time and no --spp may reach past the last sample index, 2^62 = {}: "
+                                     "give --spp, or a first sample at most 2^62 - 2^40 = {}",
+                                     r.first_sample, kMaxSampleIndex, kMaxSampleIndex - kTimedMargin));
+    if (!(r.checkpoint_every >= 0) || !std::isfinite(r.checkpoint_every))
+        throw UsageError("--checkpoint-every must be zero (only at the end) or a positive number of seconds");
+    settings.checkpoint_every = r.checkpoint_every;
 }
 
 namespace {

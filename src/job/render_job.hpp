@@ -24,6 +24,10 @@
 
 namespace pathlab {
 
+constexpr double kDefaultCheckpointEvery = 300;  // --checkpoint-every's default, in seconds
+// Sample (pass) indices end at 2^62: a render's first_sample + spp must not reach past it.
+constexpr uint64_t kMaxSampleIndex = uint64_t(1) << 62;
+
 struct JobRequest {
     std::optional<std::string> algorithm;
     std::optional<uint64_t> spp;
@@ -35,6 +39,8 @@ struct JobRequest {
     SamplerKind sampler = SamplerKind::Independent;
     bool spectral = false;  // --spectral (else the scene file's <default name="mode">, else RGB)
     uint64_t default_spp = 64;
+    uint64_t first_sample = 0;     // --first-sample N: the index of the first pass (disjoint ranges merge into one render)
+    double checkpoint_every = kDefaultCheckpointEvery;  // --checkpoint-every SECONDS (0: only at the end and when interrupted)
     bool mis_power = false;        // --mis power (bdpt, vcm, bpm, pt-mis, pt-mis3, direct-mis)
     std::string strategies_dir;    // --strategies DIR (bdpt)
     int strategies_depth = 4;      // --strategies-depth N (bdpt)

@@ -1,7 +1,8 @@
 // Writes the seed corpora of the reader fuzz targets, from files pathlab (and the libraries it
 // links) can make itself: small images in every format and variant the readers know, and OBJ
-// meshes, voxel grids. Usage: fuzz_make_seeds DIR  (creates DIR/exr, DIR/hdr, DIR/pfm, DIR/png,
-// DIR/jpeg, DIR/obj, DIR/vol, DIR/vdb).
+// meshes (OBJ, PLY, .serialized), voxel grids, spectrum files and a checkpoint. Usage:
+// fuzz_make_seeds DIR  (creates DIR/exr, DIR/hdr, DIR/pfm, DIR/png,
+// DIR/jpeg, DIR/obj, DIR/vol, DIR/vdb, DIR/ply, DIR/serialized, DIR/spd, DIR/checkpoint).
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
@@ -10,6 +11,7 @@
 #include <stb_image_write.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -18,7 +20,10 @@
 #include <string>
 #include <vector>
 
+#include "geometry/mesh_files.hpp"
 #include "image/image_io.hpp"
+#include "job/checkpoint.hpp"
+#include "job/rank_group.hpp"
 #include "media/grid_files.hpp"
 
 namespace fs = std::filesystem;
@@ -76,7 +81,8 @@ int main(int argc, char** argv) {
         return 2;
     }
     const fs::path dir = argv[1];
-    for (const char* sub : {"exr", "hdr", "pfm", "png", "jpeg", "obj", "vol", "vdb"}) fs::create_directories(dir / sub);
+    for (const char* sub : {"exr", "hdr", "pfm", "png", "jpeg", "obj", "vol", "vdb", "ply", "serialized", "spd", "checkpoint"})
+        fs::create_directories(dir / sub);
 
     // pathlab's own writers, at sizes around the readers' special cases (HDR run-length
     // encoding needs widths of 8 or more).
@@ -167,6 +173,64 @@ int main(int argc, char** argv) {
         g.channels = 1;
         for (size_t i = 0; i < g.voxel_count(); ++i) g.data.push_back(i % 5 == 0 ? 0.0f : float(i % 7) * 0.25f);
         pathlab::write_vdb_file((dir / "vdb" / ("grid" + std::to_string(side) + ".vdb")).string(), g, "density", 0.1);
+    }
+
+    // PLY: ASCII with normals and a quad, binary little and big endian with uvs and a list of
+    // another count type.
+    const std::string ply_vertices = "element vertex 4\nproperty float x\nproperty float y\nproperty float z\n";
+    write_bytes(dir / "ply" / "ascii.ply", "ply\nformat ascii 1.0\ncomment a quad\n" + ply_vertices +
+                                               "property float nx\nproperty float ny\nproperty float nz\n"
+                                               "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                                               "0 0 0 0 0 1\n1 0 0 0 0 1\n1 1 0 0 0 1\n0 1 0 0 0 1\n4 0 1 2 3\n");
+    for (const bool big : {false, true}) {
+        std::string b = std::string("ply\nformat binary_") + (big ? "big" : "little") + "_endian 1.0\n" + ply_vertices +
+                        "property float u\nproperty float v\nelement face 2\nproperty list uint16 uint32 vertex_indices\nend_header\n";
+        const auto put = [&](const void* p, size_t n) {
+            std::string bytes(static_cast<const char*>(p), n);
+            if (big) std::reverse(bytes.begin(), bytes.end());
+            b += bytes;
+        };
+        const float v[4][5] = {{0, 0, 0, 0, 0}, {1, 0, 0, 1, 0}, {1, 1, 0, 1, 1}, {0, 1, 0, 0, 1}};
+        for (const auto& row : v)
+            for (const float x : row) put(&x, 4);
+        for (const auto& face : {std::array<uint32_t, 3>{0, 1, 2}, std::array<uint32_t, 3>{0, 2, 3}}) {
+            const uint16_t n = 3;
+            put(&n, 2);
+            for (const uint32_t i : face) put(&i, 4);
+        }
+        write_bytes(dir / "ply" / (big ? "binary-big.ply" : "binary-little.ply"), b);
+    }
+
+    // Mitsuba .serialized: a quad with normals and uvs, single and double precision.
+    {
+        pathlab::MeshDesc m;
+        m.positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+        m.normals = {{0, 0, 1}, {0, 0, 1}, {0, 0, 1}, {0, 0, 1}};
+        m.uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+        m.triangles = {{0, 1, 2}, {0, 2, 3}};
+        write_bytes(dir / "serialized" / "quad.serialized", pathlab::serialized_mesh_bytes(m));
+        write_bytes(dir / "serialized" / "quad-double.serialized", pathlab::serialized_mesh_bytes(m, true));
+    }
+
+    // Spectrum files: comments, blank lines, tabs, exponents.
+    write_bytes(dir / "spd" / "simple.spd", "# a spectrum\n400 0.1\n500 0.25\n\n600\t0.5\n700 1e-1\n");
+    write_bytes(dir / "spd" / "dense.spd", [] {
+        std::string s;
+        for (int w = 360; w <= 830; w += 5) s += std::to_string(w) + " " + std::to_string(0.5 + 0.4 * std::sin(w * 0.05)) + "\n";
+        return s;
+    }());
+
+    // A checkpoint of a 3x2 film of two passes, written by pathlab's writer.
+    {
+        pathlab::Film film(3, 2);
+        for (int pass = 0; pass < 2; ++pass)
+            for (size_t p = 0; p < film.pixel_count(); ++p) film.add(p, pathlab::Rgb(float(p) * 0.25f, 0.5f, float(pass)));
+        pathlab::CheckpointInfo info;
+        info.identity.fields = {{"scene", "cornell-box"}, {"algorithm", "pt-mis"}, {"seed", "1234"}};
+        info.passes = pathlab::PassSet::range(0, 2);
+        info.width = 3, info.height = 2, info.seconds = 0.5, info.writer = "fuzz";
+        pathlab::LocalRanks ranks;
+        pathlab::write_checkpoint((dir / "checkpoint" / "small.ckpt").string(), ranks, film, info);
     }
     return 0;
 }

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Fuzzes pathlab's readers of untrusted files with libFuzzer (clang, AddressSanitizer, UBSan).
-#   scripts/fuzz.sh TARGET [SECONDS]   TARGET: scene_xml, exr, hdr, pfm, png, jpeg, obj, vol, vdb, ies, or all
+#   scripts/fuzz.sh TARGET [SECONDS]   TARGET: scene_xml, exr, hdr, pfm, png, jpeg, obj, vol, vdb, ies, ply,
+#                                      serialized, spd, checkpoint, or all
 #                                      (all: each target in turn for SECONDS); default 660 s
 #   scripts/fuzz.sh [SECONDS]          the scene-file loader, as before (scene_xml)
 # Seeds: the shipped scenes, meshes and IES files, images and meshes written by fuzz_make_seeds
@@ -14,14 +15,14 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-all_targets=(scene_xml exr hdr pfm png jpeg obj vol vdb ies)
+all_targets=(scene_xml exr hdr pfm png jpeg obj vol vdb ies ply serialized spd checkpoint)
 if [[ $# -eq 0 || $1 =~ ^[0-9]+$ ]]; then
     targets=(scene_xml)
     seconds=${1:-660}
 else
     case $1 in
         all) targets=("${all_targets[@]}") ;;
-        scene_xml | exr | hdr | pfm | png | jpeg | obj | vol | vdb | ies) targets=("$1") ;;
+        scene_xml | exr | hdr | pfm | png | jpeg | obj | vol | vdb | ies | ply | serialized | spd | checkpoint) targets=("$1") ;;
         *) echo "fuzz.sh: unknown target '$1' (valid: ${all_targets[*]}, all)" >&2; exit 2 ;;
     esac
     seconds=${2:-660}
@@ -93,6 +94,12 @@ for t in "${targets[@]}"; do
             # throws; RootNode::readTopology holds it by a raw pointer): one node per refused
             # file, theirs, so leaks are not reported for this target.
             extra=(-detect_leaks=0)
+            ;;
+        ply | serialized)
+            corpus=build-fuzz/corpus-$t
+            mkdir -p "$corpus"
+            make_seeds
+            cp -n build-fuzz/seeds/"$t"/* tests/data/scenes/mitsuba/meshes/*."$t" "$corpus"/ 2>/dev/null || true
             ;;
         ies)
             corpus=build-fuzz/corpus-ies

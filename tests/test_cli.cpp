@@ -175,6 +175,10 @@ TEST_F(Cli, IcOptionsRecordsAndStatistics) {
     CliResult r = run({"-s", "2", "-a", "pt-mis", "--ic-error", "0.1", "-o", path("x.exr")});
     EXPECT_EQ(r.code, 2);
     EXPECT_TRUE(contains(r.err, "are ic's, not pt-mis's")) << r.err;
+    r = run({"-s", "2", "-a", "bdpt", "--ic-records", path("records.png"), "-o", path("x.exr")});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_TRUE(contains(r.err, "are ic's, not bdpt's")) << r.err;
+    EXPECT_FALSE(fs::exists(path("records.png")));
     r = run({"-s", "2", "-a", "ic", "--ic-rays", "2", "-o", path("x.exr")});
     EXPECT_EQ(r.code, 2);
     EXPECT_TRUE(contains(r.err, "--ic-rays must be 4 to 65536")) << r.err;

@@ -198,6 +198,7 @@ std::vector<RenderJob> make_jobs(const RenderCommandOptions& o, bool check_paths
     request.ic_rays = o.ic_rays;
     request.ic_error = o.ic_error;
     if (o.ic_no_gradients) request.ic_gradients = false;
+    request.ic_records = !o.ic_records.empty();
     request.pbgi_surfels = o.pbgi_surfels;
     request.pbgi_cutoff = o.pbgi_cutoff;
     request.pbgi_bounces = o.pbgi_bounces;
@@ -287,10 +288,7 @@ std::vector<RenderJob> make_jobs(const RenderCommandOptions& o, bool check_paths
                 add_checkpoint_output(paths, checkpoints[j], resumes[j]);
             }
         }
-        // (The options of other estimators are refused by RenderJob; --ic-records is the command line's.)
-        const std::string& algorithm = jobs[j].integrator_info().name;
-        if (!o.ic_records.empty() && algorithm != "ic")
-            throw UsageError(fmt::format("--ic-rays, --ic-error, --ic-no-gradients and --ic-records are ic's, not {}'s", algorithm));
+        // (The options of other estimators, --ic-records too, are refused by RenderJob.)
         if (!o.ic_records.empty()) {
             const std::string p = jobs[j].expand(o.ic_records);
             paths.output(p, "--ic-records", /*image=*/true);

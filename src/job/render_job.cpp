@@ -133,7 +133,7 @@ static std::string option_refusal(const IntegratorInfo& info, const JobRequest& 
     if (!r.vcm_merging && !r.vcm_connections) return "--no-merging and --no-connections together leave vcm no strategy";
     if ((!r.vcm_merging || !r.vcm_connections) && a != "vcm")
         return fmt::format("--no-merging and --no-connections switch off vcm's strategies, not {}'s", a);
-    if ((r.ic_rays || r.ic_error || r.ic_gradients) && a != "ic")
+    if ((r.ic_rays || r.ic_error || r.ic_gradients || r.ic_records) && a != "ic")
         return fmt::format("--ic-rays, --ic-error, --ic-no-gradients and --ic-records are ic's, not {}'s", a);
     if ((r.pbgi_surfels || r.pbgi_cutoff || r.pbgi_bounces || r.pbgi_resolution || r.pbgi_direct_samples || r.pbgi_spacing) && a != "pbgi")
         return fmt::format(

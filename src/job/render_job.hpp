@@ -53,6 +53,7 @@ struct JobRequest {
     std::optional<int> ic_rays;           // --ic-rays (ic)
     std::optional<float> ic_error;        // --ic-error (ic)
     std::optional<bool> ic_gradients;     // false: --ic-no-gradients (ic)
+    bool ic_records = false;              // --ic-records given (ic; the command line writes the image)
     std::optional<int> pbgi_surfels;          // --pbgi-surfels (pbgi)
     std::optional<float> pbgi_cutoff;         // --pbgi-cutoff (pbgi)
     std::optional<int> pbgi_bounces;          // --pbgi-bounces (pbgi)

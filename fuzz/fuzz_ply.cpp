@@ -1,0 +1,28 @@
+// libFuzzer target for the PLY mesh reader (load_ply_mesh: pathlab's walk of the header and body,
+// then Assimp): any input must load or fail with a MeshLoadError; a loaded mesh must be usable
+// (indices within its vertices, finite positions). Assimp reads files: each input is written to a
+// file of this process first. Built and run by scripts/fuzz.sh ply.
+#include <unistd.h>
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <fstream>
+#include <string>
+
+#include "geometry/mesh_files.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+    static const std::string path = "/tmp/pathlab-fuzz-ply-" + std::to_string(getpid()) + ".ply";
+    std::ofstream(path, std::ios::binary | std::ios::trunc).write(reinterpret_cast<const char*>(data), std::streamsize(size));
+    try {
+        const pathlab::MeshDesc m = pathlab::load_ply_mesh(path);
+        for (const auto& t : m.triangles)
+            for (const uint32_t i : t)
+                if (i >= m.positions.size()) __builtin_trap();
+        for (const pathlab::Vec3f& p : m.positions)
+            if (!pathlab::is_finite(p)) __builtin_trap();
+    } catch (const pathlab::MeshLoadError&) {
+    }
+    return 0;
+}

@@ -29,6 +29,7 @@
 
 #include "app/interrupt.hpp"
 #include "cli_runner.hpp"
+#include "geometry/mesh_files.hpp"
 #include "geometry/shape_meshes.hpp"
 #include "hostile_runner.hpp"
 #include "image/image_io.hpp"
@@ -101,6 +102,8 @@ void read_file_as_its_kind(const std::string& file) {
         (void)read_jpeg8(file);
     } else if (fs::path(file).extension() == ".obj") {
         (void)load_obj_mesh(file);
+    } else if (fs::path(file).extension() == ".serialized") {
+        (void)load_serialized_mesh(file, 0);
     } else {
         (void)read_image(file);
     }
@@ -144,6 +147,7 @@ TEST_F(Hostile, RegressionCorporaFailCleanlyInBoundedTimeAndMemory) {
         {"segment-past-end.jpg", "cannot read JPEG: truncated: the file ends inside a segment of 65535 bytes"},
         {"exponent-int-overflow.obj", "a number with an exponent of 10 digits"},
         {"index-out-of-range.obj", "line 4: index '99999999999' is out of range"},
+        {"fuzz-serialized-offset-overflow.serialized", "shape 0's offset 18446744073709551615 is outside the file"},
     };
     int files = 0, checked = 0;
     for (const char* dir : {"tests/data/image_regressions", "tests/data/obj_regressions"}) {

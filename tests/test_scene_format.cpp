@@ -567,6 +567,11 @@ TEST(SceneFileMeshes, HostilePlyHeadersAreRefusedWithTheirProblem) {
     refused("ascii-short.ply", ascii + "5 0 1 2\n", "the file ends inside element 'face' (item 1 of 1), in its list 'vertex_indices' of 5 values");
     refused("ascii-count.ply", ascii + "3.5 0 1 2\n", "its list 'vertex_indices' has the count '3.5', not a count");
     refused("ascii-negative.ply", ascii + "-3 0 1 2\n", "has the count '-3', not a count");
+    // ASCII values that are no numbers (Assimp read "-1" and control characters as -1 and leaked
+    // its parser's state: the fuzzer's finding), in a vertex and in a list.
+    refused("ascii-value.ply", "ply\nformat ascii 1.0\n" + vertex + faces + "0 0 0\n1 0 0\n-1\x12\x12 1 0\n3 0 1 2\n",
+            "element 'vertex' (item 3 of 3): its property 'x' is '-1\\x12\\x12', not a number");
+    refused("ascii-index.ply", ascii + "3 0 one 2\n", "element 'face' (item 1 of 1): its property 'vertex_indices' is 'one', not a number");
     const auto binary = [&](const std::string& count_type, const std::string& count) {
         std::string b = "ply\nformat binary_little_endian 1.0\n" + vertex + "element face 1\nproperty list " + count_type +
                         " int vertex_indices\nend_header\n";

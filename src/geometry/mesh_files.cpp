@@ -6,6 +6,7 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <charconv>
 #include <cctype>
 #include <cstring>
 #include <filesystem>
@@ -206,6 +207,18 @@ void check_ply_file(const std::string& path) {
     // The body, as the header describes it.
     PlyBody reader(in, body);
     std::string word;
+    // An ASCII value must be a number (Assimp read "-1" followed by control characters as a
+    // number and leaked its parser's state): a decimal or nan / inf, shown escaped when not.
+    const auto ascii_value = [&](const PlyElement& e, uint64_t i, const PlyProperty& p) {
+        const char* first = word.data() + (word.starts_with('+') ? 1 : 0);
+        double v;
+        const auto [end, ec] = std::from_chars(first, word.data() + word.size(), v);
+        if (ec == std::errc() && end == word.data() + word.size() && first != end) return;
+        std::string shown;
+        for (const unsigned char c : word) shown += std::isprint(c) ? std::string(1, char(c)) : fmt::format("\\x{:02x}", c);
+        throw MeshLoadError(fmt::format("mesh '{}': element '{}' (item {} of {}): its property '{}' is '{}', not a number", path, e.name,
+                                        i + 1, e.count, p.name, shown));
+    };
     for (const PlyElement& e : elements) {
         const bool lists = std::any_of(e.properties.begin(), e.properties.end(), [](const PlyProperty& p) { return p.count_size > 0; });
         if (binary && !lists) {  // fixed-size items, skipped at once
@@ -222,6 +235,7 @@ void check_ply_file(const std::string& path) {
                 };
                 if (p.count_size == 0) {  // one value
                     if (binary ? !reader.skip(p.size) : !reader.word(word)) throw ends("");
+                    if (!binary) ascii_value(e, i, p);
                     continue;
                 }
                 int64_t n = 0;
@@ -245,9 +259,11 @@ void check_ply_file(const std::string& path) {
                     throw MeshLoadError(fmt::format("mesh '{}': element '{}' (item {} of {}): its list '{}' claims {} values, more than the "
                                                     "file holds after it ({} bytes)",
                                                     path, e.name, i + 1, e.count, p.name, n, reader.left()));
-                for (int64_t k = 0; k < n; ++k)
+                for (int64_t k = 0; k < n; ++k) {
                     if (binary ? !reader.skip(p.size) : !reader.word(word))
                         throw ends(fmt::format(", in its list '{}' of {} values", p.name, n));
+                    if (!binary) ascii_value(e, i, p);
+                }
             }
     }
 }
@@ -366,7 +382,7 @@ MeshDesc load_serialized_mesh(const std::string& path, int shape_index) {
     };
     const uint64_t begin = offset_of(uint32_t(shape_index));
     const uint64_t end = uint32_t(shape_index) + 1 < count ? offset_of(uint32_t(shape_index) + 1) : table;
-    if (begin + 4 > end || end > table) throw bad(fmt::format("shape {}'s offset {} is outside the file", shape_index, begin));
+    if (begin > end || end - begin < 4 || end > table) throw bad(fmt::format("shape {}'s offset {} is outside the file", shape_index, begin));
     uint16_t shape_magic, shape_version;
     std::memcpy(&shape_magic, data + begin, 2);
     std::memcpy(&shape_version, data + begin + 2, 2);

@@ -201,6 +201,22 @@ std::vector<BsdfCase> sampling_cases() {
     both_lobes("principled_glass_" + tag(0.16f, 45), principled(0.4f, 0.1f, 0.7f, 0.5f, 0), 45, 0.16f);
     both_lobes("principled_glass_inside_" + tag(0.16f, 30), principled(0.4f, 0.1f, 0.7f, 0, 0.5f), 30, 0.16f, true);
     both_lobes("principled_glass_inside_" + tag(0.16f, 60), principled(0.4f, 0.1f, 0.7f, 0, 0), 60, 0.16f, true);
+    // principledthin: every lobe (specular and diffuse reflection and transmission, sheen, tint),
+    // anisotropic, from behind, nearly smooth, and at an index whose transmission roughness
+    // (0.65 eta - 0.35) r is below the reflection's.
+    const auto thin = [](float roughness, float spec_trans, float diff_trans, float anisotropic, float eta) {
+        return [=] {
+            PrincipledThinMaterial p;
+            p.base_color = Rgb(0.6f, 0.4f, 0.3f);
+            p.roughness = roughness, p.spec_trans = spec_trans, p.diff_trans = diff_trans, p.anisotropic = anisotropic, p.eta = eta;
+            p.sheen = 0.5f, p.spec_tint = 0.3f, p.flatness = 0.2f;
+            return Material{p, true};
+        };
+    };
+    both_lobes("principledthin_" + tag(0.16f, 45), thin(0.4f, 0.6f, 0.8f, 0, 1.5f), 45, 0.16f);
+    both_lobes("principledthin_aniso_" + tag(0.09f, 30), thin(0.3f, 0.8f, 0.4f, 0.6f, 1.33f), 30, 0.05f);
+    both_lobes("principledthin_behind_" + tag(0.16f, 60), thin(0.4f, 0.5f, 1.2f, 0, 1.5f), 60, 0.16f, true);
+    both_lobes("principledthin_smooth_" + tag(0.01f, 20), thin(0.1f, 0.9f, 0.2f, 0, 1.2f), 20, 0.01f);
     return out;
 }
 
@@ -218,7 +234,9 @@ TEST_P(BsdfSampling, MatchesItsPdfAndEval) {
     // normal's other side beyond the critical angle).
     Vec3f axis(-wi.x, -wi.y, wi.z);
     const auto wrong_side = [&](const Vec3f& wo) { return c.side != 0 && (wo.z * wi.z > 0) != (c.side > 0); };
-    if (c.side < 0) {
+    if (c.side < 0 && std::holds_alternative<PrincipledThinMaterial>(m.model)) {
+        axis = Vec3f(-wi.x, -wi.y, -wi.z);  // a thin sheet lets the mirrored direction through, unbent
+    } else if (c.side < 0) {
         const auto* d = std::get_if<RoughDielectricMaterial>(&m.model);
         const auto* p = std::get_if<PrincipledMaterial>(&m.model);
         const float ext = d ? d->ext_ior : 1.0f, in = d ? d->int_ior : p->eta;

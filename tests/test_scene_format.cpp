@@ -216,7 +216,6 @@ TEST(SceneFileStructure, RefusalsNameTheMissingFeature) {
         std::string body, message;
     };
     const std::vector<Case> cases = {
-        {"<shape type=\"cube\"><bsdf type=\"principledthin\"/></shape>", "not its thin-sheet variant"},
         {"<sensor type=\"perspective\"><film type=\"hdrfilm\"><rfilter type=\"sinc\"/></film></sensor>",
          "unsupported rfilter type 'sinc'; supported: box, tent, gaussian, mitchell, catmullrom, lanczos"},
         {"<sensor type=\"perspective\"><film type=\"hdrfilm\"><string name=\"pixel_format\" value=\"xyz\"/></film></sensor>",

@@ -66,6 +66,13 @@ std::vector<Case> cases() {
              p.roughness = 0.4f, p.metallic = 0.3f, p.spec_trans = 0.4f, p.transmits = true, p.sheen = 0.5f, p.clearcoat = 0.6f;
              return Material{p, false};
          }},
+        {"principledthin",  // without the tints, as principled
+         [](const ColourLanes& L) {
+             PrincipledThinMaterial p;
+             p.base_color = L({0.3f, 0.6f, 0.2f});
+             p.roughness = 0.35f, p.spec_trans = 0.5f, p.diff_trans = 0.7f, p.sheen = 0.4f, p.eta = 1.3f;
+             return Material{p, true};
+         }},
         {"blendbsdf",
          [](const ColourLanes& L) {
              Material m{BlendMaterial{std::make_shared<const Material>(make_phong(L({0.7f, 0.2f, 0.2f}))),

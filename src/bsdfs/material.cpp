@@ -41,11 +41,13 @@ void Material::prepare() {
     if (d && textures)
         for (const TextureBinding& b : textures->bindings)
             anisotropic = anisotropic || b.slot == MicrofacetDistribution::kSlotAlphaU || b.slot == MicrofacetDistribution::kSlotAlphaV;
-    if (const auto* p = std::get_if<PrincipledMaterial>(&model)) {
-        anisotropic = p->anisotropic > 0;
+    const auto disney = [&](float a, int slot) {
+        anisotropic = a > 0;
         if (textures)
-            for (const TextureBinding& b : textures->bindings) anisotropic = anisotropic || b.slot == PrincipledMaterial::kSlotAnisotropic;
-    }
+            for (const TextureBinding& b : textures->bindings) anisotropic = anisotropic || b.slot == slot;
+    };
+    if (const auto* p = std::get_if<PrincipledMaterial>(&model)) disney(p->anisotropic, PrincipledMaterial::kSlotAnisotropic);
+    if (const auto* p = std::get_if<PrincipledThinMaterial>(&model)) disney(p->anisotropic, PrincipledThinMaterial::kSlotAnisotropic);
     tangent_frame = anisotropic || perturbed();
     // blendbsdf and mask vary where their nested materials do, and take their tangent frames.
     const auto nested = [&](const Material& inner) {

@@ -33,6 +33,7 @@
 #include "bsdfs/phong.hpp"
 #include "bsdfs/plastic.hpp"
 #include "bsdfs/principled.hpp"
+#include "bsdfs/principledthin.hpp"
 #include "bsdfs/roughconductor.hpp"
 #include "bsdfs/roughdielectric.hpp"
 #include "bsdfs/roughplastic.hpp"
@@ -83,13 +84,13 @@ struct MaskMaterial {
 // One BSDF per header (parameters and defaults documented at the top of each).
 using MaterialModel = std::variant<PhongMaterial, ConductorMaterial, DielectricMaterial, RoughConductorMaterial,
                                    RoughDielectricMaterial, PlasticMaterial, RoughPlasticMaterial, ThinDielectricMaterial,
-                                   BlendMaterial, MaskMaterial, PrincipledMaterial>;
+                                   BlendMaterial, MaskMaterial, PrincipledMaterial, PrincipledThinMaterial>;
 
 // std::visit, as a switch that the compiler always inlines: the hot loop calls sample() at
 // several places, and an out-of-line dispatch there cost about 3% of pt-mis's time.
 template <typename F>
 [[gnu::always_inline]] inline decltype(auto) visit_model(const MaterialModel& model, F&& f) {
-    static_assert(std::variant_size_v<MaterialModel> == 11, "add the new model's case below");
+    static_assert(std::variant_size_v<MaterialModel> == 12, "add the new model's case below");
     switch (model.index()) {
         case 0: return f(*std::get_if<0>(&model));
         case 1: return f(*std::get_if<1>(&model));
@@ -101,7 +102,8 @@ template <typename F>
         case 7: return f(*std::get_if<7>(&model));
         case 8: return f(*std::get_if<8>(&model));
         case 9: return f(*std::get_if<9>(&model));
-        default: return f(*std::get_if<10>(&model));
+        case 10: return f(*std::get_if<10>(&model));
+        default: return f(*std::get_if<11>(&model));
     }
 }
 
@@ -222,6 +224,15 @@ struct Material {
         if (const auto* p = std::get_if<PrincipledMaterial>(&model)) return p->transmits;
         return std::holds_alternative<DielectricMaterial>(model) || std::holds_alternative<RoughDielectricMaterial>(model);
     }
+    // True where light from behind the surface may reach the other side through a lobe light
+    // sampling can see: rough glass, and thin sheets (two-sided, no inside), also within a blend
+    // or mask. Next-event estimation skips lights behind other surfaces.
+    bool transmits() const {
+        if (std::holds_alternative<PrincipledThinMaterial>(model)) return true;
+        if (std::holds_alternative<BlendMaterial>(model) || std::holds_alternative<MaskMaterial>(model))
+            return (lobes() & kLobeTransmission) != 0;
+        return is_dielectric();
+    }
 
     // The context's adjustments (material.cpp: out of line, so that the hot path's visit of the
     // model stays the only one in the integrators' code and is inlined there).
@@ -256,6 +267,9 @@ private:
     static uint32_t lobes_of(const PrincipledMaterial& m) {
         return kLobeDiffuse | kLobeGlossy | kLobeReflection | (m.transmits ? kLobeTransmission : 0u);
     }
+    static uint32_t lobes_of(const PrincipledThinMaterial& m) {
+        return kLobeDiffuse | kLobeReflection | (m.spec_trans > 0 ? kLobeGlossy : 0u) | (m.spec_trans > 0 || m.diff_trans > 0 ? kLobeTransmission : 0u);
+    }
 };
 
 // The diffuse reflectance (Mitsuba's aov "albedo"): Lambertian and Phong's rho_d, a coated
@@ -265,6 +279,7 @@ inline Rgb diffuse_albedo(const Material& m) {
     if (const auto* p = std::get_if<PlasticMaterial>(&m.model)) return p->coat.diffuse_reflectance;
     if (const auto* p = std::get_if<RoughPlasticMaterial>(&m.model)) return p->coat.diffuse_reflectance;
     if (const auto* p = std::get_if<PrincipledMaterial>(&m.model)) return p->base_color;  // as Mitsuba's eval_diffuse_reflectance
+    if (const auto* p = std::get_if<PrincipledThinMaterial>(&m.model)) return p->base_color;
     if (const auto* b = std::get_if<BlendMaterial>(&m.model))
         return diffuse_albedo(*b->first) * (1 - b->weight) + diffuse_albedo(*b->second) * b->weight;
     if (const auto* k = std::get_if<MaskMaterial>(&m.model)) return diffuse_albedo(*k->inner) * k->opacity;

@@ -56,6 +56,47 @@
 
 namespace pathlab {
 
+// Pieces principled and principledthin share (Mitsuba's principledhelpers.h).
+namespace disney {
+
+// Schlick's weight (1 - cos)^5, clamped as Mitsuba's schlick_weight.
+inline float schlick_weight(float cos) {
+    const float m = std::clamp(1 - cos, 0.0f, 1.0f);
+    return m * m * m * m * m;
+}
+// The weight w of Schlick(R0) = R0 (1 - w) + w at the microfacet cosine cos (> 0) on the front
+// side of a surface of relative index eta: from the cosine of the refracted direction where
+// eta < 1 (calc_schlick).
+inline float schlick_weight_front(float cos, float eta) {
+    if (eta > 1) return schlick_weight(cos);
+    const float cos_t2 = 1 - (1 - cos * cos) * (eta * eta);
+    return schlick_weight(std::sqrt(std::max(0.0f, cos_t2)));
+}
+// Schlick's R0 of the relative index eta.
+inline float schlick_r0(float eta) { return (eta - 1) * (eta - 1) / ((eta + 1) * (eta + 1)); }
+// GGX of the roughness r and anisotropy a: alpha_u = max(0.001, r^2 / s), alpha_v = max(0.001,
+// r^2 s), s = sqrt(1 - 0.9 a) (calc_dist_params).
+inline MicrofacetDistribution specular_distribution(float roughness, float anisotropic) {
+    const float r2 = roughness * roughness, aspect = std::sqrt(1 - 0.9f * anisotropic);
+    return MicrofacetDistribution(MicrofacetType::GGX, std::max(0.001f, r2 / aspect), std::max(0.001f, r2 * aspect));
+}
+// The diffuse lobe's shape, times c / pi: Burley's (1 - Fi/2)(1 - Fo/2) with retro-reflection,
+// lerped towards Hanrahan-Krueger's flattened shape by `flatness` (cos_i, cos_o > 0; cos_d =
+// wo.h).
+inline float diffuse_shape(float cos_i, float cos_o, float cos_d, float roughness, float flatness) {
+    const float Fo = schlick_weight(cos_o), Fi = schlick_weight(cos_i);
+    const float Rr = 2 * roughness * cos_d * cos_d;
+    float shape = (1 - 0.5f * Fi) * (1 - 0.5f * Fo) + Rr * (Fo + Fi + Fo * Fi * (Rr - 1));
+    if (flatness > 0) {  // Hanrahan-Krueger's fake subsurface, as Burley's
+        const float Fss90 = Rr / 2, Fss = (1 + (Fss90 - 1) * Fo) * (1 + (Fss90 - 1) * Fi);
+        const float f_ss = 1.25f * (Fss * (1 / (cos_o + cos_i) - 0.5f) + 0.5f);
+        shape += (f_ss - shape) * flatness;
+    }
+    return shape;
+}
+
+}  // namespace disney
+
 struct PrincipledMaterial {
     Rgb base_color{0.5f};
     float roughness = 0.5f, anisotropic = 0, metallic = 0, spec_trans = 0, spec_tint = 0, sheen = 0, sheen_tint = 0,
@@ -88,10 +129,7 @@ struct PrincipledMaterial {
         }
     };
 
-    MicrofacetDistribution specular_distribution() const {
-        const float r2 = roughness * roughness, aspect = std::sqrt(1 - 0.9f * anisotropic);
-        return MicrofacetDistribution(MicrofacetType::GGX, std::max(0.001f, r2 / aspect), std::max(0.001f, r2 * aspect));
-    }
+    MicrofacetDistribution specular_distribution() const { return disney::specular_distribution(roughness, anisotropic); }
     // The selection probabilities of the lobes for wi (cos_i = |wi.z|, front: wi.z > 0).
     struct LobeChoice {
         float specular = 0, transmission = 0, clearcoat = 0, diffuse = 0;
@@ -137,19 +175,7 @@ struct PrincipledMaterial {
     std::optional<BsdfSample> sample(const Vec3f& wi_in, Vec2f u) const;
 
 private:
-    // Schlick's weight (1 - cos)^5, clamped as Mitsuba's schlick_weight.
-    static float schlick_weight(float cos) {
-        const float m = std::clamp(1 - cos, 0.0f, 1.0f);
-        return m * m * m * m * m;
-    }
-    // The weight w of Schlick(R0) = R0 (1 - w) + w at the microfacet cosine cos (> 0) on the
-    // front side: from the cosine of the refracted direction where eta < 1 (principledhelpers.h,
-    // calc_schlick).
-    float schlick_weight_front(float cos) const {
-        if (eta > 1) return schlick_weight(cos);
-        const float cos_t2 = 1 - (1 - cos * cos) * (eta * eta);
-        return schlick_weight(std::sqrt(std::max(0.0f, cos_t2)));
-    }
+    float schlick_weight_front(float cos) const { return disney::schlick_weight_front(cos, eta); }
     // GTR1 (the clearcoat's normal distribution) and its Smith masking with alpha 0.25.
     static float gtr1(float cos_h, float alpha) {
         const float a2 = alpha * alpha;
@@ -188,7 +214,7 @@ inline PrincipledMaterial::Terms PrincipledMaterial::terms(const Vec3f& wi_in, c
             const float D = dist.D(h), G = dist.G2(wi, wo), F_d = fresnel_dielectric(ci, e);
             const float k = D * G / (4 * wi.z * wo.z);
             if (front) {
-                const float w = schlick_weight_front(ci), R0 = (eta - 1) * (eta - 1) / ((eta + 1) * (eta + 1));
+                const float w = schlick_weight_front(ci), R0 = disney::schlick_r0(eta);
                 t.a += k * ((1 - metallic) * (1 - spec_tint) * F_d + metallic * w + (1 - metallic) * spec_tint * w);
                 t.b += k * metallic * (1 - w);
                 add_tint(k * (1 - metallic) * spec_tint * (1 - w) * R0);
@@ -205,17 +231,10 @@ inline PrincipledMaterial::Terms PrincipledMaterial::terms(const Vec3f& wi_in, c
             }
         }
         if (front && brdf > 0) {
-            const float Fo = schlick_weight(wo.z), Fi = schlick_weight(wi.z);
-            const float cos_d = dot(h, wo), Rr = 2 * roughness * cos_d * cos_d;
-            float shape = (1 - 0.5f * Fi) * (1 - 0.5f * Fo) + Rr * (Fo + Fi + Fo * Fi * (Rr - 1));
-            if (flatness > 0) {  // Hanrahan-Krueger's fake subsurface, as Burley's
-                const float Fss90 = Rr / 2, Fss = (1 + (Fss90 - 1) * Fo) * (1 + (Fss90 - 1) * Fi);
-                const float f_ss = 1.25f * (Fss * (1 / (wo.z + wi.z) - 0.5f) + 0.5f);
-                shape += (f_ss - shape) * flatness;
-            }
-            t.b += brdf * kInvPi * shape;
+            const float cos_d = dot(h, wo);
+            t.b += brdf * kInvPi * disney::diffuse_shape(wi.z, wo.z, cos_d, roughness, flatness);
             if (sheen > 0 && metallic < 1) {
-                const float s = sheen * (1 - metallic) * schlick_weight(std::abs(cos_d));
+                const float s = sheen * (1 - metallic) * disney::schlick_weight(std::abs(cos_d));
                 t.a += s * (1 - sheen_tint);
                 add_tint(s * sheen_tint);
             }

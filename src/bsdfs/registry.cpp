@@ -49,6 +49,7 @@ const std::vector<BsdfPlugin>& bsdf_plugins() {
         {plastic_plugin, one_sided<PlasticMaterial, read_plastic>},
         {roughplastic_plugin, one_sided<RoughPlasticMaterial, read_roughplastic>},
         {principled_plugin, one_sided<PrincipledMaterial, read_principled>},
+        {principledthin_plugin, [](Properties& p) { return Material{read_principledthin(p), true}; }},  // (the same from both sides)
         {thindielectric_plugin, [](Properties& p) { return Material{read_thindielectric(p), true}; }},
         {twosided_plugin, nullptr},
         {blendbsdf_plugin, nullptr},

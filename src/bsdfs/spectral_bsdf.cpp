@@ -12,6 +12,7 @@ namespace pathlab {
 
 const char* spectral_material_names() {
     return "diffuse, phong, conductor, roughconductor, dielectric, roughdielectric, thindielectric, plastic, roughplastic, principled, "
+           "principledthin, "
            "blendbsdf (at most one of its two with Dirac lobes), mask (of a non-dispersive material)";
 }
 
@@ -150,6 +151,11 @@ Spectrum4 model_value(const MaterialModel& model, const MaterialSpectra* spectra
     }
     if (const auto* p = std::get_if<PrincipledMaterial>(&model)) {
         // a + b c + c_sqrt sqrt(c) with the base colour c at the wavelengths, as principled.hpp.
+        float unused;
+        const Spectrum4 c = reflectance(p->base_color, nullptr, wl);
+        return p->terms(wi, wo, unused).value(c, sqrt(c));
+    }
+    if (const auto* p = std::get_if<PrincipledThinMaterial>(&model)) {  // a + b c
         float unused;
         const Spectrum4 c = reflectance(p->base_color, nullptr, wl);
         return p->terms(wi, wo, unused).value(c, sqrt(c));

@@ -72,7 +72,7 @@ public:
             if (choice.index >= 0) {
                 const Light& light = scene_.lights()[size_t(choice.index)];
                 const auto ls = sample_light(light, sp.p, u);
-                if (ls && !is_black(ls->Le) && !(dot(ls->wi, sp.ng) <= 0 && !sp.material->is_dielectric())) {
+                if (ls && !is_black(ls->Le) && !(dot(ls->wi, sp.ng) <= 0 && !sp.material->transmits())) {
                     const Vec3f wo = sp.frame.to_local(ls->wi);
                     float pdf_bsdf;
                     const Rgb f = sp.material->eval_and_pdf(sp, sp.wi, wo, pdf_bsdf);

@@ -190,6 +190,10 @@ struct IntegratorInfo {
     // Chooses a light at each shading point for next-event estimation, so --light-sampler applies
     // (light paths start on a light chosen by power, whatever it says).
     bool samples_lights = false;
+    // Traces light paths that scatter with the adjoint BSDF f(wo, wi) (light tracing, bdpt, the
+    // photon methods, vcm): a BSDF that is not reciprocal (principledthin's specular transmission,
+    // as Mitsuba defines it) would make them converge to another image, so RenderJob refuses it.
+    bool light_paths = false;
 
     PluginInfo plugin() const;
 };

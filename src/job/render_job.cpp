@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <cstdlib>
 #include <optional>
 
@@ -85,6 +86,22 @@ void apply_environment_caps(RenderSettings& s, const SceneDescription& d) {
 
 }  // namespace
 
+// The first material of the scene whose BSDF is not reciprocal ("" for none): a principledthin
+// with specular transmission (principledthin.hpp), also inside a blend or mask.
+std::string non_reciprocal_material(const SceneDescription& d) {
+    const std::function<bool(const Material&)> non_reciprocal = [&](const Material& m) {
+        if (const auto* t = std::get_if<PrincipledThinMaterial>(&m.model)) return t->spec_trans > 0;
+        if (const auto* b = std::get_if<BlendMaterial>(&m.model)) return non_reciprocal(*b->first) || non_reciprocal(*b->second);
+        if (const auto* k = std::get_if<MaskMaterial>(&m.model)) return non_reciprocal(*k->inner);
+        return false;
+    };
+    for (size_t i = 0; i < d.materials.size(); ++i)
+        if (non_reciprocal(d.materials[i]))
+            return i < d.material_ids.size() && !d.material_ids[i].empty() ? fmt::format("principledthin '{}'", d.material_ids[i])
+                                                                             : std::string("principledthin");
+    return "";
+}
+
 std::string integrator_refusal(const IntegratorInfo& info, const SceneDescription& d, const JobRequest& r) {
     if (r.light_sampler && !info.samples_lights)
         return fmt::format("{} does not choose lights at its shading points (its light paths start on a light chosen "
@@ -99,6 +116,13 @@ std::string integrator_refusal(const IntegratorInfo& info, const SceneDescriptio
             return fmt::format("{0} does not render participating media, and this scene has the {1}: {0} would render "
                                "the scene as if the medium were not there. The integrators that render media: {2}",
                                info.name, medium, media_integrator_names());
+    if (info.light_paths)
+        if (const std::string m = non_reciprocal_material(d); !m.empty())
+            return fmt::format("{} scatters light paths with the adjoint BSDF, and this scene's {} has specular transmission, "
+                               "which Mitsuba's principledthin defines without reciprocity (f(wi, wo) != f(wo, wi)): {} would "
+                               "converge to another image. Render it with a camera-side integrator (path, pt-mis3, pt-naive, "
+                               "volpath, direct, ic, pbgi)",
+                               info.name, m, info.name);
     if (!info.any_camera && d.camera.kind != CameraKind::Perspective)
         return fmt::format("{} cannot render through a {} sensor: it connects light paths to a pinhole camera (or sizes "
                            "its radii by the pinhole's pixels); use a camera-side integrator (path, direct, pt-naive, "

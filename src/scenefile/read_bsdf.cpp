@@ -198,9 +198,6 @@ Material read_bsdf_at(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b, 
     }
     xml.check_attributes(n, {"type", "id", "name"});
     const std::string type = xml.attr(n, "type");
-    if (type == "principledthin")
-        xml.fail(n, "unsupported bsdf type 'principledthin': pathlab has principled but not its thin-sheet variant (diff_trans, "
-                    "a sheet's diffuse and specular transmission); use principled with spec_trans on a closed shape, or thindielectric");
     const BsdfPlugin* plugin = find_bsdf_plugin(type);
     if (type == null_bsdf_plugin().type) xml.fail(n, "a null BSDF is a shape's own BSDF (nested in it, or declared with an id); nothing wraps it");
     if (!plugin) xml.fail(n, fmt::format("unsupported bsdf type '{}'; supported: {}", type, bsdf_type_names()));

@@ -530,6 +530,7 @@ const IntegratorInfo& bdpt_integrator() {
                          false, true, path_params(), [](const IntegratorOptions& o) { return make_for_transport<Bdpt>(o); },
                          /*any_camera=*/false};
         i.media = true;
+        i.light_paths = true;
         return i;
     }();
     return info;

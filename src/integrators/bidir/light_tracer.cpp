@@ -202,6 +202,7 @@ const IntegratorInfo& light_tracer_integrator() {
                          false, false, path_params(), [](const IntegratorOptions& o) { return make_for_transport<LightTracer>(o); },
                          /*any_camera=*/false};
         i.media = true;
+        i.light_paths = true;
         return i;
     }();
     return info;

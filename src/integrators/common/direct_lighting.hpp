@@ -23,7 +23,7 @@ namespace pathlab {
 // RIS's target at a surface (light_resampling.hpp): the luminance of the unshadowed
 // contribution f * Le * |cos theta| of a candidate light sample; 0 behind an opaque surface.
 inline float surface_target(const ShadingPoint& sp, const LightSample& c) {
-    if (dot(c.wi, sp.ng) <= 0 && !sp.material->is_dielectric()) return 0.0f;
+    if (dot(c.wi, sp.ng) <= 0 && !sp.material->transmits()) return 0.0f;
     const Vec3f w = sp.frame.to_local(c.wi);
     float pdf;
     return luminance(sp.material->eval_and_pdf(sp, sp.wi, w, pdf)) * luminance(c.Le) * std::abs(w.z);
@@ -41,13 +41,14 @@ template <class Wl>
 ColourAt<Wl> estimate_light_sample(const Scene& scene, const ShadingPoint& sp, Sampler& sampler, bool mis, Wl& wl, bool power = false) {
     using Colour = ColourAt<Wl>;
     const bool dispersive = changes_wavelengths(*sp.material, wl);
-    const bool transmits = sp.material->is_dielectric();
+    const bool transmits = sp.material->transmits();
     const auto nee = sample_nee(scene, sp.p, sp.frame.n, sampler, nee_candidates(scene, &sp, wl),
                                 [&](const LightSample& c, int) { return surface_target(sp, c); });
     if (!nee) return Colour(0.0f);
     const LightChoice choice = nee->choice;
     const LightSample* ls = &nee->ls;
-    // Lights behind the surface reach it only through a transmitting material (rough glass).
+    // Lights behind the surface reach it only through a transmitting material (rough glass, a
+    // thin sheet).
     if (dot(ls->wi, sp.ng) <= 0 && !transmits) return Colour(0.0f);
     const Vec3f wo = sp.frame.to_local(ls->wi);
     // The BSDF in RGB first (a shadow ray is traced only where it is not black), its colour once

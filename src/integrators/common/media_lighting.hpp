@@ -39,7 +39,7 @@ ColourOf<T> estimate_light(const Scene& scene, const ScatterVertex& v, Sampler& 
     int32_t medium = v.medium;
     if (v.sp) {
         const ShadingPoint& sp = *v.sp;
-        if (dot(ls->wi, sp.ng) <= 0 && !sp.material->is_dielectric()) return Colour(0.0f);
+        if (dot(ls->wi, sp.ng) <= 0 && !sp.material->transmits()) return Colour(0.0f);
         const Vec3f wo = sp.frame.to_local(ls->wi);
         f = bsdf_eval(sp, wo, wl, pdf_scatter);
         if (is_black(f)) return Colour(0.0f);

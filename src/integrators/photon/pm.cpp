@@ -343,6 +343,7 @@ const IntegratorInfo& pm_integrator() {
                          [](const IntegratorOptions& o) { return make_for_transport<PhotonMapper>(o); }};
         i.media = true;
         i.samples_lights = true;
+        i.light_paths = true;
         return i;
     }();
     return info;

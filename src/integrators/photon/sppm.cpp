@@ -299,6 +299,7 @@ const IntegratorInfo& sppm_integrator() {
                          false, false};
         i.media = true;
         i.samples_lights = true;
+        i.light_paths = true;
         return i;
     }();
     return info;
@@ -312,6 +313,7 @@ const IntegratorInfo& ppm_integrator() {
                          false, false};
         i.media = true;
         i.samples_lights = true;
+        i.light_paths = true;
         return i;
     }();
     return info;

@@ -338,6 +338,7 @@ const IntegratorInfo& vcm_integrator() {
         IntegratorInfo i{"vcm", {}, "vertex connection and merging: bdpt's connections and photon merging, combined by MIS",
                          false, true, vcm_params(), [](const IntegratorOptions& o) { return make_for_transport<Vcm>(o); }, false, true};
         i.media = true;
+        i.light_paths = true;
         return i;
     }();
     return info;
@@ -354,6 +355,7 @@ const IntegratorInfo& bpm_integrator() {
                          },
                          false, true};
         i.media = true;
+        i.light_paths = true;
         return i;
     }();
     return info;

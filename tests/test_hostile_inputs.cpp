@@ -103,7 +103,7 @@ void read_file_as_its_kind(const std::string& file) {
     } else if (fs::path(file).extension() == ".obj") {
         (void)load_obj_mesh(file);
     } else if (fs::path(file).extension() == ".serialized") {
-        (void)load_serialized_mesh(file, 0);
+        (void)load_serialized_mesh(file, file.find("-shape1.") != std::string::npos ? 1 : 0);  // (the shape the name says)
     } else {
         (void)read_image(file);
     }
@@ -148,6 +148,7 @@ TEST_F(Hostile, RegressionCorporaFailCleanlyInBoundedTimeAndMemory) {
         {"exponent-int-overflow.obj", "a number with an exponent of 10 digits"},
         {"index-out-of-range.obj", "line 4: index '99999999999' is out of range"},
         {"fuzz-serialized-offset-overflow.serialized", "shape 0's offset 18446744073709551615 is outside the file"},
+        {"fuzz-serialized-counts-beyond-data-shape1.serialized", "shape 1 claims 8 vertices and 134217740 triangles (1610612976 bytes), more than its 94 compressed bytes hold"},
     };
     int files = 0, checked = 0;
     for (const char* dir : {"tests/data/image_regressions", "tests/data/obj_regressions"}) {

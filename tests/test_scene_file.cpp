@@ -307,7 +307,7 @@ TEST(SceneFileErrors, NameFileLineColumnAndTheProblem) {
         {"<scene version=\"3\"><shape type=\"sphere\"><ref id=\"nope\"/></shape></scene>", 1, 41, "no <bsdf> with id 'nope'"},
         {"<scene version=\"3\"><bsdf type=\"hair\" id=\"p\"/><shape type=\"sphere\"/></scene>", 1, 20,
          "unsupported bsdf type 'hair'; supported: diffuse, phong, conductor, roughconductor, dielectric, "
-         "roughdielectric, plastic, roughplastic, principled, thindielectric, twosided, blendbsdf, mask"},
+         "roughdielectric, plastic, roughplastic, principled, principledthin, thindielectric, twosided, blendbsdf, mask"},
         {"<scene version=\"3\"><shape type=\"sphere\"><float name=\"radius\" value=\"$r\"/></shape></scene>", 1, 41,
          "undefined parameter $r"},
         {"<scene version=\"3\"><shape type=\"obj\"><string name=\"filename\" value=\"missing.obj\"/></shape></scene>", 1, 38,

@@ -404,6 +404,14 @@ MeshDesc load_serialized_mesh(const std::string& path, int shape_index) {
         throw bad(fmt::format("{} vertices and {} triangles", vertices, triangles));
     const bool dbl = (flags & kDoublePrecision) != 0;
     if (dbl == ((flags & kSinglePrecision) != 0)) throw bad("neither (or both) single and double precision flagged");
+    // What the counts need, against what the shape's compressed bytes can hold (deflate expands
+    // at most 1032 times): checked before anything is allocated (a 340-byte file claimed 2^28
+    // triangles, 3 GiB).
+    const uint64_t per_vertex = (3 + (flags & kHasNormals ? 3 : 0) + (flags & kHasUvs ? 2 : 0) + (flags & kHasColors ? 3 : 0)) * (dbl ? 8 : 4);
+    const uint64_t needed = vertices * per_vertex + triangles * 3 * (vertices > 0xffffffffull ? 8 : 4), packed = end - begin - 4;
+    if (needed > 1032 * packed)
+        throw bad(fmt::format("shape {} claims {} vertices and {} triangles ({} bytes), more than its {} compressed bytes hold", shape_index,
+                              vertices, triangles, needed, packed));
     const auto read_floats = [&](size_t n, float* out) {
         if (!dbl) return z.read(out, n * sizeof(float));
         std::vector<double> tmp(n);

@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <string>
 
+#include "fuzz_mesh_checks.hpp"
 #include "geometry/shape_meshes.hpp"
 
 namespace {
@@ -45,11 +46,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     try {
         const pathlab::MeshDesc m = pathlab::load_obj_mesh(path);
         if (!m.normals.empty() && m.normals.size() != m.positions.size()) __builtin_trap();
-        for (const auto& t : m.triangles)
-            for (const uint32_t i : t)
-                if (i >= m.positions.size()) __builtin_trap();
-        for (const pathlab::Vec3f& p : m.positions)
-            if (!pathlab::is_finite(p)) __builtin_trap();
+        check_usable_mesh(m);
     } catch (const pathlab::MeshLoadError&) {
     }
     return 0;

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <string>
 
+#include "fuzz_mesh_checks.hpp"
 #include "geometry/mesh_files.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
@@ -17,11 +18,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     for (const int shape : {0, 1}) {
         try {
             const pathlab::MeshDesc m = pathlab::load_serialized_mesh(path, shape);
-            for (const auto& t : m.triangles)
-                for (const uint32_t i : t)
-                    if (i >= m.positions.size()) __builtin_trap();
-            for (const pathlab::Vec3f& p : m.positions)
-                if (!pathlab::is_finite(p)) __builtin_trap();
+            check_usable_mesh(m);
         } catch (const pathlab::MeshLoadError&) {
         }
     }

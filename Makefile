@@ -31,7 +31,7 @@ test: build
 # per sample against the constant environment, spot and IES: 2 minutes), the light samplers
 # (uniform, power and the light BVH at equal time on the many-light scenes and the course scenes: 6 minutes), volpath (volumes: throughput, MIS at equal time, optical thickness),
 # textures (textured against constant materials per sample, texture lookups: 2 minutes) and differentiable rendering (a gradient against a
-# primal render, memory vs spp and depth: 1 minute).
+# primal render, memory vs spp and depth: 1 minute) and streaming to a viewer (--display-server's cost: 1.5 minutes).
 bench: build
 	$(BUILD)/bench/pathlab_bench perf --json out/bench/performance.json
 	$(BUILD)/bench/pathlab_bench lt
@@ -45,6 +45,7 @@ bench: build
 	$(BUILD)/bench/pathlab_bench volumes
 	$(BUILD)/bench/pathlab_bench textures
 	$(BUILD)/bench/pathlab_bench diff
+	$(BUILD)/bench/pathlab_bench display
 
 # Equal-spp and equal-time RMSE of the course's estimators on the 8 scenes (about 10 minutes).
 bench-estimators: build

@@ -16,12 +16,14 @@
 //   pathlab_bench lights   an environment map's cost per sample against the constant environment; spot and IES
 //   pathlab_bench textures textured against constant materials per sample; texture lookups
 //   pathlab_bench diff     a gradient's cost (path replay) relative to a primal render, its memory vs spp and depth
+//   pathlab_bench display  the cost of --display-server (samples/s with and without a viewer), time to the first image
 //   pathlab_bench spectral the spectral layer's building blocks: wavelength sampling, RGB upsampling, the XYZ film estimator
 #include <CLI/CLI.hpp>
 
 #include "bidir_efficiency.hpp"
 #include "bidirectional.hpp"
 #include "differentiable.hpp"
+#include "display.hpp"
 #include "distributed.hpp"
 #include "estimator_efficiency.hpp"
 #include "light_tracing.hpp"
@@ -126,6 +128,13 @@ int main(int argc, char** argv) {
     gat->add_option("--cutoffs", gopt.cutoffs, "Cutoff solid angles")->delimiter(',')->capture_default_str();
     gat->add_option("--resolutions", gopt.resolutions, "Micro-buffer sides")->delimiter(',')->capture_default_str();
     LightsOptions lo;
+    DisplayOptions dso;
+    CLI::App* dsc = app.add_subcommand("display", "The cost of --display-server: samples/s with and without a viewer, time to the first image");
+    dsc->add_option("--size", dso.size, "Image width and height")->capture_default_str();
+    dsc->add_option("--seconds", dso.seconds, "Seconds per timed render")->capture_default_str();
+    dsc->add_option("--repeats", dso.repeats, "Interleaved pairs (medians reported)")->capture_default_str();
+    dsc->add_option("--algorithms", dso.algorithms, "Integrators")->delimiter(',')->capture_default_str();
+    dsc->add_option("--scene", dso.scene, "Scene")->capture_default_str();
     CLI::App* lic = app.add_subcommand("lights", "An environment map's cost per sample against the constant environment; spot and IES");
     lic->add_option("--size", lo.size, "Image width and height")->capture_default_str();
     lic->add_option("--seconds", lo.seconds, "Seconds per timed render")->capture_default_str();
@@ -190,6 +199,7 @@ int main(int argc, char** argv) {
     if (*smc && sm_files->count() > 0 && smc->count("--scenes") == 0) smo.scenes.clear();
     if (*dfc) differentiable_suite(dfo);
     if (*lic) lights_suite(lo);
+    if (*dsc) display_suite(dso);
     if (*mlc) many_lights_suite(mlo);
     if (*vol) volumes_suite(vo);
     if (*txc) textures_suite(tx);

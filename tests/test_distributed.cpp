@@ -20,6 +20,7 @@
 #include <fmt/format.h>
 
 #include "cli_runner.hpp"
+#include "fake_tev.hpp"
 #include "image/image_io.hpp"
 #include "integrators/integrators.hpp"
 #include "job/checkpoint.hpp"
@@ -550,6 +551,32 @@ TEST_F(Distributed, TwoRanksOfOneThreadEqualOneProcessOfTwoThreadsForEveryIntegr
 // one-process bytes there too.
 TEST_F(Distributed, TwoRanksEqualOneProcessInSpectralMode) {
     expect_two_ranks_equal_one_process({"pt-mis", "lt", "bdpt", "sppm", "pm", "vcm", "ic", "pbgi", "volpath"}, "--spectral");
+}
+
+// --display-server with two ranks: the root sends the ranks' films summed. The first update
+// after the first round (passes 0 and 1, one per rank) equals a one-process render of 2 spp, and
+// the last equals the image written.
+TEST_F(Distributed, TwoRanksStreamTheSummedFilmToTheViewer) {
+    FakeTev tev;
+    std::string err;
+    ASSERT_EQ(shell(fmt::format("{} {} -a lt --spp 40 --threads 1 --display-server {} -o {}", mpirun(2), kSmall, tev.address(),
+                                path("two.pfm")), &err), 0)
+        << err;
+    ASSERT_EQ(shell(fmt::format("{} {} -a lt --spp 2 --threads 1 -o {}", PATHLAB_BINARY, kSmall, path("first.pfm")), &err), 0) << err;
+    const std::vector<std::string> got = wait_for(tev, 1);
+    ASSERT_EQ(got.size(), 1u) << "one connection, from the root";
+    const std::vector<TevPacket> ps = parse_packets(got[0]);
+    ASSERT_GE(ps.size(), 3u);
+    EXPECT_EQ(ps[0].type, 4);
+    const auto equal = [](const TevPacket& p, const Image& image) {
+        if (p.type != 6 || size_t(p.width) * size_t(p.height) != image.pixel_count()) return false;
+        for (size_t i = 0; i < image.pixel_count(); ++i)
+            for (int c = 0; c < 3; ++c)
+                if (p.data[size_t(c)][i] != image[i][c]) return false;
+        return true;
+    };
+    EXPECT_TRUE(equal(ps[1], read_image(path("first.pfm"))));
+    EXPECT_TRUE(equal(ps.back(), read_image(path("two.pfm"))));
 }
 
 TEST_F(Distributed, RanksWithATimeBudgetAgreeOnOneSampleCount) {

@@ -12,6 +12,8 @@
 
 #include "app/command_arguments.hpp"
 #include "app/interrupt.hpp"
+#include "display/display_server.hpp"
+#include "display/tev_protocol.hpp"
 #include "job/usage_error.hpp"
 #include "image/image_io.hpp"
 #include "integrators/bidir/strategy_images.hpp"
@@ -146,6 +148,11 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
     app.add_option("--first-sample", o.first_sample,
                    "Index of the first sample (pass) to render: renders of disjoint ranges add up, with `pathlab merge`, to one render")
         ->capture_default_str();
+    app.add_option("--display-server", o.display_server,
+                   fmt::format("Show the render as it converges in a running tev (its HOST:PORT; port {} when only HOST is "
+                               "given): the image is sent after the first pass and then twice a second. An unreachable viewer "
+                               "never stops the render (pathlab says so once and tries again in the background)",
+                               tev::kDefaultPort));
     app.add_flag("-q,--quiet", o.quiet, "No progress line and no summary");
 }
 
@@ -207,6 +214,9 @@ std::vector<RenderJob> make_jobs(const RenderCommandOptions& o, bool check_paths
     request.pbgi_spacing = o.pbgi_spacing;
     request.first_sample = o.first_sample;
     request.checkpoint_every = o.checkpoint_every;
+    if (!o.display_server.empty() && !parse_display_address(o.display_server))
+        throw UsageError(fmt::format("--display-server: '{}' is not HOST, HOST:PORT or [IPv6]:PORT (a port from 1 to 65535)",
+                                     o.display_server));
 
     std::vector<RenderJob> jobs;
     // -a all: every estimator that renders the scene; those that cannot (a medium, spectral mode,
@@ -389,6 +399,12 @@ int run_render_command(const RenderCommandOptions& o, RankGroup* ranks) {
 
     const bool show_progress = root && !o.quiet && isatty(STDERR_FILENO);
 
+    // The viewer, one connection for all the renders of this command (on the root, which holds the summed film).
+    std::unique_ptr<DisplayServer> display;
+    if (root && !o.display_server.empty())
+        display = std::make_unique<DisplayServer>(*parse_display_address(o.display_server),
+                                                  [](const std::string& message) { fmt::print(stderr, "pathlab: warning: {}\n", message); });
+
     InterruptGuard interrupt;
     // A scene that fails (too large for memory, a full disk) is reported and the others still
     // render; the exit code is then 1.
@@ -401,6 +417,13 @@ int run_render_command(const RenderCommandOptions& o, RankGroup* ranks) {
         // The scene, and the estimator when there are several.
         const std::string name =
             job.scene_choice().name + (several_algorithms ? " / " + job.integrator_info().name : std::string());
+        if (!o.display_server.empty()) {
+            // Every rank takes part in summing the films for it; the root sends the sum.
+            const std::string title = job.scene_choice().name + " / " + job.integrator_info().name;
+            job.settings.display = [&display, title](const Film& film, const RenderStats&) {
+                if (display) display->post(film_frame(title, film));
+            };
+        }
         if (show_progress) fmt::print(stderr, "{} / {}\n", job.scene_choice().name, job.integrator_info().name);
 
         // Every rank loads the scene from the same path and makes its film; the root takes up

@@ -59,6 +59,7 @@ struct RenderCommandOptions {
     double checkpoint_every = kDefaultCheckpointEvery;  // --checkpoint-every SECONDS
     std::string resume;              // --resume FILE
     uint64_t first_sample = 0;       // --first-sample N
+    std::string display_server;      // --display-server HOST[:PORT] (tev)
     OptionGroups given;              // the options given, which checkpoints record (resumed_command.hpp)
 };
 

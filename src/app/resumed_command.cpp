@@ -13,8 +13,11 @@ namespace {
 
 // The options a checkpoint's command leaves out: the scene (recorded on its own), --resume, and
 // --checkpoint (a resumed render goes on checkpointing to the file it resumes, not to where the
-// first run did, unless --checkpoint is given again).
-bool recorded(const std::string& name) { return name != "--scene" && name != "--resume" && name != "--checkpoint"; }
+// first run did, unless --checkpoint is given again), and --display-server (where this run is
+// watched, not what it renders).
+bool recorded(const std::string& name) {
+    return name != "--scene" && name != "--resume" && name != "--checkpoint" && name != "--display-server";
+}
 
 // Options naming files the render writes: recorded by absolute path, so that resuming from
 // another folder writes where the first run did.

@@ -81,7 +81,16 @@ RenderStats render_into(const Scene& scene, Integrator& integrator, const Render
     st.resumed_spp = settings.done.count();
     PassSet done = settings.done;
     uint64_t batch = 1, my_spp = 0;
-    double my_seconds = 0, last_checkpoint = 0;
+    double my_seconds = 0, last_checkpoint = 0, last_display = -1;
+    // The film as it is, to settings.display (on the root; the ranks' films summed first).
+    const auto show = [&](const RenderStats& stats) {
+        if (rank_count == 1) return settings.display(film, stats);
+        Film sum = ranks.root() ? Film(w, h) : Film();
+        ranks.reduce_film(film, size_t(1) << 16, [&](size_t first_pixel, const PixelSums* sums, size_t count) {
+            std::copy(sums, sums + count, sum.data() + first_pixel);
+        });
+        if (ranks.root()) settings.display(sum, stats);
+    };
     const uint64_t pixels = uint64_t(w) * uint64_t(h);
     while (true) {
         // This round: the next passes still to do, one contiguous part per rank.
@@ -122,6 +131,10 @@ RenderStats render_into(const Scene& scene, Integrator& integrator, const Render
         st.passes = done;
         st.samples = (st.spp - st.resumed_spp) * pixels;
         if (settings.after_pass && rank_count == 1) settings.after_pass(film, st);
+        if (settings.display && (last_display < 0 || st.seconds - last_display >= settings.display_every)) {
+            show(st);
+            last_display = st.seconds;
+        }
         if (shared[2] > 0) {
             st.interrupted = true;
             break;
@@ -173,6 +186,7 @@ RenderStats render_into(const Scene& scene, Integrator& integrator, const Render
         st.ranks.push_back({ranks.name(), my_spp, my_seconds, st.rays});
     }
     if (ranks.root()) {
+        if (settings.display) settings.display(film, st);
         integrator.finish(ctx);
         if (settings.checkpoint) {
             const double t0 = seconds_since_start();

@@ -71,6 +71,14 @@ struct RenderSettings {
     // called when several ranks render (each holds only a part of the film).
     std::function<void(const Film&, const RenderStats&)> after_pass;
 
+    // The image as it converges (--display-server): display(film, stats) is called on the root
+    // after the first round, then after a round at most every display_every seconds, and with
+    // the final film. With several ranks their films are summed for it (every rank takes part,
+    // so display must be set on all of them). It only reads the film: the render is the same
+    // with and without it.
+    std::function<void(const Film&, const RenderStats&)> display;
+    double display_every = 0.5;
+
     // The processes rendering this image together; null: this one alone.
     RankGroup* ranks = nullptr;
     // Passes the film already holds (a resumed checkpoint; only the root's film holds them),

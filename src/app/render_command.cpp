@@ -137,6 +137,13 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
     app.add_option("--pbgi-resolution", o.pbgi_resolution, "pbgi: the micro-buffer's side in pixels (default 16)");
     app.add_option("--pbgi-direct-samples", o.pbgi_direct_samples, "pbgi: MIS pairs for each surfel side's direct light (default 16)");
     app.add_option("--pbgi-spacing", o.pbgi_spacing, "pbgi: pixels between the gathers at the first hits, interpolated between (default 2)");
+    app.add_option("--chains", o.mlt_chains,
+                   "pssmlt: Markov chains per pass (a fixed number, so the image does not depend on the threads; default 64)");
+    app.add_option("--bootstrap", o.mlt_bootstrap,
+                   "pssmlt: independent paths of each pass's bootstrap, which estimates the normalisation b and starts the chains "
+                   "(default 4096)");
+    app.add_option("--large-step", o.mlt_large_step, "pssmlt: the probability of a large step (every number fresh; default 0.3)");
+    app.add_option("--sigma", o.mlt_sigma, "pssmlt: the small steps' standard deviation in primary sample space (default 0.01)");
     app.add_option("--checkpoint", o.checkpoint,
                    "Save the render's whole state to this file (atomically) every --checkpoint-every seconds, at the end and "
                    "when interrupted, to continue it with --resume (placeholders as for -o)");
@@ -213,6 +220,10 @@ std::vector<RenderJob> make_jobs(const RenderCommandOptions& o, bool check_paths
     request.pbgi_direct_samples = o.pbgi_direct_samples;
     request.pbgi_spacing = o.pbgi_spacing;
     request.first_sample = o.first_sample;
+    request.mlt_chains = o.mlt_chains;
+    request.mlt_bootstrap = o.mlt_bootstrap;
+    request.mlt_large_step = o.mlt_large_step;
+    request.mlt_sigma = o.mlt_sigma;
     request.checkpoint_every = o.checkpoint_every;
     if (!o.display_server.empty() && !parse_display_address(o.display_server))
         throw UsageError(fmt::format("--display-server: '{}' is not HOST, HOST:PORT or [IPv6]:PORT (a port from 1 to 65535)",
@@ -486,7 +497,7 @@ int run_render_command(const RenderCommandOptions& o, RankGroup* ranks) {
         const RenderStats& s = result.stats;
         if (root) {
             try {
-                job.write_outputs(result, o.exposure, render_metadata(identity, s.passes, s.invalid_samples));
+                job.write_outputs(result, o.exposure, render_metadata(identity, s.passes, s.invalid_samples, s.integrator));
                 if (!o.stats_path.empty()) write_stats(job.expand(o.stats_path), job, result, threads, group.size());
             } catch (const std::exception& e) {
                 fmt::print(stderr, "pathlab: error: {}: {}\n", name, e.what());

@@ -60,6 +60,10 @@ struct RenderCommandOptions {
     std::string resume;              // --resume FILE
     uint64_t first_sample = 0;       // --first-sample N
     std::string display_server;      // --display-server HOST[:PORT] (tev)
+    std::optional<int> mlt_chains;         // --chains (pssmlt)
+    std::optional<int> mlt_bootstrap;      // --bootstrap
+    std::optional<float> mlt_large_step;   // --large-step
+    std::optional<float> mlt_sigma;        // --sigma
     OptionGroups given;              // the options given, which checkpoints record (resumed_command.hpp)
 };
 

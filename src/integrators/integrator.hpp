@@ -73,6 +73,13 @@ struct IntegratorOptions {
     bool ic_clamp_screen = true;      // radii within 1.5 to 20 pixel footprints (Tabellion and Lamorlette)
     bool ic_clamp_neighbours = true;  // neighbour clamping (Krivanek et al.)
     std::string ic_records_path;
+    // pssmlt: Markov chains (a fixed number, so the image does not depend on the threads), the
+    // independent paths of each pass's bootstrap, the probability of a large step and the
+    // small steps' standard deviation in primary sample space.
+    int mlt_chains = 64;
+    int mlt_bootstrap = 4096;
+    float mlt_large_step = 0.3f;
+    float mlt_sigma = 0.01f;
     // pbgi: surfels (about), the cutoff solid angle (0: brute force), surfel bounces, the
     // micro-buffer's side, the MIS pairs of each surfel side's direct light, and the pixels
     // between the gathers at the camera's first hits.
@@ -119,6 +126,7 @@ using PassProgress = std::function<void(double)>;
 struct IntegratorStatistic {
     std::string name;
     double value;
+    bool in_metadata = false;  // also written into the image's metadata (pathlab:NAME): a pure function of the render's settings
 };
 
 class Integrator {

@@ -25,5 +25,6 @@ const IntegratorInfo& ppm_integrator();
 const IntegratorInfo& vcm_integrator();
 const IntegratorInfo& bpm_integrator();
 const IntegratorInfo& volpath_integrator();
+const IntegratorInfo& pssmlt_integrator();
 
 }  // namespace pathlab

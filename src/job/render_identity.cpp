@@ -60,6 +60,7 @@ std::string hex_float(double v) { return fmt::format("{:a}", v); }
 }  // namespace
 
 std::string options_text(const IntegratorOptions& o) {
+    const IntegratorOptions defaults;
     return fmt::format("max_depth={} rr_depth={} only_length={} mis={} photons={} radius={} alpha={} merging={} connections={} "
                        "ic_rays={} ic_error={} ic_gradients={}",
                        o.max_depth, o.rr_depth, o.only_length, o.mis_power ? "power" : "balance", o.photons, hex_float(o.photon_radius),
@@ -67,7 +68,12 @@ std::string options_text(const IntegratorOptions& o) {
                        int(o.ic_gradients)) +
            (o.spectral ? " mode=spectral" : "") + (o.volume_beam ? "" : " volume=points") +
            (o.light_sampler == LightSamplerKind::Power ? "" : fmt::format(" lights={}", light_sampler_name(o.light_sampler))) +
-           (o.light_sampler == LightSamplerKind::Ris ? fmt::format(" ris={}", o.ris_candidates) : "");  // the text of the defaults as it always was
+           (o.light_sampler == LightSamplerKind::Ris ? fmt::format(" ris={}", o.ris_candidates) : "") +
+           (o.mlt_chains == defaults.mlt_chains && o.mlt_bootstrap == defaults.mlt_bootstrap && o.mlt_large_step == defaults.mlt_large_step &&
+                    o.mlt_sigma == defaults.mlt_sigma
+                ? ""
+                : fmt::format(" chains={} bootstrap={} large_step={} sigma={}", o.mlt_chains, o.mlt_bootstrap, hex_float(o.mlt_large_step),
+                              hex_float(o.mlt_sigma)));  // the text of the defaults as it always was
 }
 
 std::string metadata_key(const std::string& field) {
@@ -81,7 +87,7 @@ std::string metadata_key(const std::string& field) {
 }
 
 std::vector<std::pair<std::string, std::string>> render_metadata(const RenderIdentity& identity, const PassSet& passes,
-                                                                 uint64_t invalid_samples) {
+                                                                 uint64_t invalid_samples, const std::vector<IntegratorStatistic>& statistics) {
     std::vector<std::pair<std::string, std::string>> m;
     for (const auto& [k, v] : identity.fields) m.emplace_back(metadata_key(k), v);
     m.emplace_back("pathlab:spp", fmt::format("{}", passes.count()));
@@ -89,6 +95,8 @@ std::vector<std::pair<std::string, std::string>> render_metadata(const RenderIde
     m.emplace_back("pathlab:passes", passes.to_string());
     m.emplace_back("pathlab:invalidSamples", fmt::format("{}", invalid_samples));
     m.emplace_back("pathlab:version", PATHLAB_VERSION);
+    for (const IntegratorStatistic& x : statistics)
+        if (x.in_metadata) m.emplace_back(metadata_key(x.name), fmt::format("{}", x.value));
     return m;
 }
 

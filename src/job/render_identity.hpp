@@ -49,7 +49,8 @@ std::string options_text(const IntegratorOptions& o);
 // pathlab:seed, pathlab:sampler), pathlab:spp (passes in the image), pathlab:firstSample (the
 // smallest), pathlab:passes (PassSet text), pathlab:invalidSamples and pathlab:version.
 std::vector<std::pair<std::string, std::string>> render_metadata(const RenderIdentity& identity, const PassSet& passes,
-                                                                 uint64_t invalid_samples);
+                                                                 uint64_t invalid_samples,
+                                                                 const std::vector<IntegratorStatistic>& statistics = {});
 // The attribute name of an identity field ("scene hash" -> "pathlab:sceneHash").
 std::string metadata_key(const std::string& field);
 

@@ -162,6 +162,8 @@ static std::string option_refusal(const IntegratorInfo& info, const JobRequest& 
     if ((r.pbgi_surfels || r.pbgi_cutoff || r.pbgi_bounces || r.pbgi_resolution || r.pbgi_direct_samples || r.pbgi_spacing) && a != "pbgi")
         return fmt::format(
             "--pbgi-surfels, --pbgi-cutoff, --pbgi-bounces, --pbgi-resolution, --pbgi-direct-samples and --pbgi-spacing are pbgi's, not {}'s", a);
+    if ((r.mlt_chains || r.mlt_bootstrap || r.mlt_large_step || r.mlt_sigma) && a != "pssmlt")
+        return fmt::format("--chains, --bootstrap, --large-step and --sigma set pssmlt's Markov chains, not {}'s", a);
     const auto out_of = [](const char* name, const auto& v, double lo, double hi) -> std::string {
         if (v && !(double(*v) >= lo && double(*v) <= hi)) return fmt::format("{} must be {:g} to {:g}, got {}", name, lo, hi, *v);
         return "";
@@ -170,7 +172,9 @@ static std::string option_refusal(const IntegratorInfo& info, const JobRequest& 
                                    out_of("--pbgi-surfels", r.pbgi_surfels, 1, 1e7), out_of("--pbgi-cutoff", r.pbgi_cutoff, 0, 4 * kPi),
                                    out_of("--pbgi-bounces", r.pbgi_bounces, 1, 64), out_of("--pbgi-resolution", r.pbgi_resolution, 2, 256),
                                    out_of("--pbgi-direct-samples", r.pbgi_direct_samples, 1, 65536),
-                                   out_of("--pbgi-spacing", r.pbgi_spacing, 1, 64)})
+                                   out_of("--pbgi-spacing", r.pbgi_spacing, 1, 64), out_of("--chains", r.mlt_chains, 1, 1 << 20),
+                                   out_of("--bootstrap", r.mlt_bootstrap, 1, 1 << 24), out_of("--large-step", r.mlt_large_step, 0, 1),
+                                   out_of("--sigma", r.mlt_sigma, 1e-6, 1)})
         if (!why.empty()) return why;
     return "";
 }
@@ -212,6 +216,10 @@ RenderJob::RenderJob(SceneChoice scene, const JobRequest& r) : choice_(std::move
     options_.hide_emitters = d.hide_emitters.value_or(false);
     if (const std::string why = integrator_refusal(*info_, d, r); !why.empty()) throw UsageError(why);
     if (const std::string why = option_refusal(*info_, r); !why.empty()) throw UsageError(why);
+    options_.mlt_chains = r.mlt_chains.value_or(options_.mlt_chains);
+    options_.mlt_bootstrap = r.mlt_bootstrap.value_or(options_.mlt_bootstrap);
+    options_.mlt_large_step = r.mlt_large_step.value_or(options_.mlt_large_step);
+    options_.mlt_sigma = r.mlt_sigma.value_or(options_.mlt_sigma);
     options_.light_sampler = r.light_sampler.value_or(LightSamplerKind::Power);
     if (r.ris_candidates && options_.light_sampler != LightSamplerKind::Ris)
         throw UsageError("--ris-candidates is the number of light samples --light-sampler ris resamples; give --light-sampler ris");

@@ -62,6 +62,10 @@ struct JobRequest {
     std::optional<int> pbgi_spacing;          // --pbgi-spacing (pbgi)
     std::optional<LightSamplerKind> light_sampler;  // --light-sampler (next-event estimation; default power)
     std::optional<int> ris_candidates;              // --ris-candidates (ris)
+    std::optional<int> mlt_chains;                  // --chains (pssmlt)
+    std::optional<int> mlt_bootstrap;               // --bootstrap (pssmlt)
+    std::optional<float> mlt_large_step;            // --large-step (pssmlt)
+    std::optional<float> mlt_sigma;                 // --sigma (pssmlt)
 };
 
 // The integrator `name` (or an alias); a UsageError listing them all otherwise.

@@ -7,6 +7,7 @@
 
 #include "core/rng.hpp"
 #include "core/vec.hpp"
+#include "samplers/primary_samples.hpp"
 #include "samplers/sobol.hpp"
 #include <vector>
 
@@ -17,6 +18,7 @@ namespace pathlab {
 enum class SamplerKind {
     Independent,  // PCG32 numbers: independent samples (the course's estimators, the tests)
     Sobol,        // padded, shuffled, Owen-scrambled 2D Sobol points (lower error, see sobol.hpp)
+    Primary,      // the numbers of a Markov chain's state (primary_samples.hpp: pssmlt)
 };
 
 // The random numbers of one path sample. With SamplerKind::Sobol, the k-th call of next1d() or
@@ -32,8 +34,12 @@ public:
           reversed_index_(reverse_bits(uint32_t(sample_index))),
           pixel_hash_(mix64(seed ^ mix64(pixel_index ^ 0x243f6a8885a308d3ull))) {}
 
+    // The numbers of a primary-sample-space state, in the order the path reads them.
+    explicit Sampler(PrimarySamples& state) : rng_(0, 0), kind_(SamplerKind::Primary), reversed_index_(0), pixel_hash_(0), state_(&state) {}
+
     float next1d() {
         if (kind_ == SamplerKind::Independent) return rng_.next_float();
+        if (kind_ == SamplerKind::Primary) return state_->next1d();
         const uint64_t h = dimension_hash();
         return fixed_to_float(scrambled_dimension0(shuffled_index(uint32_t(h)), uint32_t(h >> 32)));
     }
@@ -42,6 +48,7 @@ public:
             const float a = rng_.next_float();
             return {a, rng_.next_float()};
         }
+        if (kind_ == SamplerKind::Primary) return state_->next2d();
         const uint64_t h = dimension_hash();
         const uint32_t i = shuffled_index(uint32_t(h));
         const uint32_t seed1 = uint32_t((h * 0xd1342543de82ef95ull) >> 32);  // a third seed
@@ -53,7 +60,11 @@ public:
     // what an integrator draws there does not shift this stream's dimensions. volpath draws
     // its free-flight distances there, so that a path through no medium uses exactly the
     // numbers pt-mis uses. (Keyed by the sample index's low 32 bits.)
-    Sampler fork(uint64_t stream) const { return Sampler(pixel_hash_, stream, reverse_bits(reversed_index_), kind_); }
+    // A primary-sample-space sampler has one stream: its fork reads on from the same state.
+    Sampler fork(uint64_t stream) const {
+        if (kind_ == SamplerKind::Primary) return Sampler(*state_);
+        return Sampler(pixel_hash_, stream, reverse_bits(reversed_index_), kind_);
+    }
 
 private:
     uint64_t dimension_hash() { return mix64(pixel_hash_ + 0x9e3779b97f4a7c15ull * ++dimension_); }
@@ -67,6 +78,7 @@ private:
     uint32_t reversed_index_;  // bit-reversed sample index
     uint32_t dimension_ = 0;
     uint64_t pixel_hash_;
+    PrimarySamples* state_ = nullptr;
 };
 
 // The scene-file samplers (Mitsuba's independent, stratified, ...): their sample count is the

@@ -21,12 +21,26 @@ namespace {
 // A density on [0, 1) with a sharp peak and a flat floor, the kind of target MLT is for.
 double toy_density(double x) { return 0.2 + std::exp(-0.5 * std::pow((x - 0.7) / 0.05, 2)) + (x < 0.1 ? 1.5 : 0.0); }
 
+// Pearson's test of chain states against toy_density (40 bins, each integrated numerically).
+Chi2Result against_toy_density(const std::vector<float>& states) {
+    constexpr int kBins = 40;
+    std::vector<double> observed(kBins + 1, 0.0), expected(kBins + 1, 0.0);
+    for (float x : states) observed[size_t(std::min(kBins - 1, int(x * kBins)))] += 1;
+    double total = 0;
+    for (int b = 0; b < kBins; ++b) {
+        double sum = 0;
+        for (int k = 0; k < 200; ++k) sum += toy_density((b + (k + 0.5) / 200) / kBins) / 200;
+        expected[size_t(b)] = sum, total += sum;
+    }
+    for (int b = 0; b < kBins; ++b) expected[size_t(b)] *= double(states.size()) / total;
+    return chi2_from_counts(observed, expected);
+}
+
 // Independent chains, each `steps` Metropolis-Hastings steps on toy_density from `start`; the
 // histogram of their last states against the density's bin integrals.
 template <class Start>
 Chi2Result toy_chains(float sigma, float large, int steps, Start start, bool wrong_acceptance = false, int chains = 20000) {
-    constexpr int kBins = 40;
-    std::vector<double> observed(kBins + 1, 0.0), expected(kBins + 1, 0.0);
+    std::vector<float> states;
     for (int c = 0; c < chains; ++c) {
         PrimarySamples state(sigma, large);
         state.restart(17, uint64_t(c));
@@ -44,21 +58,14 @@ Chi2Result toy_chains(float sigma, float large, int steps, Start start, bool wro
                 state.reject();
             }
         }
-        observed[size_t(std::min(kBins - 1, int(x * kBins)))] += 1;
+        states.push_back(x);
     }
-    double total = 0;
-    for (int b = 0; b < kBins; ++b) {
-        double sum = 0;
-        for (int k = 0; k < 200; ++k) sum += toy_density((b + (k + 0.5) / 200) / kBins) / 200;
-        expected[size_t(b)] = sum;
-        total += sum;
-    }
-    for (int b = 0; b < kBins; ++b) expected[size_t(b)] *= chains / total;
-    return chi2_from_counts(observed, expected);
+    return against_toy_density(states);
 }
 
 // The first state: the first number (uniform; the chains then need steps to forget it).
 float uniform_start(PrimarySamples& state, int) { return state.next1d(); }
+
 TEST(PrimarySamples, LargeAndSmallStepsKeepTheTargetDensity) {
     const Chi2Result r = toy_chains(0.01f, 0.3f, 200, uniform_start);
     EXPECT_GT(r.p_value, suite_chi2_alpha()) << r.describe();
@@ -68,8 +75,8 @@ TEST(PrimarySamples, SmallStepsAloneKeepTheTargetDensity) {
     // From a stationary start, small steps only (wide ones, so that 50 of them move a state
     // far): the kernel alone must keep the density (detailed balance of the symmetric Gaussian
     // step, wrapped, with Metropolis acceptance).
-    constexpr int kChains = 20000, kBins = 40;
-    std::vector<double> observed(kBins + 1, 0.0), expected(kBins + 1, 0.0);
+    constexpr int kChains = 20000;
+    std::vector<float> states;
     for (int c = 0; c < kChains; ++c) {
         PrimarySamples state(0.08f, 0.0f);
         // A stationary first state: restart until a large step's number passes rejection sampling.
@@ -92,16 +99,9 @@ TEST(PrimarySamples, SmallStepsAloneKeepTheTargetDensity) {
                 state.reject();
             }
         }
-        observed[size_t(std::min(kBins - 1, int(x * kBins)))] += 1;
+        states.push_back(x);
     }
-    double total = 0;
-    for (int b = 0; b < kBins; ++b) {
-        double sum = 0;
-        for (int k = 0; k < 200; ++k) sum += toy_density((b + (k + 0.5) / 200) / kBins) / 200;
-        expected[size_t(b)] = sum, total += sum;
-    }
-    for (int b = 0; b < kBins; ++b) expected[size_t(b)] *= kChains / total;
-    const Chi2Result r = chi2_from_counts(observed, expected);
+    const Chi2Result r = against_toy_density(states);
     EXPECT_GT(r.p_value, suite_chi2_alpha()) << r.describe();
 }
 
@@ -109,10 +109,9 @@ TEST(PrimarySamples, ANumberCreatedDuringTheChainIsUniformAndIndependent) {
     // The target depends on the second number only after the first passes a threshold, so the
     // second number is created lazily, in the middle of the chain, and by rejected proposals
     // too; its marginal under the target is known: density(x2) for the chains whose x1 < 0.5.
-    constexpr int kChains = 20000, kBins = 40;
+    constexpr int kChains = 20000;
     const auto target = [](double x1, double x2) { return x1 < 0.5 ? toy_density(x2) : 1.0; };
-    std::vector<double> observed(kBins + 1, 0.0), expected(kBins + 1, 0.0);
-    int counted = 0;
+    std::vector<float> states;
     for (int c = 0; c < kChains; ++c) {
         PrimarySamples state(0.02f, 0.3f);
         state.restart(23, uint64_t(c));
@@ -132,20 +131,10 @@ TEST(PrimarySamples, ANumberCreatedDuringTheChainIsUniformAndIndependent) {
                 state.reject();
             }
         }
-        if (x1 < 0.5f) {
-            observed[size_t(std::min(kBins - 1, int(x2 * kBins)))] += 1;
-            ++counted;
-        }
+        if (x1 < 0.5f) states.push_back(x2);
     }
-    double total = 0;
-    for (int b = 0; b < kBins; ++b) {
-        double sum = 0;
-        for (int k = 0; k < 200; ++k) sum += toy_density((b + (k + 0.5) / 200) / kBins) / 200;
-        expected[size_t(b)] = sum, total += sum;
-    }
-    for (int b = 0; b < kBins; ++b) expected[size_t(b)] *= counted / total;
-    const Chi2Result r = chi2_from_counts(observed, expected);
-    EXPECT_GT(counted, kChains / 4);
+    const Chi2Result r = against_toy_density(states);
+    EXPECT_GT(states.size(), size_t(kChains / 4));
     EXPECT_GT(r.p_value, suite_chi2_alpha()) << r.describe();
 }
 

@@ -11,6 +11,8 @@
 
 #include "chi2.hpp"
 #include "integrators/mlt/pssmlt.hpp"
+#include "job/render_job.hpp"
+#include "job/usage_error.hpp"
 #include "judge/image_statistics.hpp"
 #include "render_helpers.hpp"
 #include "samplers/sampler.hpp"
@@ -234,6 +236,32 @@ TEST(Pssmlt, SameBytesWithOneAndTwoThreadsAndWhenContinued) {
     RenderResult half = mlt_render(2, 7);
     mlt_render(1, 9, 7, &half.film);
     EXPECT_TRUE(half.film.identical(one.film));
+}
+
+TEST(Pssmlt, OptionsAreItsOwnAndChecked) {
+    JobRequest r;
+    r.algorithm = "pssmlt";
+    r.mlt_chains = 8, r.mlt_bootstrap = 100, r.mlt_large_step = 0.5f, r.mlt_sigma = 0.05f;
+    RenderJob job(4, r);
+    EXPECT_EQ(job.integrator_options().mlt_chains, 8);
+    EXPECT_EQ(job.integrator_options().mlt_bootstrap, 100);
+    const auto refused = [](JobRequest q) -> std::string {
+        try {
+            RenderJob j(4, q);
+        } catch (const UsageError& e) {
+            return e.what();
+        }
+        return "";
+    };
+    JobRequest other;
+    other.algorithm = "bdpt", other.mlt_chains = 8;
+    EXPECT_NE(refused(other).find("set pssmlt's Markov chains, not bdpt's"), std::string::npos) << refused(other);
+    JobRequest bad = r;
+    bad.mlt_large_step = 1.5f;
+    EXPECT_NE(refused(bad).find("--large-step must be 0 to 1"), std::string::npos) << refused(bad);
+    JobRequest sobol = r;
+    sobol.sampler = SamplerKind::Sobol;
+    EXPECT_NE(refused(sobol).find("pssmlt takes no --sampler sobol"), std::string::npos) << refused(sobol);
 }
 
 }  // namespace

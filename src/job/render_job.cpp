@@ -103,6 +103,9 @@ std::string non_reciprocal_material(const SceneDescription& d) {
 }
 
 std::string integrator_refusal(const IntegratorInfo& info, const SceneDescription& d, const JobRequest& r) {
+    if (r.sampler == SamplerKind::Sobol && info.name == "pssmlt")
+        return "pssmlt takes no --sampler sobol: its numbers are its Markov chains' states in primary sample space, not a pixel "
+               "sampler's";
     if (r.light_sampler && !info.samples_lights)
         return fmt::format("{} does not choose lights at its shading points (its light paths start on a light chosen "
                            "by power), so --light-sampler does not apply to it; the integrators it applies to: {}",

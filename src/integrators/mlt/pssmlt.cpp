@@ -196,7 +196,6 @@ PassCounters Pssmlt<T>::render_passes(const RenderContext& ctx, Film& film, uint
             });
         }
         pass_.finish(film, ctx.filter, Vec2f(0.0f, 0.0f));
-        b_sum_ += b, ++passes_;
     }
     accepted_ += accepted.load(), proposed_ += proposed.load();
     return {rays.load(), invalid.load()};

@@ -52,8 +52,8 @@ private:
     std::vector<PrimarySamples> states_;  // one per chain, kept from pass to pass (no allocation once warm)
     std::vector<double> weights_, cumulative_;
     PassImage pass_;
-    double normalisation_ = 0, b_sum_ = 0;
-    uint64_t passes_ = 0, accepted_ = 0, proposed_ = 0;
+    double normalisation_ = 0;  // b from prepare()'s bootstrap (the metadata's)
+    uint64_t accepted_ = 0, proposed_ = 0;  // mutations, for the acceptance rate
 };
 extern template class Pssmlt<RgbTransport>;
 extern template class Pssmlt<SpectralTransport>;

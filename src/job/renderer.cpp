@@ -81,7 +81,7 @@ RenderStats render_into(const Scene& scene, Integrator& integrator, const Render
     st.resumed_spp = settings.done.count();
     PassSet done = settings.done;
     uint64_t batch = 1, my_spp = 0;
-    double my_seconds = 0, last_checkpoint = 0, last_display = -1;
+    double my_seconds = 0, last_checkpoint = 0, last_display = -1, my_display_seconds = 0;
     // The film as it is, to settings.display (on the root; the ranks' films summed first).
     const auto show = [&](const RenderStats& stats) {
         if (rank_count == 1) return settings.display(film, stats);
@@ -123,7 +123,7 @@ RenderStats render_into(const Scene& scene, Integrator& integrator, const Render
         my_spp += mine.count(), my_seconds += my_round_seconds;
         done.insert(round);
         // The collective of the round: the slowest part, the time spent, any rank interrupted.
-        double shared[3] = {my_round_seconds, seconds_since_start(), settings.cancel && settings.cancel->load() ? 1.0 : 0.0};
+        double shared[4] = {my_round_seconds, seconds_since_start(), settings.cancel && settings.cancel->load() ? 1.0 : 0.0, my_display_seconds};
         ranks.all_max(shared);
         const double round_seconds = shared[0];
         st.seconds = shared[1];
@@ -131,8 +131,12 @@ RenderStats render_into(const Scene& scene, Integrator& integrator, const Render
         st.passes = done;
         st.samples = (st.spp - st.resumed_spp) * pixels;
         if (settings.after_pass && rank_count == 1) settings.after_pass(film, st);
-        if (settings.display && (last_display < 0 || st.seconds - last_display >= settings.display_every)) {
+        // The image to the viewer: every display_every seconds, or less often when showing it
+        // costs over 5% of the time (a large film; the slowest rank's cost, so all ranks agree).
+        if (settings.display && (last_display < 0 || st.seconds - last_display >= std::max(settings.display_every, 20 * shared[3]))) {
+            const double t0 = seconds_since_start();
             show(st);
+            my_display_seconds = seconds_since_start() - t0;
             last_display = st.seconds;
         }
         if (shared[2] > 0) {

@@ -72,8 +72,8 @@ struct RenderSettings {
     std::function<void(const Film&, const RenderStats&)> after_pass;
 
     // The image as it converges (--display-server): display(film, stats) is called on the root
-    // after the first round, then after a round at most every display_every seconds, and with
-    // the final film. With several ranks their films are summed for it (every rank takes part,
+    // after the first round, then after a round at most every display_every seconds (less often
+    // when showing the image takes over 5% of the time), and with the final film. With several ranks their films are summed for it (every rank takes part,
     // so display must be set on all of them). It only reads the film: the render is the same
     // with and without it.
     std::function<void(const Film&, const RenderStats&)> display;

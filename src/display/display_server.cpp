@@ -1,8 +1,6 @@
 #include "display/display_server.hpp"
 
 #include <fcntl.h>
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 #include <netdb.h>
 #include <netinet/in.h>
 #include <netinet/tcp.h>
@@ -23,16 +21,8 @@
 namespace pathlab {
 
 DisplayFrame film_frame(const std::string& name, const Film& film) {
-    DisplayFrame f{name, film.width(), film.height(), {"R", "G", "B"}, std::vector<float>(3 * film.pixel_count())};
-    // As Film::mean computes it (the same floats as the image written), into the frame directly.
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, film.pixel_count(), 4096), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t i = r.begin(); i != r.end(); ++i)
-            if (const uint64_t n = film.count(i)) {
-                const Rgb m(film.sum(i) / double(n));
-                for (int c = 0; c < 3; ++c) f.pixels[3 * i + size_t(c)] = m[c];
-            }
-    });
-    return f;
+    const Image mean = film.mean();  // the same floats as the image written
+    return {name, film.width(), film.height(), {"R", "G", "B"}, std::vector<float>(mean.data(), mean.data() + 3 * mean.pixel_count())};
 }
 
 std::optional<DisplayAddress> parse_display_address(const std::string& text) {

@@ -82,13 +82,17 @@ RenderStats render_into(const Scene& scene, Integrator& integrator, const Render
     PassSet done = settings.done;
     uint64_t batch = 1, my_spp = 0;
     double my_seconds = 0, last_checkpoint = 0, last_display = -1, my_display_seconds = 0;
+    // The ranks' films summed into `into` on the root (chunks of 64Ki pixels, 10 MiB); every rank calls it.
+    const auto sum_ranks_into = [&](Film& into) {
+        ranks.reduce_film(film, size_t(1) << 16, [&](size_t first_pixel, const PixelSums* sums, size_t count) {
+            std::copy(sums, sums + count, into.data() + first_pixel);
+        });
+    };
     // The film as it is, to settings.display (on the root; the ranks' films summed first).
     const auto show = [&](const RenderStats& stats) {
         if (rank_count == 1) return settings.display(film, stats);
         Film sum = ranks.root() ? Film(w, h) : Film();
-        ranks.reduce_film(film, size_t(1) << 16, [&](size_t first_pixel, const PixelSums* sums, size_t count) {
-            std::copy(sums, sums + count, sum.data() + first_pixel);
-        });
+        sum_ranks_into(sum);
         if (ranks.root()) settings.display(sum, stats);
     };
     const uint64_t pixels = uint64_t(w) * uint64_t(h);
@@ -167,11 +171,9 @@ RenderStats render_into(const Scene& scene, Integrator& integrator, const Render
     st.samples = (st.spp - st.resumed_spp) * pixels;
 
     if (rank_count > 1) {
-        // The ranks' films summed into the root's (chunks of 64Ki pixels, 10 MiB).
+        // The ranks' films summed into the root's.
         const double t0 = seconds_since_start();
-        ranks.reduce_film(film, size_t(1) << 16, [&](size_t first_pixel, const PixelSums* sums, size_t count) {
-            std::copy(sums, sums + count, film.data() + first_pixel);
-        });
+        sum_ranks_into(film);
         st.reduce_seconds = seconds_since_start() - t0;
         const double mine_figures[4] = {double(my_spp), my_seconds, double(st.rays), double(st.invalid_samples)};
         const std::vector<double> all = ranks.gather(mine_figures);

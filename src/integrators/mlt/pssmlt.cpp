@@ -78,9 +78,8 @@ typename Pssmlt<T>::PathSample Pssmlt<T>::evaluate(const RenderContext& ctx, Pri
 }
 
 template <class T>
-double Pssmlt<T>::bootstrap(const RenderContext& ctx, uint64_t pass, std::vector<double>& cumulative, uint64_t& invalid,
+double Pssmlt<T>::bootstrap(const RenderContext& ctx, uint64_t pass, int n, std::vector<double>& cumulative, uint64_t& invalid,
                             std::atomic<uint64_t>& rays) {
-    const int n = options_.mlt_bootstrap;
     weights_.resize(size_t(n));
     const uint64_t seed = stream_seed(ctx.seed, pass, kBootstrapStream);
     std::atomic<uint64_t> bad{0};
@@ -119,13 +118,11 @@ template <class T>
 void Pssmlt<T>::prepare(const RenderContext& ctx, const PassProgress&) {
     make_states(ctx);
     // b from a bootstrap of its own, 16 times a pass's: the figure the image's metadata states.
-    const int per_pass = options_.mlt_bootstrap;
-    options_.mlt_bootstrap = int(std::min<int64_t>(int64_t(per_pass) * 16, 1 << 24));
+    const int n = int(std::min<int64_t>(int64_t(options_.mlt_bootstrap) * 16, 1 << 24));
     std::vector<double> cumulative;
     uint64_t invalid = 0;
     std::atomic<uint64_t> rays{0};
-    normalisation_ = bootstrap(ctx, kNormalisationPass, cumulative, invalid, rays);
-    options_.mlt_bootstrap = per_pass;
+    normalisation_ = bootstrap(ctx, kNormalisationPass, n, cumulative, invalid, rays);
 }
 
 template <class T>
@@ -138,7 +135,7 @@ PassCounters Pssmlt<T>::render_passes(const RenderContext& ctx, Film& film, uint
     for (int k = 0; k < count; ++k) {
         const uint64_t pass = first + uint64_t(k);
         uint64_t bad = 0;
-        const double b = bootstrap(ctx, pass, cumulative_, bad, rays);
+        const double b = bootstrap(ctx, pass, options_.mlt_bootstrap, cumulative_, bad, rays);
         invalid += bad;
         pass_.begin(pixels, chains);
         if (b > 0) {

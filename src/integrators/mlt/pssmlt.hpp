@@ -38,9 +38,9 @@ public:
     PathSample evaluate(const RenderContext& ctx, PrimarySamples& state) const;
 
 private:
-    // Pass `pass`'s bootstrap: --bootstrap independent paths, their running sum of I in
-    // `cumulative`; returns b^, their mean I.
-    double bootstrap(const RenderContext& ctx, uint64_t pass, std::vector<double>& cumulative, uint64_t& invalid,
+    // Pass `pass`'s bootstrap: n independent paths (a pass's: --bootstrap), their running sum of
+    // I in `cumulative`; returns b^, their mean I.
+    double bootstrap(const RenderContext& ctx, uint64_t pass, int n, std::vector<double>& cumulative, uint64_t& invalid,
                      std::atomic<uint64_t>& rays);
 
     // One state per chain (min(--chains, pixels)), kept from pass to pass.

@@ -46,6 +46,16 @@ double albedo(const Material& m, const Vec3f& wi, int n = 512) {
 // albedo is c (1 - 1/42 + 5 r / 84): (1 - Fo/2) loses 2 int (1 - mu)^5 mu dmu / 2 = 1/42, and
 // the retro-reflection Rr Fo, Rr = 2 r cos_d^2 = r (1 + mu), adds 2 r int (1 + mu)(1 - mu)^5 mu dmu
 // = 5 r / 84 (Burley's retro-reflection makes a rough surface reflect more than it receives).
+// The error a scene file holding a sphere with this <bsdf> raises ("" when it loads).
+std::string error_of(const std::string& bsdf) {
+    try {
+        load_scene_text("<scene version=\"3.0.0\"><shape type=\"sphere\">" + bsdf + "</shape></scene>", "bad.xml", ".");
+    } catch (const SceneFileError& e) {
+        return e.what();
+    }
+    return "";
+}
+
 TEST(Principled, DiffuseAlbedoAtNormalIncidenceIsTheClosedForm) {
     for (float r : {0.0f, 0.5f, 1.0f}) {
         PrincipledMaterial p;
@@ -187,14 +197,6 @@ TEST(Principled, SceneFilesReadItAsMitsubaDoes) {
     EXPECT_FALSE(plain.transmits);
     EXPECT_FLOAT_EQ(plain.roughness, 0.5f);
 
-    const auto error_of = [](const std::string& bsdf) -> std::string {
-        try {
-            load_scene_text("<scene version=\"3.0.0\"><shape type=\"sphere\">" + bsdf + "</shape></scene>", "bad.xml", ".");
-        } catch (const SceneFileError& e) {
-            return e.what();
-        }
-        return "";
-    };
     EXPECT_NE(error_of(R"(<bsdf type="principled"><float name="eta" value="1.3"/><float name="specular" value="0.3"/></bsdf>)")
                   .find("either eta or specular"),
               std::string::npos);
@@ -333,14 +335,6 @@ TEST(PrincipledThin, SceneFilesReadItAsMitsubaDoes) {
     EXPECT_FLOAT_EQ(plain.eta, 1.5f);
     EXPECT_FLOAT_EQ(plain.roughness, 0.5f);
     EXPECT_FLOAT_EQ(plain.diff_trans, 0.0f);
-    const auto error_of = [](const std::string& bsdf) -> std::string {
-        try {
-            load_scene_text("<scene version=\"3.0.0\"><shape type=\"sphere\">" + bsdf + "</shape></scene>", "bad.xml", ".");
-        } catch (const SceneFileError& e) {
-            return e.what();
-        }
-        return "";
-    };
     EXPECT_NE(error_of(R"(<bsdf type="principledthin"><float name="diff_trans" value="2.5"/></bsdf>)").find("between 0 and 2"), std::string::npos);
     EXPECT_NE(error_of(R"(<bsdf type="principledthin"><float name="metallic" value="0.5"/></bsdf>)").find("metallic"), std::string::npos);
     EXPECT_NE(error_of(R"(<bsdf type="principledthin"><float name="diffuse_transmittance_sampling_rate" value="0"/></bsdf>)")

@@ -8,6 +8,7 @@
 #include "instrument/allocation_counter.hpp"
 #include "integrators/bidir/bdpt.hpp"
 #include "integrators/bidir/light_tracer.hpp"
+#include "integrators/mlt/mmlt.hpp"
 #include "integrators/mlt/pssmlt.hpp"
 #include "integrators/photon/pm.hpp"
 #include "integrators/photon/sppm.hpp"
@@ -44,8 +45,10 @@ void expect_no_allocations(const Scene& scene, int index) {
     const char* mode = T::spectral ? " (spectral)" : "";
     IntegratorOptions options;
     options.spectral = T::spectral;
+    IntegratorOptions finite = options;
+    finite.max_depth = 5;  // (mmlt's chains need a last length)
     for (const IntegratorInfo& info : integrators()) {
-        const auto integrator = info.make(options);
+        const auto integrator = info.make(info.name == "mmlt" ? finite : options);
         const RenderContext ctx{scene, camera, 64, 64, 7, SamplerKind::Independent, 32};
         if (const auto* lt = dynamic_cast<const LightTracer<T>*>(integrator.get())) {
             // Light paths: once the splat list has grown (here: by a pass of twice as many
@@ -108,10 +111,10 @@ void expect_no_allocations(const Scene& scene, int index) {
             if (vcm) { EXPECT_GT(vcm->photon_count(), 2048u) << info.name << mode << " on scene " << index; }
             continue;
         }
-        if (dynamic_cast<const Pssmlt<T>*>(integrator.get())) {
-            // Passes: after two (which size the chains' states, the bootstrap's arrays and the
-            // splat lists), a pass allocates only when a chain's splat list or state outgrows
-            // its capacity, at most once per chain (64 chains; measured: 0 or 1).
+        if (dynamic_cast<const Pssmlt<T>*>(integrator.get()) || dynamic_cast<const Mmlt<T>*>(integrator.get())) {
+            // Passes: after two (which size the chains' states, the bootstrap's arrays, the
+            // splat lists and mmlt's subpaths), a pass allocates only when a chain's splat list
+            // or state outgrows its capacity, at most once per chain (64 chains; measured: 0 or 1).
             tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
             Film film(64, 64);
             integrator->prepare(ctx, {});

@@ -545,6 +545,7 @@ void Distributed::expect_two_ranks_equal_one_process(const std::vector<std::stri
 
 TEST_F(Distributed, TwoRanksOfOneThreadEqualOneProcessOfTwoThreadsForEveryIntegrator) {
     expect_two_ranks_equal_one_process({"pt-mis", "lt", "bdpt", "sppm", "ppm", "pm", "vcm", "bpm", "ic", "pbgi", "volpath", "pssmlt"}, "");
+    expect_two_ranks_equal_one_process({"mmlt"}, "--max-depth 5");
 }
 
 // Spectral mode's wavelengths come from per-sample (or per-pass) streams, so ranks give the

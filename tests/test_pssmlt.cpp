@@ -212,7 +212,7 @@ TEST(PssmltAgreement, ConvergesInSpectralMode) {
 // is wrong, and the comparison says so.
 TEST(PssmltAgreement, DetectsAMissingRejectionWeight) {
     IntegratorOptions o = mlt_options();
-    Pssmlt<RgbTransport> mlt(o, PssmltFaults{.drop_current_weight = true});
+    Pssmlt<RgbTransport> mlt(o, ChainFaults{.drop_current_weight = true});
     EXPECT_FALSE(compare_with_pt_mis(4, mlt, 1024).agree);
 }
 
@@ -255,7 +255,7 @@ TEST(Pssmlt, OptionsAreItsOwnAndChecked) {
     };
     JobRequest other;
     other.algorithm = "bdpt", other.mlt_chains = 8;
-    EXPECT_NE(refused(other).find("set pssmlt's Markov chains, not bdpt's"), std::string::npos) << refused(other);
+    EXPECT_NE(refused(other).find("set the Markov chains of pssmlt and mmlt, not bdpt's"), std::string::npos) << refused(other);
     JobRequest bad = r;
     bad.mlt_large_step = 1.5f;
     EXPECT_NE(refused(bad).find("--large-step must be 0 to 1"), std::string::npos) << refused(bad);

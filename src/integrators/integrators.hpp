@@ -26,5 +26,6 @@ const IntegratorInfo& vcm_integrator();
 const IntegratorInfo& bpm_integrator();
 const IntegratorInfo& volpath_integrator();
 const IntegratorInfo& pssmlt_integrator();
+const IntegratorInfo& mmlt_integrator();
 
 }  // namespace pathlab

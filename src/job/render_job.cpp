@@ -103,9 +103,14 @@ std::string non_reciprocal_material(const SceneDescription& d) {
 }
 
 std::string integrator_refusal(const IntegratorInfo& info, const SceneDescription& d, const JobRequest& r) {
-    if (r.sampler == SamplerKind::Sobol && info.name == "pssmlt")
-        return "pssmlt takes no --sampler sobol: its numbers are its Markov chains' states in primary sample space, not a pixel "
-               "sampler's";
+    const bool mlt = info.name == "pssmlt" || info.name == "mmlt";
+    if (r.sampler == SamplerKind::Sobol && mlt)
+        return fmt::format("{} takes no --sampler sobol: its numbers are its Markov chains' states in primary sample space, not a pixel "
+                           "sampler's",
+                           info.name);
+    if (info.name == "mmlt" && (r.max_depth ? *r.max_depth : d.max_depth.value_or(-1)) < 0)
+        return "mmlt needs a finite --max-depth: its Markov chains run per path length, 0 to --max-depth bounces, and an unlimited "
+               "depth has no last length (give the same --max-depth to the estimators it is compared with, e.g. --max-depth 10)";
     if (r.light_sampler && !info.samples_lights)
         return fmt::format("{} does not choose lights at its shading points (its light paths start on a light chosen "
                            "by power), so --light-sampler does not apply to it; the integrators it applies to: {}",
@@ -155,8 +160,8 @@ static std::string option_refusal(const IntegratorInfo& info, const JobRequest& 
     if (r.photon_alpha && !one_of({"sppm", "ppm", "vcm", "bpm"})) return fmt::format("--alpha is the radius reduction of sppm, ppm, vcm and bpm, not {}'s", a);
     if (r.volume_beam && !one_of({"sppm", "ppm", "pm"}))
         return fmt::format("--volume-estimate chooses how sppm, ppm and pm gather photons in media; {} has no such choice", a);
-    if (r.mis_power && !one_of({"bdpt", "vcm", "bpm", "pt-mis", "pt-mis3", "direct-mis"}))
-        return fmt::format("--mis chooses the heuristic of bdpt, vcm, bpm, pt-mis, pt-mis3 and direct-mis; {} has its own", a);
+    if (r.mis_power && !one_of({"bdpt", "vcm", "bpm", "mmlt", "pt-mis", "pt-mis3", "direct-mis"}))
+        return fmt::format("--mis chooses the heuristic of bdpt, vcm, bpm, mmlt, pt-mis, pt-mis3 and direct-mis; {} has its own", a);
     if (!r.vcm_merging && !r.vcm_connections) return "--no-merging and --no-connections together leave vcm no strategy";
     if ((!r.vcm_merging || !r.vcm_connections) && a != "vcm")
         return fmt::format("--no-merging and --no-connections switch off vcm's strategies, not {}'s", a);
@@ -165,8 +170,8 @@ static std::string option_refusal(const IntegratorInfo& info, const JobRequest& 
     if ((r.pbgi_surfels || r.pbgi_cutoff || r.pbgi_bounces || r.pbgi_resolution || r.pbgi_direct_samples || r.pbgi_spacing) && a != "pbgi")
         return fmt::format(
             "--pbgi-surfels, --pbgi-cutoff, --pbgi-bounces, --pbgi-resolution, --pbgi-direct-samples and --pbgi-spacing are pbgi's, not {}'s", a);
-    if ((r.mlt_chains || r.mlt_bootstrap || r.mlt_large_step || r.mlt_sigma) && a != "pssmlt")
-        return fmt::format("--chains, --bootstrap, --large-step and --sigma set pssmlt's Markov chains, not {}'s", a);
+    if ((r.mlt_chains || r.mlt_bootstrap || r.mlt_large_step || r.mlt_sigma) && !one_of({"pssmlt", "mmlt"}))
+        return fmt::format("--chains, --bootstrap, --large-step and --sigma set the Markov chains of pssmlt and mmlt, not {}'s", a);
     const auto out_of = [](const char* name, const auto& v, double lo, double hi) -> std::string {
         if (v && !(double(*v) >= lo && double(*v) <= hi)) return fmt::format("{} must be {:g} to {:g}, got {}", name, lo, hi, *v);
         return "";

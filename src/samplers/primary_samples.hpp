@@ -14,6 +14,11 @@
 // (X's value) and then mutated like the rest: the chain is exactly the one over infinitely many
 // numbers. (pbrt-v3's MLTSampler creates them as 0 and mutates from there, which is uniform only
 // after many small steps.)
+//
+// Streams: a state may hold several sequences of numbers (mmlt: the camera subpath's, the light
+// subpath's and the connection's), interleaved, so that a path reading more numbers in one does
+// not shift the numbers of the others (a small step then changes each subpath a little).
+// And a label: a discrete part of the state that the mutations leave alone (mmlt's path length).
 #pragma once
 
 #include <cmath>
@@ -28,17 +33,22 @@ namespace pathlab {
 class PrimarySamples {
 public:
     PrimarySamples() = default;
-    PrimarySamples(float sigma, float large_step_probability) : sigma_(sigma), large_step_probability_(large_step_probability) {}
+    static constexpr int kMaxStreams = 3;
+    PrimarySamples(float sigma, float large_step_probability, int streams = 1)
+        : sigma_(sigma), large_step_probability_(large_step_probability), streams_(streams) {}
 
     // An empty state whose numbers will come from the stream (a, b): the first iteration must be
     // a large step (its path is then a path of independent uniform numbers).
-    void restart(uint64_t a, uint64_t b) {
+    void restart(uint64_t a, uint64_t b, uint32_t label = 0) {
         rng_ = Pcg32(a, b);
         has_spare_ = false;
         numbers_.clear();
-        iteration_ = 0, last_large_ = 0, next_ = 0;
+        iteration_ = 0, last_large_ = 0;
         large_ = false;
+        label_ = label;
     }
+    uint32_t label() const { return label_; }
+    int streams() const { return streams_; }
     // The numbers drawn from now on (mutations and new numbers) come from the stream (a, b).
     void reseed(uint64_t a, uint64_t b) {
         rng_ = Pcg32(a, b);
@@ -49,18 +59,20 @@ public:
     void start_iteration(bool large) {
         ++iteration_;
         large_ = large;
-        next_ = 0;
+        for (size_t& n : next_) n = 0;
     }
     // Decides large or small from the state's own stream, then begins.
     void start_iteration() { start_iteration(rng_.next_float() < large_step_probability_); }
     bool large_step() const { return large_; }
 
-    float next1d() {
-        if (next_ == numbers_.size()) {
+    // The next number of stream `stream` (0 to streams - 1).
+    float next1d(int stream = 0) {
+        const size_t index = next_[stream]++ * size_t(streams_) + size_t(stream);
+        while (index >= numbers_.size()) {
             // A number the current state never read: X's value is a fresh uniform one.
             numbers_.push_back({rng_.next_float(), 0.0f, iteration_ - 1, 0});
         }
-        Number& n = numbers_[next_++];
+        Number& n = numbers_[index];
         if (n.modified < last_large_) {  // an accepted large step replaced it since
             n.value = rng_.next_float();
             n.modified = last_large_;
@@ -78,9 +90,9 @@ public:
         n.modified = iteration_;
         return n.value;
     }
-    Vec2f next2d() {
-        const float a = next1d();
-        return {a, next1d()};
+    Vec2f next2d(int stream = 0) {
+        const float a = next1d(stream);
+        return {a, next1d(stream)};
     }
 
     // The proposal becomes the state.
@@ -116,9 +128,11 @@ private:
 
     float sigma_ = 0.01f, large_step_probability_ = 0.3f;
     Pcg32 rng_{0, 0};
-    std::vector<Number> numbers_;
+    int streams_ = 1;
+    std::vector<Number> numbers_;  // stream k's i-th number at i * streams_ + k
     uint64_t iteration_ = 0, last_large_ = 0;
-    size_t next_ = 0;
+    size_t next_[kMaxStreams] = {};
+    uint32_t label_ = 0;
     bool large_ = false;
     float spare_ = 0;
     bool has_spare_ = false;

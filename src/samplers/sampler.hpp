@@ -34,12 +34,13 @@ public:
           reversed_index_(reverse_bits(uint32_t(sample_index))),
           pixel_hash_(mix64(seed ^ mix64(pixel_index ^ 0x243f6a8885a308d3ull))) {}
 
-    // The numbers of a primary-sample-space state, in the order the path reads them.
-    explicit Sampler(PrimarySamples& state) : rng_(0, 0), kind_(SamplerKind::Primary), reversed_index_(0), pixel_hash_(0), state_(&state) {}
+    // The numbers of a primary-sample-space state's stream, in the order the path reads them.
+    explicit Sampler(PrimarySamples& state, int stream = 0)
+        : rng_(0, 0), kind_(SamplerKind::Primary), reversed_index_(0), dimension_(uint32_t(stream)), pixel_hash_(0), state_(&state) {}
 
     float next1d() {
         if (kind_ == SamplerKind::Independent) return rng_.next_float();
-        if (kind_ == SamplerKind::Primary) return state_->next1d();
+        if (kind_ == SamplerKind::Primary) return state_->next1d(int(dimension_));
         const uint64_t h = dimension_hash();
         return fixed_to_float(scrambled_dimension0(shuffled_index(uint32_t(h)), uint32_t(h >> 32)));
     }
@@ -48,7 +49,7 @@ public:
             const float a = rng_.next_float();
             return {a, rng_.next_float()};
         }
-        if (kind_ == SamplerKind::Primary) return state_->next2d();
+        if (kind_ == SamplerKind::Primary) return state_->next2d(int(dimension_));
         const uint64_t h = dimension_hash();
         const uint32_t i = shuffled_index(uint32_t(h));
         const uint32_t seed1 = uint32_t((h * 0xd1342543de82ef95ull) >> 32);  // a third seed
@@ -60,9 +61,9 @@ public:
     // what an integrator draws there does not shift this stream's dimensions. volpath draws
     // its free-flight distances there, so that a path through no medium uses exactly the
     // numbers pt-mis uses. (Keyed by the sample index's low 32 bits.)
-    // A primary-sample-space sampler has one stream: its fork reads on from the same state.
+    // A primary-sample-space sampler's fork reads on from the same state and stream.
     Sampler fork(uint64_t stream) const {
-        if (kind_ == SamplerKind::Primary) return Sampler(*state_);
+        if (kind_ == SamplerKind::Primary) return Sampler(*state_, int(dimension_));
         return Sampler(pixel_hash_, stream, reverse_bits(reversed_index_), kind_);
     }
 
@@ -76,7 +77,7 @@ private:
     Pcg32 rng_;
     SamplerKind kind_;
     uint32_t reversed_index_;  // bit-reversed sample index
-    uint32_t dimension_ = 0;
+    uint32_t dimension_ = 0;  // (Primary: the state's stream)
     uint64_t pixel_hash_;
     PrimarySamples* state_ = nullptr;
 };

@@ -204,6 +204,14 @@ int Bdpt<T>::sample_hero(const RenderContext& ctx, size_t pixel, uint64_t pass, 
 template <class T>
 void Bdpt<T>::camera_subpath(const RenderContext& ctx, size_t pixel, Sampler& sampler, const Wavelengths& wl, Subpath& path,
                              const Vec2f* shift, const MergeMis* vm, int hero) const {
+    const Vec2f jitter = shift ? (sampler.next2d(), *shift) : sampler.next2d();
+    const float x = float(pixel % size_t(ctx.width)), y = float(pixel / size_t(ctx.width));
+    camera_subpath_at(ctx, {x + jitter.x, y + jitter.y}, sampler, wl, path, max_camera_vertices(), vm, hero);
+}
+
+template <class T>
+void Bdpt<T>::camera_subpath_at(const RenderContext& ctx, Vec2f raster, Sampler& sampler, const Wavelengths& wl, Subpath& path,
+                                int max_vertices, const MergeMis* vm, int hero) const {
     path.clear();
     Vertex c;
     c.kind = VertexKind::Camera;
@@ -212,18 +220,16 @@ void Bdpt<T>::camera_subpath(const RenderContext& ctx, size_t pixel, Sampler& sa
     c.pdf_fwd = 1;
     c.medium = ctx.scene.camera_medium();
     path.push_back(c);
-    const Vec2f jitter = shift ? (sampler.next2d(), *shift) : sampler.next2d();
-    const float x = float(pixel % size_t(ctx.width)), y = float(pixel / size_t(ctx.width));
-    const Ray ray = ctx.camera.generate(x + jitter.x, y + jitter.y);
+    const Ray ray = ctx.camera.generate(raster.x, raster.y);
     // We cos / (pdfA pdfW) = 1 for the pinhole: the camera path starts with throughput 1.
-    random_walk(ctx, ray, sampler, Colour(1.0f), ctx.camera.pdf_direction(ray.d), max_camera_vertices(), TransportMode::Radiance, wl, path,
+    random_walk(ctx, ray, sampler, Colour(1.0f), ctx.camera.pdf_direction(ray.d), max_vertices, TransportMode::Radiance, wl, path,
                 c.medium, hero);
     set_running_mis(path.data(), int(path.size()), /*light_side=*/false, MisRules(options_.mis_power, vm));
 }
 
 template <class T>
 void Bdpt<T>::light_subpath(const RenderContext& ctx, Sampler& sampler, const Wavelengths& wl, Subpath& path, const MergeMis* vm,
-                            int hero) const {
+                            int hero, int max_vertices) const {
     path.clear();
     const Scene& scene = ctx.scene;
     const auto start = start_light_path(scene, sampler);
@@ -246,7 +252,7 @@ void Bdpt<T>::light_subpath(const RenderContext& ctx, Sampler& sampler, const Wa
     path.push_back(l);
     const Colour beta = l.beta * (es->cos / (choice.pmf * es->pdfA * es->pdfW));
     const Ray ray = (flags & kLightSurface) ? spawn_ray(es->origin, es->normal, es->direction) : Ray{es->origin, es->direction, kInf};
-    random_walk(ctx, ray, sampler, beta, es->pdfW, max_light_vertices(), TransportMode::Importance, wl, path, l.medium, hero);
+    random_walk(ctx, ray, sampler, beta, es->pdfW, max_vertices < 0 ? max_light_vertices() : max_vertices, TransportMode::Importance, wl, path, l.medium, hero);
     if (l.infinite) {
         // From infinity the first hit's density is that of the entry disk, projected; the light
         // vertex's own density is that of its direction under light sampling.

@@ -119,8 +119,12 @@ public:
     // sample (sample_hero; -1: drawn from the subpath's own stream).
     void camera_subpath(const RenderContext& ctx, size_t pixel, Sampler& sampler, const Wavelengths& wl, Subpath& path,
                         const Vec2f* shift = nullptr, const MergeMis* vm = nullptr, int hero = -1) const;
+    // `max_vertices` (mmlt): at most this many vertices (-1: as many as --max-depth allows).
     void light_subpath(const RenderContext& ctx, Sampler& sampler, const Wavelengths& wl, Subpath& path,
-                       const MergeMis* vm = nullptr, int hero = -1) const;
+                       const MergeMis* vm = nullptr, int hero = -1, int max_vertices = -1) const;
+    // The camera subpath through the raster position `raster` (mmlt's), of at most max_vertices vertices.
+    void camera_subpath_at(const RenderContext& ctx, Vec2f raster, Sampler& sampler, const Wavelengths& wl, Subpath& path,
+                           int max_vertices, const MergeMis* vm = nullptr, int hero = -1) const;
     // The hero channel of a pixel sample in a scene with media (from a stream of its own; RGB
     // draws one of the three, spectral mode's hero is its first wavelength), else -1.
     static int sample_hero(const RenderContext& ctx, size_t pixel, uint64_t pass, const Wavelengths& wl);

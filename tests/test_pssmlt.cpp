@@ -11,11 +11,13 @@
 
 #include "chi2.hpp"
 #include "integrators/mlt/pssmlt.hpp"
+#include "integrators/path/volpath.hpp"
 #include "job/render_job.hpp"
 #include "job/usage_error.hpp"
 #include "judge/image_statistics.hpp"
 #include "render_helpers.hpp"
 #include "samplers/sampler.hpp"
+#include "scene_helpers.hpp"
 
 namespace pathlab::test {
 namespace {
@@ -205,6 +207,19 @@ INSTANTIATE_TEST_SUITE_P(Scenes, PssmltAgreement, ::testing::Values(0, 1, 2, 3, 
 TEST(PssmltAgreement, ConvergesInSpectralMode) {
     Pssmlt<SpectralTransport> mlt(mlt_options(true));
     const AgreementResult r = compare_with_pt_mis(5, mlt, 2048, true);
+    EXPECT_TRUE(r.agree) << r.describe();
+}
+
+// In a scene with media the chains' paths are volpath's: the light box in chromatic fog.
+TEST(PssmltAgreement, ConvergesToVolpathInFog) {
+    SceneDescription d = make_builtin_scene(4);
+    d.media.push_back(HomogeneousMedium{Rgb(0.5f, 0.6f, 0.7f), Rgb(0.4f, 0.45f, 0.6f), HgPhase{0.4f}});
+    d.meshes.push_back(fog_box(0));
+    Pssmlt<RgbTransport> mlt(mlt_options());
+    const RenderResult a = render_integrator(d, mlt, 8, 8, 4096, 401);
+    const auto volpath = make_volpath({});
+    const RenderResult b = render_integrator(d, *volpath, 8, 8, 4096, 402);
+    const AgreementResult r = test_agreement(a.film.mean(), a.film.standard_error(), b.film.mean(), b.film.standard_error(), kAgreement);
     EXPECT_TRUE(r.agree) << r.describe();
 }
 

@@ -239,11 +239,11 @@ TEST_F(SceneFileMedia, IntegratorsWithoutMediaRefuseScenesWithMedia) {
             }
             EXPECT_TRUE(contains(message, info.name + " does not render participating media")) << message;
             EXPECT_TRUE(contains(message, where)) << message;
-            EXPECT_TRUE(contains(message, "The integrators that render media: lt, bdpt, pm, ppm, sppm, bpm, vcm, volpath, mmlt")) << message;
+            EXPECT_TRUE(contains(message, "The integrators that render media: lt, bdpt, pm, ppm, sppm, bpm, vcm, volpath, pssmlt, mmlt")) << message;
             ++refusing;
         }
     }
-    EXPECT_EQ(refusing, 2 * (int(integrators().size()) - 9));  // all but lt, bdpt, pm, ppm, sppm, bpm, vcm, volpath, mmlt
+    EXPECT_EQ(refusing, 2 * (int(integrators().size()) - 10));  // all but lt, bdpt, pm, ppm, sppm, bpm, vcm, volpath, pssmlt, mmlt
     // From the command line: exit code 2, and `pathlab algorithms` says which render media.
     std::ofstream(path("fog.xml")) << "<scene version=\"3.0.0\">\n<medium type=\"homogeneous\" id=\"fog\"/>\n"
                                       "<shape type=\"cube\"><ref name=\"interior\" id=\"fog\"/></shape>\n" + rest + "</scene>\n";
@@ -268,7 +268,7 @@ TEST_F(SceneFileMedia, IntegratorsWithoutMediaRefuseScenesWithMedia) {
     EXPECT_TRUE(contains(other.err, "--volume-estimate chooses how sppm, ppm and pm gather photons in media")) << other.err;
     EXPECT_FALSE(fs::exists(path("bad.exr")));
     const CliResult list = run({"algorithms"});
-    EXPECT_TRUE(contains(list.out, "Participating media (scenes with a <medium>): lt, bdpt, pm, ppm, sppm, bpm, vcm, volpath, mmlt;")) << list.out;
+    EXPECT_TRUE(contains(list.out, "Participating media (scenes with a <medium>): lt, bdpt, pm, ppm, sppm, bpm, vcm, volpath, pssmlt, mmlt;")) << list.out;
 }
 
 }  // namespace

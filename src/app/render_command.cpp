@@ -138,12 +138,12 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
     app.add_option("--pbgi-direct-samples", o.pbgi_direct_samples, "pbgi: MIS pairs for each surfel side's direct light (default 16)");
     app.add_option("--pbgi-spacing", o.pbgi_spacing, "pbgi: pixels between the gathers at the first hits, interpolated between (default 2)");
     app.add_option("--chains", o.mlt_chains,
-                   "pssmlt: Markov chains per pass (a fixed number, so the image does not depend on the threads; default 64)");
+                   "pssmlt, mmlt: Markov chains per pass (a fixed number, so the image does not depend on the threads; default 64)");
     app.add_option("--bootstrap", o.mlt_bootstrap,
-                   "pssmlt: independent paths of each pass's bootstrap, which estimates the normalisation b and starts the chains "
+                   "pssmlt, mmlt: independent paths of each pass's bootstrap, which estimates the normalisation b and starts the chains "
                    "(default 4096)");
-    app.add_option("--large-step", o.mlt_large_step, "pssmlt: the probability of a large step (every number fresh; default 0.3)");
-    app.add_option("--sigma", o.mlt_sigma, "pssmlt: the small steps' standard deviation in primary sample space (default 0.01)");
+    app.add_option("--large-step", o.mlt_large_step, "pssmlt, mmlt: the probability of a large step (every number fresh; default 0.3)");
+    app.add_option("--sigma", o.mlt_sigma, "pssmlt, mmlt: the small steps' standard deviation in primary sample space (default 0.01)");
     app.add_option("--checkpoint", o.checkpoint,
                    "Save the render's whole state to this file (atomically) every --checkpoint-every seconds, at the end and "
                    "when interrupted, to continue it with --resume (placeholders as for -o)");

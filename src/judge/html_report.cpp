@@ -168,6 +168,32 @@ std::string inset_html(const std::string& stem, const PixelRect& c, const std::s
                        xml_escape(stem), c.width * scale, c.height * scale, caption);
 }
 
+// Per pixel, the standard error over the reference (each the mean of its three channels): how
+// far from converged each part of the image is, in proportion to its brightness. Pixels
+// darker than 1% of the reference's mean are left at 0 (their relative error says little);
+// `median` and `p90` get the 50th and 90th percentiles over the others.
+Image relative_error(const Image& se, const Image& reference, double& median, double& p90) {
+    Image out(se.width(), se.height());
+    double mean = 0;
+    for (size_t p = 0; p < reference.pixel_count(); ++p) mean += (reference[p][0] + reference[p][1] + reference[p][2]) / 3;
+    mean /= double(std::max<size_t>(1, reference.pixel_count()));
+    std::vector<double> values;
+    for (size_t p = 0; p < se.pixel_count(); ++p) {
+        const double ref = (reference[p][0] + reference[p][1] + reference[p][2]) / 3.0, s = (se[p][0] + se[p][1] + se[p][2]) / 3.0;
+        if (!(ref > 0.01 * mean) || !std::isfinite(s)) continue;
+        const float r = float(s / ref);
+        out[p] = Rgb(r, r, r);
+        values.push_back(r);
+    }
+    median = p90 = 0;
+    if (!values.empty()) {
+        std::sort(values.begin(), values.end());
+        median = values[values.size() / 2];
+        p90 = values[std::min(values.size() - 1, values.size() * 9 / 10)];
+    }
+    return out;
+}
+
 std::string csv_field(const std::string& s) {
     if (s.find_first_of(",\"\n") == std::string::npos) return s;
     std::string out = "\"";
@@ -228,7 +254,20 @@ std::vector<std::string> write_html_report(const ReportData& data, const std::st
     const size_t most_efficient =
         efficiencies.empty() ? 0 : size_t(std::max_element(efficiencies.begin(), efficiencies.end()) - efficiencies.begin());
 
-    std::string images, errors, std_errors, insets;
+    // The relative errors, on one scale: the largest of the renders' 90th percentiles.
+    std::vector<Image> relative(data.renders.size());
+    std::vector<std::pair<double, double>> relative_percentiles(data.renders.size());
+    double relative_scale = 0;
+    for (size_t i = 0; i < data.renders.size(); ++i) {
+        const ReportRender& r = data.renders[i];
+        if (r.std_error.pixel_count() != r.mean.pixel_count() || r.mean.pixel_count() != data.reference.pixel_count()) continue;
+        auto& [median, p90] = relative_percentiles[i];
+        relative[i] = relative_error(r.std_error, data.reference, median, p90);
+        relative_scale = std::max(relative_scale, p90);
+    }
+    if (!(relative_scale > 0)) relative_scale = 1;
+
+    std::string images, errors, std_errors, relative_errors, insets;
     images += figure_html({write_exposures(data.reference, "reference"), "", "reference",
                            "<b>reference</b><br>" + xml_escape(data.reference_label)},
                           w, h, data.crops);
@@ -258,6 +297,12 @@ std::vector<std::string> write_html_report(const ReportData& data, const std::st
                                                        return n ? sum / double(n) : 0.0;
                                                    }())},
                                       w, h);
+        if (relative[i].pixel_count() > 0)
+            relative_errors += figure_html({"", write_png(false_colour_magnitude(relative[i], relative_scale), name + "_relerror.png"),
+                                            r.algorithm + " relative error",
+                                            fmt::format("<b>{}</b><br>median {:.3g}, 90th percentile {:.3g}", xml_escape(r.algorithm),
+                                                        relative_percentiles[i].first, relative_percentiles[i].second)},
+                                           w, h);
         for (size_t k = 0; k < data.crops.size(); ++k)
             inset_rows[k] += inset_html(write_exposures(crop(r.mean, data.crops[k]), fmt::format("{}_crop{}", name, k)), data.crops[k],
                                         fmt::format("<b>{}</b>", xml_escape(r.algorithm)));
@@ -321,7 +366,18 @@ std::vector<std::string> write_html_report(const ReportData& data, const std::st
                           "mean of its three channels), on one scale for all: where an estimator is noisy. Red: NaN/Inf.</p>\n"
                           "<div class=\"bar\"><span>0</span><img src=\"{}\" alt=\"colour scale\"><span>{:.3g}</span></div>\n"
                           "<div class=\"grid\">\n{}</div>\n",
-                          xml_escape(se_bar), se_scale, std_errors);
+                          xml_escape(se_bar), se_scale, std_errors) +
+                  (relative_errors.empty()
+                       ? ""
+                       : fmt::format("<h2>Per-pixel relative error</h2>\n<p>Each pixel's standard error over the reference's value: how "
+                                     "evenly an estimator converges. Markov chains (pssmlt, mmlt) spend their mutations in proportion to "
+                                     "brightness, so their dim regions lag; bdpt's error follows its strategies instead. The standard "
+                                     "errors are over independent passes (every estimator's passes are, pssmlt's and mmlt's too: each "
+                                     "pass starts its chains afresh), so one render measures them. Black: pixels darker than 1% of the "
+                                     "reference's mean.</p>\n"
+                                     "<div class=\"bar\"><span>0</span><img src=\"{}\" alt=\"colour scale\"><span>{:.3g}</span></div>\n"
+                                     "<div class=\"grid\">\n{}</div>\n",
+                                     xml_escape(se_bar), relative_scale, relative_errors));
 
     const std::string html = fmt::format(
         R"(<!DOCTYPE html>

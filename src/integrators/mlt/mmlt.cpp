@@ -102,6 +102,22 @@ PassCounters Mmlt<T>::render_passes(const RenderContext& ctx, Film& film, uint64
 template class Mmlt<RgbTransport>;
 template class Mmlt<SpectralTransport>;
 
+namespace {
+
+// The path tracers' parameters, but a finite depth needed and no Russian roulette.
+std::vector<ParamInfo> mmlt_params() {
+    std::vector<ParamInfo> p = path_params();
+    for (ParamInfo& i : p) {
+        if (i.name == "max_depth")
+            i.doc = "longest path in Mitsuba's convention, 2 direct light only (pathlab's bounces: max_depth - 1); -1 (unlimited) is "
+                            "refused: the chains run per path length";
+        if (i.name == "rr_depth") i.doc = "accepted and ignored: mmlt's subpaths have the lengths of its states (no Russian roulette)";
+    }
+    return p;
+}
+
+}  // namespace
+
 const IntegratorInfo& mmlt_integrator() {
     static const IntegratorInfo info = [] {
         IntegratorInfo i{"mmlt",
@@ -110,7 +126,7 @@ const IntegratorInfo& mmlt_integrator() {
                          "that choose the strategy as part of the state, expected-value splatting",
                          false,
                          true,
-                         path_params(),
+                         mmlt_params(),
                          [](const IntegratorOptions& o) { return make_for_transport<Mmlt>(o); },
                          /*any_camera=*/false};
         i.media = true;

@@ -4,7 +4,9 @@
 // spectral mode, and every number the path tracer draws), and Markov chains over X
 // (samplers/primary_samples.hpp: large and small steps) visit paths in proportion to their
 // scalar contribution I(X) (the luminance of |R|, |G|, |B|, so that I > 0 wherever the path
-// carries light).
+// carries light). In a scene with participating media the path is volpath's instead (pt-mis
+// extended to media: its distances, hero channel and transmittance estimates read the same
+// numbers).
 //
 // The chains, their bootstrap and their splatting are markov_chains.hpp's; each state has one
 // stream of numbers and no label.
@@ -15,12 +17,16 @@
 
 #include "integrators/integrators.hpp"
 #include "integrators/path/pt_mis.hpp"
+#include "integrators/path/volpath.hpp"
 
 namespace pathlab {
 
 template <class T>
 Pssmlt<T>::Pssmlt(const IntegratorOptions& o, ChainFaults faults)
-    : options_(limited_to_length(o)), rules_(options_), chains_(options_, /*streams=*/1, /*labels=*/1, faults) {}
+    : options_(limited_to_length(o)),
+      rules_(options_),
+      chains_(options_, /*streams=*/1, /*labels=*/1, faults),
+      volpath_(make_volpath(options_)) {}
 
 template <class T>
 ChainSample Pssmlt<T>::evaluate(const RenderContext& ctx, PrimarySamples& state) const {
@@ -32,7 +38,9 @@ ChainSample Pssmlt<T>::evaluate(const RenderContext& ctx, PrimarySamples& state)
     const Ray ray = ctx.camera.needs_lens_sample() ? ctx.camera.generate(p.raster.x, p.raster.y, sampler.next2d())
                                                    : ctx.camera.generate(p.raster.x, p.raster.y);
     WavelengthsOf<T> wl = T::camera_wavelengths(sampler);
-    const auto L = pt_mis_camera_radiance(ctx.scene, ray, sampler, rules_, wl, false, options_.only_length, options_.hide_emitters);
+    const auto L = ctx.scene.has_media()
+                       ? static_cast<const PixelIntegrator<T>&>(*volpath_).radiance(ctx.scene, ray, sampler, wl)
+                       : pt_mis_camera_radiance(ctx.scene, ray, sampler, rules_, wl, false, options_.only_length, options_.hide_emitters);
     p.colour = film_colour(L, wl);
     if (!is_finite(p.colour)) {
         p.colour = Vec3d(0.0), p.invalid = true;
@@ -60,13 +68,14 @@ const IntegratorInfo& pssmlt_integrator() {
     static const IntegratorInfo info = [] {
         IntegratorInfo i{"pssmlt",
                          {},
-                         "primary-sample-space Metropolis light transport (Kelemen 2002) over pt-mis: Markov chains of large and small steps, "
-                         "expected-value splatting",
+                         "primary-sample-space Metropolis light transport (Kelemen 2002) over pt-mis (volpath in media): Markov chains of "
+                         "large and small steps, expected-value splatting",
                          false,
                          true,
                          path_params(),
                          [](const IntegratorOptions& o) { return make_for_transport<Pssmlt>(o); }};
         i.samples_lights = true;
+        i.media = true;
         return i;
     }();
     return info;

@@ -1,6 +1,7 @@
 // pssmlt: primary-sample-space Metropolis light transport over pt-mis (pssmlt.cpp says how).
 #pragma once
 
+#include <memory>
 #include <vector>
 
 #include "integrators/common/path_rules.hpp"
@@ -24,6 +25,7 @@ private:
     IntegratorOptions options_;
     PathRules rules_;
     MarkovChains chains_;
+    std::unique_ptr<Integrator> volpath_;  // the paths in a scene with media
 };
 extern template class Pssmlt<RgbTransport>;
 extern template class Pssmlt<SpectralTransport>;

@@ -7,8 +7,10 @@
 #include <string>
 
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include "job/render_job.hpp"
+#include "job/usage_error.hpp"
 #include "job/renderer.hpp"
 #include "judge/image_statistics.hpp"
 #include "scene/builtin_scenes.hpp"
@@ -67,6 +69,47 @@ inline RenderResult render_integrator(const SceneDescription& d, Integrator& int
     RenderSettings rs;
     rs.width = width, rs.height = height, rs.spp = spp, rs.seed = seed;
     return render(*scene, integrator, rs);
+}
+
+// Built-in scene `scene` at 12x8, seed 9, rendered by `integrator` on `threads` threads; with
+// `into`, added to that film from sample `first` on (a render continued where another stopped).
+inline RenderResult render_on_threads(Integrator& integrator, int scene, int threads, uint64_t spp, uint64_t first = 0,
+                                      Film* into = nullptr) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+    const auto built = Scene::build(make_builtin_scene(scene));
+    RenderSettings rs;
+    rs.width = 12, rs.height = 8, rs.spp = spp, rs.seed = 9, rs.first_sample = first;
+    if (into) {
+        RenderResult r;
+        r.stats = render_into(*built, integrator, rs, *into);
+        return r;
+    }
+    return render(*built, integrator, rs);
+}
+
+// Why RenderJob refuses request q on course scene 4 ("" when it accepts it).
+inline std::string refusal_of(const JobRequest& q) {
+    try {
+        RenderJob job(4, q);
+    } catch (const UsageError& e) {
+        return e.what();
+    }
+    return "";
+}
+
+// `make()`'s integrator gives the same film on scene 3 with 1 and 2 threads, and when 7 passes
+// are continued by 9 more.
+template <class Make>
+void expect_same_bytes_on_threads_and_continued(Make make) {
+    const auto run = [&](int threads, uint64_t spp, uint64_t first = 0, Film* into = nullptr) {
+        const auto integrator = make();
+        return render_on_threads(*integrator, 3, threads, spp, first, into);
+    };
+    const RenderResult one = run(1, 16), two = run(2, 16);
+    EXPECT_TRUE(one.film.identical(two.film));
+    RenderResult half = run(2, 7);
+    run(1, 9, 7, &half.film);
+    EXPECT_TRUE(half.film.identical(one.film));
 }
 
 inline bool bit_identical(const Image& a, const Image& b) {

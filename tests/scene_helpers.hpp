@@ -9,6 +9,7 @@
 #include "geometry/shape_meshes.hpp"
 #include "media/medium.hpp"
 #include "media/volume.hpp"
+#include "scene/builtin_scenes.hpp"
 #include "scene/scene_description.hpp"
 
 namespace pathlab::test {
@@ -55,6 +56,14 @@ inline MeshDesc fog_box(int32_t medium) {
     m.media.interior = medium;
     m.media.index_matched = true;
     return m;
+}
+
+// The course's light box (scene 4) filled with chromatic fog, the camera outside it.
+inline SceneDescription light_box_in_fog() {
+    SceneDescription d = make_builtin_scene(4);
+    d.media.push_back(HomogeneousMedium{Rgb(0.5f, 0.6f, 0.7f), Rgb(0.4f, 0.45f, 0.6f), HgPhase{0.4f}});
+    d.meshes.push_back(fog_box(0));
+    return d;
 }
 
 // Turns the scene's last sphere (the course scenes' blue ball) into glass of index 1.5 filled with

@@ -47,12 +47,7 @@ struct MediaScene {
 
 std::vector<MediaScene> media_scenes() {
     std::vector<MediaScene> scenes;
-    {  // The light box in chromatic fog, the camera outside it.
-        SceneDescription d = make_builtin_scene(4);
-        d.media.push_back(HomogeneousMedium{Rgb(0.5f, 0.6f, 0.7f), Rgb(0.4f, 0.45f, 0.6f), HgPhase{0.4f}});
-        d.meshes.push_back(fog_box(0));
-        scenes.push_back({"light box in fog", d});
-    }
+    scenes.push_back({"light box in fog", light_box_in_fog()});
     {  // Glossy walls, the whole world a medium: the camera and the emitter (a small ball in place
        // of the course's point light: a point light in a scattering medium gives every estimator
        // infinite variance, the 1 / d^2 of the points around it, and no z-test can hold there).

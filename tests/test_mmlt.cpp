@@ -90,9 +90,7 @@ TEST(MmltAgreement, ConvergesInSpectralMode) {
 // The light box in chromatic fog: the subpaths scatter in the medium and the connections carry
 // its transmittance (bdpt's media-aware strategies).
 TEST(MmltAgreement, ConvergesInFog) {
-    SceneDescription d = make_builtin_scene(4);
-    d.media.push_back(HomogeneousMedium{Rgb(0.5f, 0.6f, 0.7f), Rgb(0.4f, 0.45f, 0.6f), HgPhase{0.4f}});
-    d.meshes.push_back(fog_box(0));
+    const SceneDescription d = light_box_in_fog();
     Mmlt<RgbTransport> mlt(mlt_options());
     const AgreementResult r = compare_with_bdpt(d, mlt, 2048);
     EXPECT_TRUE(r.agree) << r.describe();
@@ -144,49 +142,23 @@ TEST(MmltAgreement, StandardErrorsMatchTheSpreadOverSeeds) {
     EXPECT_TRUE(r.agree) << r.describe();
 }
 
-RenderResult mlt_render(int threads, uint64_t spp, uint64_t first = 0, Film* into = nullptr) {
-    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
-    const auto scene = Scene::build(make_builtin_scene(3));
-    Mmlt<RgbTransport> mlt(mlt_options());
-    RenderSettings rs;
-    rs.width = 12, rs.height = 8, rs.spp = spp, rs.seed = 9, rs.first_sample = first;
-    if (into) {
-        RenderResult r;
-        r.stats = render_into(*scene, mlt, rs, *into);
-        return r;
-    }
-    return render(*scene, mlt, rs);
-}
-
 TEST(Mmlt, SameBytesWithOneAndTwoThreadsAndWhenContinued) {
-    const RenderResult one = mlt_render(1, 16), two = mlt_render(2, 16);
-    EXPECT_TRUE(one.film.identical(two.film));
-    RenderResult half = mlt_render(2, 7);
-    mlt_render(1, 9, 7, &half.film);
-    EXPECT_TRUE(half.film.identical(one.film));
+    expect_same_bytes_on_threads_and_continued([] { return std::make_unique<Mmlt<RgbTransport>>(mlt_options()); });
 }
 
 TEST(Mmlt, NeedsAFiniteDepthAndTakesTheChainOptions) {
-    const auto refused = [](JobRequest q) -> std::string {
-        try {
-            RenderJob j(4, q);
-        } catch (const UsageError& e) {
-            return e.what();
-        }
-        return "";
-    };
     JobRequest r;
     r.algorithm = "mmlt";
-    EXPECT_NE(refused(r).find("mmlt needs a finite --max-depth"), std::string::npos) << refused(r);
+    EXPECT_NE(refusal_of(r).find("mmlt needs a finite --max-depth"), std::string::npos) << refusal_of(r);
     r.max_depth = 6;
     r.mlt_chains = 8, r.mlt_bootstrap = 100, r.mlt_large_step = 0.5f, r.mlt_sigma = 0.05f, r.mis_power = true;
-    EXPECT_EQ(refused(r), "");
+    EXPECT_EQ(refusal_of(r), "");
     RenderJob job(4, r);
     EXPECT_EQ(job.integrator_options().mlt_chains, 8);
     EXPECT_EQ(job.integrator_options().mlt_bootstrap, 100);
     JobRequest sobol = r;
     sobol.sampler = SamplerKind::Sobol;
-    EXPECT_NE(refused(sobol).find("mmlt takes no --sampler sobol"), std::string::npos) << refused(sobol);
+    EXPECT_NE(refusal_of(sobol).find("mmlt takes no --sampler sobol"), std::string::npos) << refusal_of(sobol);
 }
 
 }  // namespace

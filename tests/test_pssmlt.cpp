@@ -212,9 +212,7 @@ TEST(PssmltAgreement, ConvergesInSpectralMode) {
 
 // In a scene with media the chains' paths are volpath's: the light box in chromatic fog.
 TEST(PssmltAgreement, ConvergesToVolpathInFog) {
-    SceneDescription d = make_builtin_scene(4);
-    d.media.push_back(HomogeneousMedium{Rgb(0.5f, 0.6f, 0.7f), Rgb(0.4f, 0.45f, 0.6f), HgPhase{0.4f}});
-    d.meshes.push_back(fog_box(0));
+    const SceneDescription d = light_box_in_fog();
     Pssmlt<RgbTransport> mlt(mlt_options());
     const RenderResult a = render_integrator(d, mlt, 8, 8, 4096, 401);
     const auto volpath = make_volpath({});
@@ -231,26 +229,8 @@ TEST(PssmltAgreement, DetectsAMissingRejectionWeight) {
     EXPECT_FALSE(compare_with_pt_mis(4, mlt, 1024).agree);
 }
 
-RenderResult mlt_render(int threads, uint64_t spp, uint64_t first = 0, Film* into = nullptr) {
-    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
-    const auto scene = Scene::build(make_builtin_scene(3));
-    Pssmlt<RgbTransport> mlt(mlt_options());
-    RenderSettings rs;
-    rs.width = 12, rs.height = 8, rs.spp = spp, rs.seed = 9, rs.first_sample = first;
-    if (into) {
-        RenderResult r;
-        r.stats = render_into(*scene, mlt, rs, *into);
-        return r;
-    }
-    return render(*scene, mlt, rs);
-}
-
 TEST(Pssmlt, SameBytesWithOneAndTwoThreadsAndWhenContinued) {
-    const RenderResult one = mlt_render(1, 16), two = mlt_render(2, 16);
-    EXPECT_TRUE(one.film.identical(two.film));
-    RenderResult half = mlt_render(2, 7);
-    mlt_render(1, 9, 7, &half.film);
-    EXPECT_TRUE(half.film.identical(one.film));
+    expect_same_bytes_on_threads_and_continued([] { return std::make_unique<Pssmlt<RgbTransport>>(mlt_options()); });
 }
 
 TEST(Pssmlt, OptionsAreItsOwnAndChecked) {
@@ -260,23 +240,15 @@ TEST(Pssmlt, OptionsAreItsOwnAndChecked) {
     RenderJob job(4, r);
     EXPECT_EQ(job.integrator_options().mlt_chains, 8);
     EXPECT_EQ(job.integrator_options().mlt_bootstrap, 100);
-    const auto refused = [](JobRequest q) -> std::string {
-        try {
-            RenderJob j(4, q);
-        } catch (const UsageError& e) {
-            return e.what();
-        }
-        return "";
-    };
     JobRequest other;
     other.algorithm = "bdpt", other.mlt_chains = 8;
-    EXPECT_NE(refused(other).find("set the Markov chains of pssmlt and mmlt, not bdpt's"), std::string::npos) << refused(other);
+    EXPECT_NE(refusal_of(other).find("set the Markov chains of pssmlt and mmlt, not bdpt's"), std::string::npos) << refusal_of(other);
     JobRequest bad = r;
     bad.mlt_large_step = 1.5f;
-    EXPECT_NE(refused(bad).find("--large-step must be 0 to 1"), std::string::npos) << refused(bad);
+    EXPECT_NE(refusal_of(bad).find("--large-step must be 0 to 1"), std::string::npos) << refusal_of(bad);
     JobRequest sobol = r;
     sobol.sampler = SamplerKind::Sobol;
-    EXPECT_NE(refused(sobol).find("pssmlt takes no --sampler sobol"), std::string::npos) << refused(sobol);
+    EXPECT_NE(refusal_of(sobol).find("pssmlt takes no --sampler sobol"), std::string::npos) << refusal_of(sobol);
 }
 
 }  // namespace

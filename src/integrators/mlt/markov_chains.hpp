@@ -53,6 +53,12 @@ struct ChainSample {
     bool invalid = false;  // NaN or infinite (counted, and black)
 };
 
+// A state's path as the chains see it: its film colour at `raster`, and I (NaN or infinite:
+// counted, and black).
+ChainSample chain_sample(Vec2f raster, const Vec3d& film_colour);
+// The raster position of two uniform numbers: anywhere on the image.
+Vec2f raster_anywhere(const RenderContext& ctx, Vec2f u);
+
 // Deliberate errors, for the tests of the tests.
 struct ChainFaults {
     bool drop_current_weight = false;  // splat the proposals only, without the current state's (1 - a) / I(X)

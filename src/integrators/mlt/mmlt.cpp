@@ -48,9 +48,7 @@ ChainSample Mmlt<T>::evaluate(const RenderContext& ctx, PrimarySamples& state, i
     const int d = first_length_ + int(state.label());
     const int strategies = d == 0 ? 1 : d + 2;
     const int s = std::min(int(camera_numbers.next1d() * float(strategies)), strategies - 1), t = d + 2 - s;
-    const Vec2f u = camera_numbers.next2d();
-    const Vec2f raster{std::min(u.x * float(ctx.width), std::nextafter(float(ctx.width), 0.0f)),
-                       std::min(u.y * float(ctx.height), std::nextafter(float(ctx.height), 0.0f))};
+    const Vec2f raster = raster_anywhere(ctx, camera_numbers.next2d());
     const WavelengthsOf<T> wl = T::camera_wavelengths(camera_numbers);
     const int hero = ctx.scene.has_media() ? hero_channel(wl, [&] { return camera_numbers.next1d(); }) : -1;
     ChainSample p;
@@ -66,14 +64,8 @@ ChainSample Mmlt<T>::evaluate(const RenderContext& ctx, PrimarySamples& state, i
     }
     const StrategyResult<T> r = bdpt_.connect(ctx, light, s, camera, t, connection_numbers, wl);
     if (is_black(r.L)) return p;
-    if (r.splat) p.raster = r.raster;
-    p.colour = film_colour(r.L * (r.weight * (faults_.drop_strategy_count ? 1.0f : float(strategies))), wl);
-    if (!is_finite(p.colour)) {
-        p.colour = Vec3d(0.0), p.invalid = true;
-        return p;
-    }
-    p.contribution = mlt_contribution(p.colour);
-    return p;
+    return chain_sample(r.splat ? r.raster : raster,
+                        film_colour(r.L * (r.weight * (faults_.drop_strategy_count ? 1.0f : float(strategies))), wl));
 }
 
 template <class T>

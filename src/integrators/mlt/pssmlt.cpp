@@ -31,23 +31,14 @@ Pssmlt<T>::Pssmlt(const IntegratorOptions& o, ChainFaults faults)
 template <class T>
 ChainSample Pssmlt<T>::evaluate(const RenderContext& ctx, PrimarySamples& state) const {
     Sampler sampler(state);
-    const Vec2f u = sampler.next2d();
-    ChainSample p;
-    p.raster = {std::min(u.x * float(ctx.width), std::nextafter(float(ctx.width), 0.0f)),
-                std::min(u.y * float(ctx.height), std::nextafter(float(ctx.height), 0.0f))};
-    const Ray ray = ctx.camera.needs_lens_sample() ? ctx.camera.generate(p.raster.x, p.raster.y, sampler.next2d())
-                                                   : ctx.camera.generate(p.raster.x, p.raster.y);
+    const Vec2f raster = raster_anywhere(ctx, sampler.next2d());
+    const Ray ray = ctx.camera.needs_lens_sample() ? ctx.camera.generate(raster.x, raster.y, sampler.next2d())
+                                                   : ctx.camera.generate(raster.x, raster.y);
     WavelengthsOf<T> wl = T::camera_wavelengths(sampler);
     const auto L = ctx.scene.has_media()
                        ? static_cast<const PixelIntegrator<T>&>(*volpath_).radiance(ctx.scene, ray, sampler, wl)
                        : pt_mis_camera_radiance(ctx.scene, ray, sampler, rules_, wl, false, options_.only_length, options_.hide_emitters);
-    p.colour = film_colour(L, wl);
-    if (!is_finite(p.colour)) {
-        p.colour = Vec3d(0.0), p.invalid = true;
-        return p;
-    }
-    p.contribution = mlt_contribution(p.colour);
-    return p;
+    return chain_sample(raster, film_colour(L, wl));
 }
 
 template <class T>

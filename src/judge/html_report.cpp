@@ -169,18 +169,15 @@ std::string inset_html(const std::string& stem, const PixelRect& c, const std::s
 }
 
 // Per pixel, the standard error over the reference (each the mean of its three channels): how
-// far from converged each part of the image is, in proportion to its brightness. Pixels
-// darker than 1% of the reference's mean are left at 0 (their relative error says little);
-// `median` and `p90` get the 50th and 90th percentiles over the others.
-Image relative_error(const Image& se, const Image& reference, double& median, double& p90) {
+// far from converged each part of the image is, in proportion to its brightness. Pixels whose
+// reference is not above `darkest` are left at 0 (their relative error says little); `median`
+// and `p90` get the 50th and 90th percentiles over the others.
+Image relative_error(const Image& se, const Image& reference, double darkest, double& median, double& p90) {
     Image out(se.width(), se.height());
-    double mean = 0;
-    for (size_t p = 0; p < reference.pixel_count(); ++p) mean += (reference[p][0] + reference[p][1] + reference[p][2]) / 3;
-    mean /= double(std::max<size_t>(1, reference.pixel_count()));
     std::vector<double> values;
     for (size_t p = 0; p < se.pixel_count(); ++p) {
         const double ref = (reference[p][0] + reference[p][1] + reference[p][2]) / 3.0, s = (se[p][0] + se[p][1] + se[p][2]) / 3.0;
-        if (!(ref > 0.01 * mean) || !std::isfinite(s)) continue;
+        if (!(ref > darkest) || !std::isfinite(s)) continue;
         const float r = float(s / ref);
         out[p] = Rgb(r, r, r);
         values.push_back(r);
@@ -254,7 +251,12 @@ std::vector<std::string> write_html_report(const ReportData& data, const std::st
     const size_t most_efficient =
         efficiencies.empty() ? 0 : size_t(std::max_element(efficiencies.begin(), efficiencies.end()) - efficiencies.begin());
 
-    // The relative errors, on one scale: the largest of the renders' 90th percentiles.
+    // The relative errors, on one scale: the largest of the renders' 90th percentiles; pixels
+    // darker than 1% of the reference's mean left out.
+    double reference_mean = 0;
+    for (size_t p = 0; p < data.reference.pixel_count(); ++p)
+        reference_mean += (data.reference[p][0] + data.reference[p][1] + data.reference[p][2]) / 3.0;
+    reference_mean /= double(std::max<size_t>(1, data.reference.pixel_count()));
     std::vector<Image> relative(data.renders.size());
     std::vector<std::pair<double, double>> relative_percentiles(data.renders.size());
     double relative_scale = 0;
@@ -262,7 +264,7 @@ std::vector<std::string> write_html_report(const ReportData& data, const std::st
         const ReportRender& r = data.renders[i];
         if (r.std_error.pixel_count() != r.mean.pixel_count() || r.mean.pixel_count() != data.reference.pixel_count()) continue;
         auto& [median, p90] = relative_percentiles[i];
-        relative[i] = relative_error(r.std_error, data.reference, median, p90);
+        relative[i] = relative_error(r.std_error, data.reference, 0.01 * reference_mean, median, p90);
         relative_scale = std::max(relative_scale, p90);
     }
     if (!(relative_scale > 0)) relative_scale = 1;

@@ -48,7 +48,6 @@ public:
         label_ = label;
     }
     uint32_t label() const { return label_; }
-    int streams() const { return streams_; }
     // The numbers drawn from now on (mutations and new numbers) come from the stream (a, b).
     void reseed(uint64_t a, uint64_t b) {
         rng_ = Pcg32(a, b);

@@ -252,7 +252,8 @@ void Bdpt<T>::light_subpath(const RenderContext& ctx, Sampler& sampler, const Wa
     path.push_back(l);
     const Colour beta = l.beta * (es->cos / (choice.pmf * es->pdfA * es->pdfW));
     const Ray ray = (flags & kLightSurface) ? spawn_ray(es->origin, es->normal, es->direction) : Ray{es->origin, es->direction, kInf};
-    random_walk(ctx, ray, sampler, beta, es->pdfW, max_vertices < 0 ? max_light_vertices() : max_vertices, TransportMode::Importance, wl, path, l.medium, hero);
+    random_walk(ctx, ray, sampler, beta, es->pdfW, max_vertices < 0 ? max_light_vertices() : max_vertices, TransportMode::Importance, wl,
+                path, l.medium, hero);
     if (l.infinite) {
         // From infinity the first hit's density is that of the entry disk, projected; the light
         // vertex's own density is that of its direction under light sampling.

@@ -71,8 +71,6 @@ public:
     MarkovChains(const IntegratorOptions& o, int streams, int labels, ChainFaults faults = {})
         : options_(o), streams_(streams), labels_(labels), faults_(faults) {}
 
-    int chains() const { return int(states_.size()); }
-
     // `evaluate(ctx, state, chain)` -> ChainSample: the path of the state's numbers (read with
     // Sampler(state, stream)) and label; `chain` (0 to chains() - 1) names the caller's scratch
     // space, used by one thread at a time.

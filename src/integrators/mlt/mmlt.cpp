@@ -102,7 +102,7 @@ std::vector<ParamInfo> mmlt_params() {
     for (ParamInfo& i : p) {
         if (i.name == "max_depth")
             i.doc = "longest path in Mitsuba's convention, 2 direct light only (pathlab's bounces: max_depth - 1); -1 (unlimited) is "
-                            "refused: the chains run per path length";
+                    "refused: the chains run per path length";
         if (i.name == "rr_depth") i.doc = "accepted and ignored: mmlt's subpaths have the lengths of its states (no Russian roulette)";
     }
     return p;

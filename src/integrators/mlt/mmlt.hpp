@@ -19,9 +19,6 @@ public:
 
     // The path of a state's numbers at the path length of its label; `chain`'s subpath buffers.
     ChainSample evaluate(const RenderContext& ctx, PrimarySamples& state, int chain);
-    // The path lengths (bounces) the chains cover: first_length() + label.
-    int first_length() const { return first_length_; }
-    int lengths() const { return lengths_; }
 
 private:
     static IntegratorOptions bdpt_options(IntegratorOptions o);
@@ -29,7 +26,7 @@ private:
 
     IntegratorOptions options_;
     Bdpt<T> bdpt_;  // the subpaths, the connections and their MIS weights
-    int first_length_, lengths_;
+    int first_length_, lengths_;  // the chains' path lengths (bounces): first_length_ + label, label < lengths_
     MarkovChains chains_;
     ChainFaults faults_;
     std::vector<std::pair<typename Bdpt<T>::Subpath, typename Bdpt<T>::Subpath>> subpaths_;  // per chain: camera, light

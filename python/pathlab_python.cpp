@@ -235,7 +235,7 @@ void apply_estimator_options(JobRequest& r, const py::kwargs& options) {
     constexpr int kIntMax = std::numeric_limits<int>::max();
     static const char* const kNames =
         "mis, photons, radius, alpha, volume_estimate, no_merging, no_connections, ic_rays, ic_error, ic_no_gradients, pbgi_surfels, "
-        "pbgi_cutoff, pbgi_bounces, pbgi_resolution, pbgi_direct_samples, pbgi_spacing";
+        "pbgi_cutoff, pbgi_bounces, pbgi_resolution, pbgi_direct_samples, pbgi_spacing, guiding_spp, guiding_rr";
     const auto number = [](const py::handle& v, const std::string& name) {
         if (!py::isinstance<py::int_>(v) && !py::isinstance<py::float_>(v))
             throw py::type_error(fmt::format("{} must be a number, not {}", name, type_name(v)));
@@ -247,10 +247,10 @@ void apply_estimator_options(JobRequest& r, const py::kwargs& options) {
         if (!py::isinstance<py::bool_>(v)) throw py::type_error(fmt::format("{} must be True or False", name));
         return v.cast<bool>();
     };
-    static const std::map<std::string, std::optional<int> JobRequest::*> pbgi_counts = {
+    static const std::map<std::string, std::optional<int> JobRequest::*> int_options = {
         {"pbgi_surfels", &JobRequest::pbgi_surfels},       {"pbgi_bounces", &JobRequest::pbgi_bounces},
         {"pbgi_resolution", &JobRequest::pbgi_resolution}, {"pbgi_direct_samples", &JobRequest::pbgi_direct_samples},
-        {"pbgi_spacing", &JobRequest::pbgi_spacing}};
+        {"pbgi_spacing", &JobRequest::pbgi_spacing},       {"guiding_spp", &JobRequest::guiding_spp}};
     for (const auto& [key, value] : options) {
         const std::string name = py::str(key);
         const py::object v = py::reinterpret_borrow<py::object>(value);
@@ -270,6 +270,8 @@ void apply_estimator_options(JobRequest& r, const py::kwargs& options) {
             r.volume_beam = e == "beam";
         } else if (name == "no_merging") {
             r.vcm_merging = !flag(v, name);
+        } else if (name == "guiding_rr") {
+            r.guiding_rr = flag(v, name);
         } else if (name == "no_connections") {
             r.vcm_connections = !flag(v, name);
         } else if (name == "ic_rays") {
@@ -280,7 +282,7 @@ void apply_estimator_options(JobRequest& r, const py::kwargs& options) {
             if (flag(v, name)) r.ic_gradients = false;
         } else if (name == "pbgi_cutoff") {
             r.pbgi_cutoff = float(number(v, name));
-        } else if (const auto field = pbgi_counts.find(name); field != pbgi_counts.end()) {
+        } else if (const auto field = int_options.find(name); field != int_options.end()) {
             r.*(field->second) = *int_argument<int>(v, name.c_str(), 0, kIntMax);
         } else {
             throw py::type_error(fmt::format("render() got an unexpected keyword argument '{}'; the estimators' options: {}", name, kNames));
@@ -674,7 +676,7 @@ PYBIND11_MODULE(pathlab, m) {
           "light_sampler ('uniform', 'power', 'bvh', 'ris') and ris_candidates are --spectral, --rr-depth, --light-sampler and\n"
           "--ris-candidates. The estimators' own options go by their command-line names: mis='power', photons, radius, alpha,\n"
           "volume_estimate='points', no_merging=True, no_connections=True, ic_rays, ic_error, ic_no_gradients=True, pbgi_surfels,\n"
-          "pbgi_cutoff, pbgi_bounces, pbgi_resolution, pbgi_direct_samples, pbgi_spacing (refused for another estimator).\n"
+          "pbgi_cutoff, pbgi_bounces, pbgi_resolution, pbgi_direct_samples, pbgi_spacing, guiding_spp, guiding_rr=True (refused for another estimator).\n"
           "first_sample is --first-sample: the index of the first sample (pass), so that renders of disjoint ranges add up, with\n"
           "`pathlab merge`, to one render (give them checkpoint= files: merge takes checkpoints, exactly). checkpoint=FILE saves\n"
           "the render's whole state every checkpoint_every seconds (default 300; 0: only at the end), at the end and on Ctrl-C;\n"

@@ -137,6 +137,12 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
     app.add_option("--pbgi-resolution", o.pbgi_resolution, "pbgi: the micro-buffer's side in pixels (default 16)");
     app.add_option("--pbgi-direct-samples", o.pbgi_direct_samples, "pbgi: MIS pairs for each surfel side's direct light (default 16)");
     app.add_option("--pbgi-spacing", o.pbgi_spacing, "pbgi: pixels between the gathers at the first hits, interpolated between (default 2)");
+    app.add_option("--guiding-spp", o.guiding_spp,
+                   "ppg: samples per pixel of the SD-tree's training, in iterations of 1, 2, 4, ... spp before the image's samples and "
+                   "not in the image (default 31; 0: no guiding)");
+    app.add_flag("--guiding-rr", o.guiding_rr,
+                 "ppg: adjoint-driven Russian roulette and splitting (Vorba and Krivanek 2016): paths whose expected contribution, "
+                 "learned with the SD-tree, is small against the pixel's are ended, large ones split (default: the throughput's roulette)");
     app.add_option("--chains", o.mlt_chains,
                    "pssmlt, mmlt: Markov chains per pass (a fixed number, so the image does not depend on the threads; default 64)");
     app.add_option("--bootstrap", o.mlt_bootstrap,
@@ -219,6 +225,8 @@ std::vector<RenderJob> make_jobs(const RenderCommandOptions& o, bool check_paths
     request.pbgi_resolution = o.pbgi_resolution;
     request.pbgi_direct_samples = o.pbgi_direct_samples;
     request.pbgi_spacing = o.pbgi_spacing;
+    request.guiding_spp = o.guiding_spp;
+    request.guiding_rr = o.guiding_rr;
     request.first_sample = o.first_sample;
     request.mlt_chains = o.mlt_chains;
     request.mlt_bootstrap = o.mlt_bootstrap;

@@ -55,6 +55,8 @@ struct RenderCommandOptions {
     std::optional<int> pbgi_resolution;
     std::optional<int> pbgi_direct_samples;
     std::optional<int> pbgi_spacing;
+    std::optional<int> guiding_spp;
+    bool guiding_rr = false;
     std::string checkpoint;          // --checkpoint FILE
     double checkpoint_every = kDefaultCheckpointEvery;  // --checkpoint-every SECONDS
     std::string resume;              // --resume FILE

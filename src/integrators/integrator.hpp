@@ -89,6 +89,9 @@ struct IntegratorOptions {
     int pbgi_bounces = 3;
     int pbgi_resolution = 16;
     int pbgi_direct_samples = 16;
+    // ppg: samples per pixel of the SD-tree's training (iterations of 1, 2, 4, ...; 0: no guiding).
+    int guiding_spp = 31;
+    bool guiding_rr = false;  // ppg: adjoint-driven Russian roulette and splitting (ADRRS)
     // Paths of no bounce (emitters and the environment seen directly) are left out (Mitsuba's hide_emitters).
     bool hide_emitters = false;
     // Spectral mode (docs/spectral.md): paths carry 4 sampled wavelengths instead of RGB, the
@@ -111,6 +114,17 @@ struct RenderContext {
     const PixelFilter* filter = nullptr;
 
     size_t pixel_count() const { return size_t(width) * size_t(height); }
+};
+
+// What prepare() was last run for (a cache or a tree built up front is kept for a render continued
+// with the same scene, seed and image size: prepare() is a pure function of them).
+struct PreparedFor {
+    const Scene* scene = nullptr;
+    uint64_t seed = 0;
+    int width = 0, height = 0;
+
+    bool matches(const RenderContext& ctx) const { return scene == &ctx.scene && seed == ctx.seed && width == ctx.width && height == ctx.height; }
+    void set(const RenderContext& ctx) { *this = {&ctx.scene, ctx.seed, ctx.width, ctx.height}; }
 };
 
 // What a call of render_passes counted.

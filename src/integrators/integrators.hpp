@@ -27,5 +27,6 @@ const IntegratorInfo& bpm_integrator();
 const IntegratorInfo& volpath_integrator();
 const IntegratorInfo& pssmlt_integrator();
 const IntegratorInfo& mmlt_integrator();
+const IntegratorInfo& ppg_integrator();
 
 }  // namespace pathlab

@@ -73,7 +73,8 @@ std::string options_text(const IntegratorOptions& o) {
                     o.mlt_sigma == defaults.mlt_sigma
                 ? ""
                 : fmt::format(" chains={} bootstrap={} large_step={} sigma={}", o.mlt_chains, o.mlt_bootstrap, hex_float(o.mlt_large_step),
-                              hex_float(o.mlt_sigma)));  // the text of the defaults as it always was
+                              hex_float(o.mlt_sigma))) +
+           (o.guiding_spp == defaults.guiding_spp ? "" : fmt::format(" guiding_spp={}", o.guiding_spp)) + (o.guiding_rr ? " guiding_rr=1" : "");  // the text of the defaults as it always was
 }
 
 std::string metadata_key(const std::string& field) {

@@ -170,6 +170,8 @@ static std::string option_refusal(const IntegratorInfo& info, const JobRequest& 
     if ((r.pbgi_surfels || r.pbgi_cutoff || r.pbgi_bounces || r.pbgi_resolution || r.pbgi_direct_samples || r.pbgi_spacing) && a != "pbgi")
         return fmt::format(
             "--pbgi-surfels, --pbgi-cutoff, --pbgi-bounces, --pbgi-resolution, --pbgi-direct-samples and --pbgi-spacing are pbgi's, not {}'s", a);
+    if ((r.guiding_spp || r.guiding_rr) && a != "ppg")
+        return fmt::format("--guiding-spp and --guiding-rr set the training and the roulette of ppg's SD-tree; {} learns nothing", a);
     if ((r.mlt_chains || r.mlt_bootstrap || r.mlt_large_step || r.mlt_sigma) && !one_of({"pssmlt", "mmlt"}))
         return fmt::format("--chains, --bootstrap, --large-step and --sigma set the Markov chains of pssmlt and mmlt, not {}'s", a);
     const auto out_of = [](const char* name, const auto& v, double lo, double hi) -> std::string {
@@ -182,7 +184,7 @@ static std::string option_refusal(const IntegratorInfo& info, const JobRequest& 
                                    out_of("--pbgi-direct-samples", r.pbgi_direct_samples, 1, 65536),
                                    out_of("--pbgi-spacing", r.pbgi_spacing, 1, 64), out_of("--chains", r.mlt_chains, 1, 1 << 20),
                                    out_of("--bootstrap", r.mlt_bootstrap, 1, 1 << 24), out_of("--large-step", r.mlt_large_step, 0, 1),
-                                   out_of("--sigma", r.mlt_sigma, 1e-6, 1)})
+                                   out_of("--sigma", r.mlt_sigma, 1e-6, 1), out_of("--guiding-spp", r.guiding_spp, 0, 1 << 20)})
         if (!why.empty()) return why;
     return "";
 }
@@ -225,6 +227,8 @@ RenderJob::RenderJob(SceneChoice scene, const JobRequest& r) : choice_(std::move
     if (const std::string why = integrator_refusal(*info_, d, r); !why.empty()) throw UsageError(why);
     if (const std::string why = option_refusal(*info_, r); !why.empty()) throw UsageError(why);
     options_.mlt_chains = r.mlt_chains.value_or(options_.mlt_chains);
+    options_.guiding_spp = r.guiding_spp ? *r.guiding_spp : d.guiding_spp.value_or(options_.guiding_spp);
+    options_.guiding_rr = r.guiding_rr || d.guiding_rr.value_or(false);
     options_.mlt_bootstrap = r.mlt_bootstrap.value_or(options_.mlt_bootstrap);
     options_.mlt_large_step = r.mlt_large_step.value_or(options_.mlt_large_step);
     options_.mlt_sigma = r.mlt_sigma.value_or(options_.mlt_sigma);

@@ -124,6 +124,8 @@ void read_plain_integrator(XmlSource& xml, const pugi::xml_node& n, SceneBuilder
         positive("buffer_resolution", 2, 256, b.desc.pbgi_resolution);
         positive("direct_samples", 1, 65536, b.desc.pbgi_direct_samples);
         positive("gather_spacing", 1, 64, b.desc.pbgi_spacing);
+        positive("training_spp", 0, 1 << 20, b.desc.guiding_spp);  // ppg
+        if (plugin.find("guiding_rr") && p.has("guiding_rr")) b.desc.guiding_rr = p.get_bool("guiding_rr");
         if (plugin.find("cutoff") && p.has("cutoff")) {
             const float c = p.get_float("cutoff");
             if (!(c >= 0 && c <= 4 * kPi)) p.fail("cutoff", fmt::format("cutoff must be a solid angle from 0 to 4 pi, got {}", c));

@@ -76,9 +76,7 @@ ColourOf<T> IrradianceCaching<T>::indirect_irradiance(const Scene& scene, const 
 template <class T>
 void IrradianceCaching<T>::prepare(const RenderContext& ctx, const PassProgress& progress) {
     // The cache depends on the scene, the image and the seed: a continued render keeps it.
-    if (prepared_scene_ == &ctx.scene && prepared_seed_ == ctx.seed && prepared_width_ == ctx.width && prepared_height_ == ctx.height &&
-        cache_.size() > 0)
-        return;
+    if (prepared_.matches(ctx) && cache_.size() > 0) return;
     const auto start = std::chrono::steady_clock::now();
     camera_position_ = ctx.camera.position();
     pixel_angle_ = ctx.camera.pixel_angle();
@@ -86,7 +84,7 @@ void IrradianceCaching<T>::prepare(const RenderContext& ctx, const PassProgress&
     const float cell = std::max(10 * pixel_angle_ * length(ctx.scene.scene_sphere().center - camera_position_), 1e-4f);
     cache_.reset(options_.ic_error, cell, options_.ic_gradients);
     gathered_ = 0;
-    prepared_scene_ = &ctx.scene, prepared_seed_ = ctx.seed, prepared_width_ = ctx.width, prepared_height_ = ctx.height;
+    prepared_.set(ctx);
     if (!(options_.ic_error > 0) || !rules_.may_bounce(1)) return;  // every point gathers for itself, or no indirect light
 
     const int w = ctx.width, h = ctx.height;

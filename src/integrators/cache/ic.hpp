@@ -63,9 +63,7 @@ private:
     float pixel_angle_ = 0;
     double build_seconds_ = 0;
     uint64_t gathered_ = 0;  // records gathered (some were covered by earlier ones and dropped)
-    const Scene* prepared_scene_ = nullptr;
-    uint64_t prepared_seed_ = 0;
-    int prepared_width_ = 0, prepared_height_ = 0;
+    PreparedFor prepared_;
 };
 extern template class IrradianceCaching<RgbTransport>;
 extern template class IrradianceCaching<SpectralTransport>;

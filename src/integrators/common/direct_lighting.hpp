@@ -37,8 +37,24 @@ int nee_candidates(const Scene& scene, const ShadingPoint* sp, const Wl& wl) {
     return sp && changes_wavelengths(*sp->material, wl) ? 1 : scene.light_sampler().candidates();
 }
 
+// The density of the other strategy of MIS for a direction wo (local) whose BSDF density is
+// pdf_bsdf: BSDF sampling's own (a guided path tracer passes its mixture's).
+struct BsdfStrategyPdf {
+    float operator()(const Vec3f&, float pdf_bsdf) const { return pdf_bsdf; }
+};
+
+// The light a light sample found, for estimators that learn from it (a guided path tracer): its
+// direction and the radiance arriving from it over the sample's density, MIS-weighted.
 template <class Wl>
-ColourAt<Wl> estimate_light_sample(const Scene& scene, const ShadingPoint& sp, Sampler& sampler, bool mis, Wl& wl, bool power = false) {
+struct LightSampleSeen {
+    bool found = false;
+    Vec3f wi;
+    ColourAt<Wl> Li{0.0f};
+};
+
+template <class Wl, class OtherPdf = BsdfStrategyPdf>
+ColourAt<Wl> estimate_light_sample(const Scene& scene, const ShadingPoint& sp, Sampler& sampler, bool mis, Wl& wl, bool power = false,
+                                   const OtherPdf& other_pdf = {}, LightSampleSeen<Wl>* seen = nullptr) {
     using Colour = ColourAt<Wl>;
     const bool dispersive = changes_wavelengths(*sp.material, wl);
     const bool transmits = sp.material->transmits();
@@ -67,8 +83,10 @@ ColourAt<Wl> estimate_light_sample(const Scene& scene, const ShadingPoint& sp, S
                                                 : spawn_segment(sp.p, sp.ng, ls->point, ls->normal);
     if (scene.occluded(shadow)) return Colour(0.0f);
     if (!dispersive) f = bsdf_colour(sp, wo, f_rgb, wl);
-    const float weight = (mis && !ls->delta) ? mis_heuristic(power, nee->pdf_source, pdf_bsdf) : 1.0f;
-    return f * light_colour(scene, choice.index, ls->Le, wl) * (std::abs(wo.z) * weight / nee->pdf);
+    const float weight = (mis && !ls->delta) ? mis_heuristic(power, nee->pdf_source, other_pdf(wo, pdf_bsdf)) : 1.0f;
+    const ColourAt<Wl> Le = light_colour(scene, choice.index, ls->Le, wl);
+    if (seen) *seen = {true, ls->wi, Le * (weight / nee->pdf)};
+    return f * Le * (std::abs(wo.z) * weight / nee->pdf);
 }
 
 // The direct estimators' first hit: `L` becomes what the camera ray sees there (the emitter it

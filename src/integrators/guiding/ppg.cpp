@@ -1,0 +1,269 @@
+// Practical path guiding (Müller, Gross and Novák, EGSR 2017): pt-mis whose continuation
+// direction is drawn, where the SD-tree (sd_tree.hpp) has learned something, from the one-sample
+// mixture of the BSDF (probability 1/2) and the tree's distribution of arriving radiance:
+//   p(wo) = a p_bsdf(wo) + (1 - a) p_tree(wo),   a = kBsdfFraction.
+// Both halves stay in the mixture for every direction, so every direction the BSDF reaches stays
+// reachable (guiding cannot lose light; it can only move variance). Next-event estimation is
+// kept: a light sample is weighed against the mixture's density, the emission the continuation
+// finds against light sampling's (balance heuristic, or power with --mis power). A Dirac lobe is
+// never guided: it is sampled only through the BSDF half, with probability a times its own.
+//
+// Training (prepare): iterations of 1, 2, 4, ... samples per pixel with their own random numbers,
+// each guided by the tree of the iterations before, record at every non-Dirac vertex the radiance
+// its continuation brought back (the light found further on, MIS-weighted, over the throughput to
+// the next vertex) over the direction's density, and the light sample's MIS-weighted radiance
+// over its density. The tree is then refined (sd_tree.hpp). The image is rendered with the last
+// tree, fixed: training samples are not in it (the paper's choice: the final iteration alone).
+// Records are added in pixel order, a block of rows at a time, so the tree and the image do not
+// depend on the thread count.
+//
+// --guiding-rr: adjoint-driven Russian roulette and splitting (Vorba and Křivánek 2016). Training
+// also learns each leaf's mean outgoing radiance (what its vertices sent back, over the throughput
+// that reached them). After a bounce, the path's expected contribution is its throughput times
+// the next vertex's leaf radiance; against the pixel's (estimated by the first hit's leaf) it is
+// kept within a window of ratio kWindow: roulette below it (survivors divided by their
+// probability), splitting into copies above it. Both are unbiased; only the variance changes.
+#include "integrators/guiding/ppg.hpp"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+
+#include "core/sampling.hpp"
+#include "integrators/common/direct_lighting.hpp"
+#include "integrators/integrators.hpp"
+
+namespace pathlab {
+
+namespace {
+
+// The training passes' random numbers: apart from the image's (Sampler(seed, pixel, pass)).
+constexpr uint64_t kTrainingSeed = 0x9b1de5a7c0ffee11ull;
+
+// The mean over lanes of a / b, lanes where b is 0 left out (a path's radiance over its
+// throughput: what arrived at a vertex along its continuation).
+template <class C>
+float mean_ratio(const C& a, const C& b) {
+    constexpr int lanes = std::is_same_v<C, Spectrum4> ? 4 : 3;
+    float sum = 0;
+    int n = 0;
+    for (int i = 0; i < lanes; ++i)
+        if (b[i] > 0) sum += a[i] / b[i], ++n;
+    return n ? sum / float(n) : 0.0f;
+}
+template <class C>
+float mean_of(const C& c) {
+    constexpr int lanes = std::is_same_v<C, Spectrum4> ? 4 : 3;
+    float sum = 0;
+    for (int i = 0; i < lanes; ++i) sum += c[i];
+    return sum / float(lanes);
+}
+
+}  // namespace
+
+template <class T>
+PathGuiding<T>::PathGuiding(const IntegratorOptions& o, GuidingFaults faults) : options_(o), rules_(o), faults_(faults) {}
+
+template <class T>
+std::vector<uint64_t> PathGuiding<T>::iteration_sizes(uint64_t training_spp) {
+    std::vector<uint64_t> sizes;
+    uint64_t size = 1, left = training_spp;
+    while (left > 0) {
+        // The last iteration takes the rest when the next doubling would not fit after it.
+        const uint64_t take = left < 3 * size ? left : size;
+        sizes.push_back(take);
+        left -= take;
+        size *= 2;
+    }
+    return sizes;
+}
+
+template <class T>
+void PathGuiding<T>::prepare(const RenderContext& ctx, const PassProgress& progress) {
+    if (prepared_.matches(ctx)) return;
+    const auto start = std::chrono::steady_clock::now();
+    tree_ = SdTree(ctx.scene.bounds_center(), ctx.scene.bounds_radius());
+    guided_ = false;
+    const std::vector<uint64_t> sizes = iteration_sizes(uint64_t(std::max<int64_t>(0, options_.guiding_spp)));
+    uint64_t total = 0, done = 0, first = 0;
+    for (uint64_t s : sizes) total += s;
+    const int w = ctx.width, h = ctx.height;
+    const bool lens = ctx.camera.needs_lens_sample();
+    // Rows are traced in parallel a block at a time, and their records added in row order.
+    const int block_rows = std::max(1, std::min(h, 65536 / std::max(1, w)));
+    std::vector<std::vector<Record>> row_records(static_cast<size_t>(block_rows));
+    for (const uint64_t spp : sizes) {
+        for (int y0 = 0; y0 < h; y0 += block_rows) {
+            const int rows = std::min(block_rows, h - y0);
+            tbb::parallel_for(0, rows, [&](int r) {
+                std::vector<Record>& out = row_records[size_t(r)];
+                out.clear();
+                const int y = y0 + r;
+                for (int x = 0; x < w; ++x) {
+                    const size_t pixel = size_t(y) * size_t(w) + size_t(x);
+                    for (uint64_t k = 0; k < spp; ++k) {
+                        Sampler sampler(ctx.seed ^ kTrainingSeed, pixel, first + k, ctx.sampler);
+                        const Vec2f jitter = sampler.next2d();
+                        const Ray ray = lens ? ctx.camera.generate(float(x) + jitter.x, float(y) + jitter.y, sampler.next2d())
+                                             : ctx.camera.generate(float(x) + jitter.x, float(y) + jitter.y);
+                        Wl wl = T::camera_wavelengths(sampler);
+                        trace(ctx.scene, ray, sampler, wl, &out);
+                    }
+                }
+            });
+            for (int r = 0; r < rows; ++r)
+                for (const Record& rec : row_records[size_t(r)])
+                    if (rec.outgoing) tree_.record_outgoing(rec.p, rec.value);
+                    else tree_.record(rec.p, rec.direction, rec.value);
+            done += spp * uint64_t(rows);
+            if (progress) progress(double(done) / double(total * uint64_t(h)));
+        }
+        tree_.refine(spp);
+        guided_ = true;
+        first += spp;
+    }
+    training_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    prepared_.set(ctx);
+}
+
+template <class T>
+ColourOf<T> PathGuiding<T>::radiance(const Scene& scene, const Ray& ray, Sampler& sampler, Wl& wl) const {
+    return trace(scene, ray, sampler, wl, nullptr);
+}
+
+template <class T>
+ColourOf<T> PathGuiding<T>::trace(const Scene& scene, const Ray& camera_ray, Sampler& sampler, Wl& wl, std::vector<Record>* records) const {
+    const bool seen_directly = !options_.hide_emitters;
+    Intersection hit;
+    if (!scene.intersect(camera_ray, hit)) return seen_directly ? escaped_radiance(scene, camera_ray.d, wl) : Colour(0.0f);
+    const Colour emitted = seen_directly ? emitted_radiance(scene, hit, -camera_ray.d, wl) : Colour(0.0f);
+    // Adjoint-driven roulette's estimate of the pixel: the radiance the first hit's leaf sends back.
+    const float pixel = guided_ && options_.guiding_rr && !records ? tree_.leaf(hit.p).outgoing : 0.0f;
+    if (!records) return emitted + walk(scene, hit, camera_ray.d, Colour(1.0f), 0, sampler, wl, nullptr, nullptr, pixel, 1);
+    std::array<PathVertex, kRecordedVertices> vertices;
+    return emitted + walk(scene, hit, camera_ray.d, Colour(1.0f), 0, sampler, wl, records, vertices.data(), pixel, 1);
+}
+
+template <class T>
+ColourOf<T> PathGuiding<T>::walk(const Scene& scene, Intersection hit, Vec3f dir, Colour beta, int first_bounce, Sampler& sampler, Wl& wl,
+                                 std::vector<Record>* records, PathVertex* vertices, float pixel, int copies) const {
+    Colour L(0.0f);
+    int n = 0;
+    const bool power = rules_.power_mis();
+    for (int bounces = first_bounce; rules_.may_bounce(bounces); ++bounces) {
+        const ShadingPoint sp = make_shading_point(scene, hit, dir);
+        if (sp.material->is_black()) break;
+        const GuidingLeaf* leaf = guided_ ? &tree_.leaf(sp.p) : nullptr;
+        const bool guide = leaf && leaf->usable && (sp.material->lobes() & (kLobeDiffuse | kLobeGlossy)) != 0;
+        const float a = guide ? kBsdfFraction : 1.0f;
+        // The continuation's density for a direction (local) of BSDF density pdf_bsdf.
+        const auto mixture_pdf = [&](const Vec3f& w, float pdf_bsdf) {
+            if (!guide) return pdf_bsdf;
+            const float tree_pdf = leaf->sampling.pdf(direction_to_square(sp.frame.to_world(w))) * (1.0f / (4.0f * kPi));
+            return a * pdf_bsdf + (1.0f - a) * tree_pdf;
+        };
+        const auto light_mis_pdf = [&](const Vec3f& w, float pdf_bsdf) {
+            return faults_.drop_guide_pdf_in_mis ? pdf_bsdf : mixture_pdf(w, pdf_bsdf);
+        };
+        PathVertex* v = records && n < kRecordedVertices ? &vertices[n++] : nullptr;
+        if (v) *v = {sp.p, Vec3f(0.0f), 0.0f, false, L, beta, L, beta};
+        LightSampleSeen<Wl> light;
+        L += beta * estimate_light_sample(scene, sp, sampler, /*mis=*/true, wl, power, light_mis_pdf, records ? &light : nullptr);
+        if (records && light.found) records->push_back({sp.p, light.wi, mean_of(light.Li), false});
+
+        // The continuation: the BSDF's sample (always without guiding), or the tree's.
+        const Vec2f u = sampler.next2d();
+        std::optional<BsdfSample> s;
+        Colour f(0.0f);
+        float pdf = 0;
+        if (!guide || sampler.next1d() < a) {
+            s = bsdf_sample(sp, u, wl);
+            if (s) {
+                f = bsdf_sample_colour(sp, *s, wl);
+                pdf = s->delta ? a * s->pdfW : mixture_pdf(s->wo, s->pdfW);
+            }
+        } else {
+            const Vec3f wo = sp.frame.to_local(square_to_direction(leaf->sampling.sample(u)));
+            float pdf_bsdf = 0;
+            f = bsdf_eval(sp, wo, wl, pdf_bsdf);
+            if (!is_black(f)) {
+                s = BsdfSample{wo, Rgb(0.0f), pdf_bsdf, false, 0, 0};
+                pdf = mixture_pdf(wo, pdf_bsdf);
+            }
+        }
+        if (!s || !(pdf > 0)) break;
+        const Colour step = f * (std::abs(s->wo.z) / pdf);
+        const Vec3f wo_world = sp.frame.to_world(s->wo);
+        if (v && !s->delta) v->direction = wo_world, v->pdf = pdf, v->guided_record = true, v->L_before = L, v->beta_after = beta * step;
+        const EmitterHit found = trace_to_emitter(scene, sp.spawn(s->wo), sp.p, sp.frame.n);
+        if (!is_black(found.Le)) {
+            const float weight = s->delta ? 1.0f : mis_heuristic(power, pdf, found.pdf_light);
+            const int light_index = found.hit ? found.isect.light : scene.environment_light();
+            L += beta * step * light_colour(scene, light_index, found.Le, wl) * weight;
+        }
+        if (!found.hit || !rules_.may_bounce(bounces + 1)) break;
+        beta *= step;
+        // Adjoint-driven roulette and splitting (Vorba and Křivánek 2016) where the next vertex's
+        // leaf knows its radiance, else the throughput's roulette.
+        const float next = pixel > 0 ? tree_.leaf(found.isect.p).outgoing : 0.0f;
+        if (next > 0) {
+            // The throughput at which the path's expected contribution is the pixel's, and a
+            // window of ratio kWindow around it.
+            const float centre = pixel / next, lower = 2.0f * centre / (1.0f + kWindow), upper = kWindow * lower;
+            const float b = mean_of(beta);
+            if (b < lower) {
+                const float q = std::max(b / lower, 1e-3f);
+                if (sampler.next1d() >= q) break;
+                if (!faults_.drop_roulette_weight) beta /= q;
+            } else if (b > upper && !T::spectral && copies < kMaxCopies) {
+                const int split = std::min({int(std::ceil(b / upper)), kMaxSplit, kMaxCopies / copies});
+                beta /= float(split);
+                for (int i = 1; i < split; ++i)
+                    L += walk(scene, found.isect, wo_world, beta, bounces + 1, sampler, wl, nullptr, nullptr, pixel, copies * split);
+                copies *= split;
+            }
+        } else if (!rules_.survive_roulette(bounces + 1, beta, sampler)) {
+            break;
+        }
+        hit = found.isect;
+        dir = wo_world;
+    }
+    // What arrived at each recorded vertex along its continuation: all the path gathered after
+    // it, over the throughput to the next vertex; recorded over the direction's density. And what
+    // the vertex sent back: all the path gathered from it on, over the throughput that reached it.
+    for (int i = 0; i < n; ++i) {
+        const PathVertex& v = vertices[i];
+        if (v.guided_record) records->push_back({v.p, v.direction, mean_ratio(L - v.L_before, v.beta_after) / v.pdf, false});
+        records->push_back({v.p, Vec3f(0.0f), mean_ratio(L - v.L_start, v.beta_start), true});
+    }
+    return L;
+}
+
+template <class T>
+std::vector<IntegratorStatistic> PathGuiding<T>::statistics() const {
+    return {{"guiding_training_seconds", training_seconds_},
+            {"guiding_leaves", double(tree_.leaf_count())},
+            {"guiding_tree_mib", double(tree_.memory_bytes()) / (1024.0 * 1024.0)}};
+}
+
+template class PathGuiding<RgbTransport>;
+template class PathGuiding<SpectralTransport>;
+
+std::vector<ParamInfo> ppg_params() {
+    std::vector<ParamInfo> p = path_params();
+    p.push_back({"training_spp", ParamType::Integer, "31",
+                 "samples per pixel of the SD-tree's training, in iterations of 1, 2, 4, ... (not in the image; --guiding-spp wins)", ""});
+    p.push_back({"guiding_rr", ParamType::Boolean, "false", "adjoint-driven Russian roulette and splitting (or --guiding-rr)", ""});
+    return p;
+}
+
+const IntegratorInfo& ppg_integrator() {
+    static const IntegratorInfo info = sampling_lights(IntegratorInfo{
+        "ppg", {"guided", "guided_path"}, "path tracing guided by a learned SD-tree of arriving radiance (practical path guiding), NEE by MIS", false, true,
+        ppg_params(), [](const IntegratorOptions& o) { return make_for_transport<PathGuiding>(o); }});
+    return info;
+}
+
+}  // namespace pathlab

@@ -1,0 +1,83 @@
+// ppg: path tracing guided by an SD-tree (practical path guiding; ppg.cpp says how).
+#pragma once
+
+#include <vector>
+
+#include "integrators/common/path_rules.hpp"
+#include "integrators/guiding/sd_tree.hpp"
+#include "integrators/integrator.hpp"
+
+namespace pathlab {
+
+// Deliberate faults for the tests that show they can fail.
+struct GuidingFaults {
+    bool drop_guide_pdf_in_mis = false;  // light sampling's MIS weight ignores the guiding density
+    bool drop_roulette_weight = false;   // adjoint-driven roulette's survivors keep their throughput
+};
+
+template <class T>
+class PathGuiding final : public PixelIntegrator<T> {
+public:
+    using Colour = ColourOf<T>;
+    using Wl = WavelengthsOf<T>;
+
+    // The probability of sampling the BSDF rather than the SD-tree where a leaf guides (Müller's 0.5).
+    static constexpr float kBsdfFraction = 0.5f;
+
+    explicit PathGuiding(const IntegratorOptions& o, GuidingFaults faults = {});
+    // Trains the SD-tree: iterations of 1, 2, 4, ... samples per pixel (the last takes what is
+    // left of --guiding-spp), each guided by the tree the previous one built.
+    void prepare(const RenderContext& ctx, const PassProgress& progress) override;
+    Colour radiance(const Scene& scene, const Ray& ray, Sampler& sampler, Wl& wl) const override;
+    std::vector<IntegratorStatistic> statistics() const override;
+
+    const SdTree& tree() const { return tree_; }
+    // The training iterations' sizes in samples per pixel, for a training budget.
+    static std::vector<uint64_t> iteration_sizes(uint64_t training_spp);
+
+    // One record of a training path (sd_tree.hpp): the radiance arriving from `direction` over
+    // its density, or (outgoing) the radiance the vertex sent back.
+    struct Record {
+        Vec3f p, direction;
+        float value;
+        bool outgoing;
+    };
+
+    // Adjoint-driven roulette and splitting (--guiding-rr): the weight window's ratio, the most
+    // copies one vertex splits a path into, and the most copies of a camera sample in all.
+    static constexpr float kWindow = 5.0f;
+    static constexpr int kMaxSplit = 8, kMaxCopies = 64;
+
+private:
+    // A training path's vertex: where its continuation left from, in which direction, with what
+    // density, the radiance gathered before its light came in and the throughput after it; and
+    // the radiance gathered before the vertex and the throughput that reached it.
+    struct PathVertex {
+        Vec3f p, direction;
+        float pdf;
+        bool guided_record;
+        Colour L_start, beta_start, L_before, beta_after;
+    };
+    static constexpr int kRecordedVertices = 64;  // a training path records its first 64 vertices
+
+    // The estimate of a camera sample (recording a training path's records).
+    Colour trace(const Scene& scene, const Ray& ray, Sampler& sampler, Wl& wl, std::vector<Record>* records) const;
+    // The radiance a path brings back from `hit` on, times beta (the throughput there), for a path
+    // that has made first_bounce bounces: records (training; `vertices` holds kRecordedVertices) or
+    // roulette and splitting against the pixel's estimate `pixel` (0: the throughput's roulette),
+    // the path being one of `copies`.
+    Colour walk(const Scene& scene, Intersection hit, Vec3f dir, Colour beta, int first_bounce, Sampler& sampler, Wl& wl,
+                std::vector<Record>* records, PathVertex* vertices, float pixel, int copies) const;
+
+    IntegratorOptions options_;
+    PathRules rules_;
+    GuidingFaults faults_;
+    SdTree tree_;
+    bool guided_ = false;  // the tree has been trained
+    double training_seconds_ = 0;
+    PreparedFor prepared_;  // a trained tree is kept for a continued render
+};
+extern template class PathGuiding<RgbTransport>;
+extern template class PathGuiding<SpectralTransport>;
+
+}  // namespace pathlab

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <atomic>
 
+#include "integrators/common/camera_ray.hpp"
 #include "integrators/integrator.hpp"
 
 namespace pathlab {
@@ -25,7 +26,6 @@ PassCounters PixelIntegrator<T>::render_passes(const RenderContext& ctx, Film& f
 
     std::atomic<uint64_t> rays{0}, invalid{0};
     std::atomic<int> tiles_done{0};
-    const bool lens = ctx.camera.needs_lens_sample();
     tbb::parallel_for(tbb::blocked_range<int>(0, tile_count, 1), [&](const tbb::blocked_range<int>& range) {
         for (int tile = range.begin(); tile != range.end(); ++tile) {
             const uint64_t rays_before = Scene::rays_traced_by_this_thread();
@@ -37,8 +37,7 @@ PassCounters PixelIntegrator<T>::render_passes(const RenderContext& ctx, Film& f
                     for (int k = 0; k < count; ++k) {
                         Sampler sampler(ctx.seed, pixel, first + uint64_t(k), ctx.sampler);
                         const Vec2f jitter = sampler.next2d();
-                        const Ray ray = lens ? ctx.camera.generate(float(x) + jitter.x, float(y) + jitter.y, sampler.next2d())
-                                             : ctx.camera.generate(float(x) + jitter.x, float(y) + jitter.y);
+                        const Ray ray = camera_ray(ctx.camera, float(x) + jitter.x, float(y) + jitter.y, sampler);
                         const Vec3d L = sample_colour(ctx, ray, sampler);
                         if (is_finite(L)) film.add(pixel, L);
                         else ++tile_invalid;
@@ -78,8 +77,7 @@ PassCounters PixelIntegrator<T>::render_filtered_passes(const RenderContext& ctx
                         Sampler sampler(ctx.seed, pixel, pass, ctx.sampler);
                         sampler.next2d();  // the unfiltered render's jitter
                         const float sx = float(x) + shift.x, sy = float(y) + shift.y;
-                        const Ray ray = ctx.camera.needs_lens_sample() ? ctx.camera.generate(sx, sy, sampler.next2d())
-                                                                       : ctx.camera.generate(sx, sy);
+                        const Ray ray = camera_ray(ctx.camera, sx, sy, sampler);
                         const Vec3d L = sample_colour(ctx, ray, sampler);
                         if (is_finite(L)) {
                             lattice_[pixel] = L;

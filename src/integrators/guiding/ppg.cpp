@@ -32,6 +32,7 @@
 #include <chrono>
 
 #include "core/sampling.hpp"
+#include "integrators/common/camera_ray.hpp"
 #include "integrators/common/direct_lighting.hpp"
 #include "integrators/integrators.hpp"
 
@@ -90,7 +91,6 @@ void PathGuiding<T>::prepare(const RenderContext& ctx, const PassProgress& progr
     uint64_t total = 0, done = 0, first = 0;
     for (uint64_t s : sizes) total += s;
     const int w = ctx.width, h = ctx.height;
-    const bool lens = ctx.camera.needs_lens_sample();
     // Rows are traced in parallel a block at a time, and their records added in row order.
     const int block_rows = std::max(1, std::min(h, 65536 / std::max(1, w)));
     std::vector<std::vector<Record>> row_records(static_cast<size_t>(block_rows));
@@ -106,8 +106,7 @@ void PathGuiding<T>::prepare(const RenderContext& ctx, const PassProgress& progr
                     for (uint64_t k = 0; k < spp; ++k) {
                         Sampler sampler(ctx.seed ^ kTrainingSeed, pixel, first + k, ctx.sampler);
                         const Vec2f jitter = sampler.next2d();
-                        const Ray ray = lens ? ctx.camera.generate(float(x) + jitter.x, float(y) + jitter.y, sampler.next2d())
-                                             : ctx.camera.generate(float(x) + jitter.x, float(y) + jitter.y);
+                        const Ray ray = camera_ray(ctx.camera, float(x) + jitter.x, float(y) + jitter.y, sampler);
                         Wl wl = T::camera_wavelengths(sampler);
                         trace(ctx.scene, ray, sampler, wl, &out);
                     }
@@ -152,10 +151,11 @@ ColourOf<T> PathGuiding<T>::walk(const Scene& scene, Intersection hit, Vec3f dir
     Colour L(0.0f);
     int n = 0;
     const bool power = rules_.power_mis();
+    const GuidingLeaf* next_leaf = nullptr;  // the leaf of `hit`, when the roulette has looked it up
     for (int bounces = first_bounce; rules_.may_bounce(bounces); ++bounces) {
         const ShadingPoint sp = make_shading_point(scene, hit, dir);
         if (sp.material->is_black()) break;
-        const GuidingLeaf* leaf = guided_ ? &tree_.leaf(sp.p) : nullptr;
+        const GuidingLeaf* leaf = guided_ ? (next_leaf ? next_leaf : &tree_.leaf(sp.p)) : nullptr;
         const bool guide = leaf && leaf->usable && (sp.material->lobes() & (kLobeDiffuse | kLobeGlossy)) != 0;
         const float a = guide ? kBsdfFraction : 1.0f;
         // The continuation's density for a direction (local) of BSDF density pdf_bsdf.
@@ -207,7 +207,8 @@ ColourOf<T> PathGuiding<T>::walk(const Scene& scene, Intersection hit, Vec3f dir
         beta *= step;
         // Adjoint-driven roulette and splitting (Vorba and Křivánek 2016) where the next vertex's
         // leaf knows its radiance, else the throughput's roulette.
-        const float next = pixel > 0 ? tree_.leaf(found.isect.p).outgoing : 0.0f;
+        next_leaf = pixel > 0 ? &tree_.leaf(found.isect.p) : nullptr;
+        const float next = next_leaf ? next_leaf->outgoing : 0.0f;
         if (next > 0) {
             // The throughput at which the path's expected contribution is the pixel's, and a
             // window of ratio kWindow around it.
@@ -251,6 +252,8 @@ std::vector<IntegratorStatistic> PathGuiding<T>::statistics() const {
 template class PathGuiding<RgbTransport>;
 template class PathGuiding<SpectralTransport>;
 
+namespace {
+
 std::vector<ParamInfo> ppg_params() {
     std::vector<ParamInfo> p = path_params();
     p.push_back({"training_spp", ParamType::Integer, "31",
@@ -258,6 +261,8 @@ std::vector<ParamInfo> ppg_params() {
     p.push_back({"guiding_rr", ParamType::Boolean, "false", "adjoint-driven Russian roulette and splitting (or --guiding-rr)", ""});
     return p;
 }
+
+}  // namespace
 
 const IntegratorInfo& ppg_integrator() {
     static const IntegratorInfo info = sampling_lights(IntegratorInfo{

@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "integrators/common/camera_ray.hpp"
 #include "integrators/integrators.hpp"
 #include "integrators/path/pt_mis.hpp"
 #include "integrators/path/volpath.hpp"
@@ -32,8 +33,7 @@ template <class T>
 ChainSample Pssmlt<T>::evaluate(const RenderContext& ctx, PrimarySamples& state) const {
     Sampler sampler(state);
     const Vec2f raster = raster_anywhere(ctx, sampler.next2d());
-    const Ray ray = ctx.camera.needs_lens_sample() ? ctx.camera.generate(raster.x, raster.y, sampler.next2d())
-                                                   : ctx.camera.generate(raster.x, raster.y);
+    const Ray ray = camera_ray(ctx.camera, raster.x, raster.y, sampler);
     WavelengthsOf<T> wl = T::camera_wavelengths(sampler);
     const auto L = ctx.scene.has_media()
                        ? static_cast<const PixelIntegrator<T>&>(*volpath_).radiance(ctx.scene, ray, sampler, wl)

@@ -5,6 +5,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "integrators/common/camera_ray.hpp"
 #include "integrators/common/path_rules.hpp"
 #include "integrators/integrators.hpp"
 #include "integrators/photon/visible_point.hpp"
@@ -138,7 +139,6 @@ PassCounters PhotonMapper<T>::render_passes(const RenderContext& ctx, Film& film
     const int w = ctx.width;
     const size_t pixels = ctx.pixel_count();
     const bool filtered = ctx.filter && !ctx.filter->is_box();
-    const bool lens = ctx.camera.needs_lens_sample();
     if (filtered) lattice_.assign(pixels, Vec3d(0.0));
     std::atomic<uint64_t> rays{0}, invalid{0};
     for (int k = 0; k < count; ++k) {
@@ -154,7 +154,7 @@ PassCounters PhotonMapper<T>::render_passes(const RenderContext& ctx, Film& film
                 Sampler sampler(ctx.seed, p, pass, ctx.sampler);
                 const Vec2f jitter = sampler.next2d();
                 const float sx = float(x) + (filtered ? shift.x : jitter.x), sy = float(y) + (filtered ? shift.y : jitter.y);
-                const Ray ray = lens ? ctx.camera.generate(sx, sy, sampler.next2d()) : ctx.camera.generate(sx, sy);
+                const Ray ray = camera_ray(ctx.camera, sx, sy, sampler);
                 WavelengthsOf<T> camera_wl = wl;
                 const Vec3d L = film_colour(radiance(ctx.scene, ray, sampler, camera_wl), camera_wl);
                 // As PixelIntegrator: an invalid sample is not added (a filtered pass adds 0 there).

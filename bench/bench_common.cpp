@@ -2,6 +2,7 @@
 
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -13,8 +14,8 @@ namespace pathlab::bench {
 RenderResult run(const Scene& scene, const std::string& algorithm, int size, int spp, double seconds, uint64_t seed,
                  std::function<void(const Film&, const RenderStats&)> after_pass, SamplerKind sampler) {
     JobRequest r;
-    // "name:key=value:...": radius (the photon methods' first radius), max_depth, rr_depth, and ppg's
-    // guiding_spp and guiding_rr (1: on).
+    // "name:key=value:...": radius (the photon methods' first radius), max_depth, rr_depth, ppg's
+    // guiding_spp and guiding_rr (1: on), and upbp's estimators (joined by '+': estimators=bpt+pb2d).
     r.algorithm = algorithm.substr(0, algorithm.find(':'));
     for (size_t at = algorithm.find(':'); at != std::string::npos;) {
         const size_t next = algorithm.find(':', at + 1);
@@ -26,7 +27,13 @@ RenderResult run(const Scene& scene, const std::string& algorithm, int size, int
         else if (key == "rr_depth") r.rr_depth = std::stoi(value);
         else if (key == "guiding_spp") r.guiding_spp = std::stoi(value);
         else if (key == "guiding_rr") r.guiding_rr = value != "0";
-        else throw std::runtime_error(fmt::format("{}: unknown setting '{}' (radius, max_depth, rr_depth, guiding_spp, guiding_rr)", algorithm, key));
+        else if (key == "estimators") {
+            std::string list = value;
+            std::replace(list.begin(), list.end(), '+', ',');
+            r.estimators = list;
+        } else
+            throw std::runtime_error(
+                fmt::format("{}: unknown setting '{}' (radius, max_depth, rr_depth, guiding_spp, guiding_rr, estimators)", algorithm, key));
         at = next;
     }
     r.width = r.height = size;

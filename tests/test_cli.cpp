@@ -148,7 +148,7 @@ TEST_F(Cli, BdptOptionsAreCheckedAndTheStrategiesWritten) {
     EXPECT_TRUE(contains(r.err, "unknown MIS heuristic 'cubic'. Valid heuristics: balance, power")) << r.err;
     r = run({"-s", "4", "-a", "lt", "--mis", "power", "-o", path("x.exr")});
     EXPECT_EQ(r.code, 2);
-    EXPECT_TRUE(contains(r.err, "--mis chooses the heuristic of bdpt, vcm, bpm, mmlt, pt-mis, pt-mis3 and direct-mis; lt has its own")) << r.err;
+    EXPECT_TRUE(contains(r.err, "--mis chooses the heuristic of bdpt, vcm, bpm, upbp, mmlt, pt-mis, pt-mis3 and direct-mis; lt has its own")) << r.err;
     r = run({"-s", "4", "-a", "lt", "--strategies", path("s"), "-o", path("x.exr")});
     EXPECT_EQ(r.code, 2);
     EXPECT_TRUE(contains(r.err, "--strategies writes the strategies of bdpt, not of lt")) << r.err;
@@ -221,7 +221,7 @@ TEST_F(Cli, SppmOptionsAreChecked) {
     EXPECT_TRUE(contains(r.err, "--photons sets the light paths of sppm, ppm and pm; pt-mis has no such count")) << r.err;
     r = run({"-s", "2", "-a", "pm", "--alpha", "0.5", "-o", path("x.exr")});
     EXPECT_EQ(r.code, 2);
-    EXPECT_TRUE(contains(r.err, "--alpha is the radius reduction of sppm, ppm, vcm and bpm, not pm's")) << r.err;
+    EXPECT_TRUE(contains(r.err, "--alpha is the radius reduction of sppm, ppm, vcm, bpm and upbp, not pm's")) << r.err;
     r = run({"-s", "2", "-a", "sppm", "--alpha", "1.5", "-o", path("x.exr")});
     EXPECT_EQ(r.code, 2);
     EXPECT_TRUE(contains(r.err, "--alpha must be in (0, 1]")) << r.err;

@@ -205,6 +205,60 @@ TEST_F(SceneFileMedia, BadGridFilesNameTheSceneLineAndTheGridFile) {
     EXPECT_TRUE(contains(r.err, "truncated")) << r.err;
 }
 
+// upbp's beam estimators need homogeneous media: with pb2d or bb1d among its estimators (the
+// default) a scene with a grid is refused, saying which estimators and integrators render it;
+// without them it renders it; the scene file's estimators are upbp's option. An unknown estimator is refused with the valid names, and
+// --estimators is refused for another integrator.
+TEST_F(SceneFileMedia, UpbpRefusesGridsForItsPointBeamEstimatorOnly) {
+    const std::string rest = R"(<shape type="rectangle"><bsdf type="diffuse"/></shape>
+        <shape type="sphere"><point name="center" value="0, 0, 2"/><emitter type="area"><rgb name="radiance" value="1"/></emitter></shape>)";
+    const SceneDescription grid = load(R"(<medium type="heterogeneous" id="smoke">
+            <volume type="gridvolume" name="sigma_t"><string name="filename" value="grid.vol"/></volume></medium>
+        <shape type="cube"><bsdf type="null"/><ref name="interior" id="smoke"/></shape>)" + rest);
+    const SceneDescription fog = load(R"(<medium type="homogeneous" id="fog"><rgb name="sigma_t" value="1"/></medium>
+        <shape type="cube"><bsdf type="null"/><ref name="interior" id="fog"/></shape>)" + rest);
+    const auto refusal = [](const SceneDescription& d, const std::string& algorithm, std::optional<std::string> estimators) {
+        JobRequest r;
+        r.algorithm = algorithm;
+        r.estimators = std::move(estimators);
+        try {
+            RenderJob job(scene_choice_of(d), r);
+        } catch (const UsageError& e) {
+            return std::string(e.what());
+        }
+        return std::string();
+    };
+    for (const std::optional<std::string>& e :
+         {std::optional<std::string>(), std::optional<std::string>("pb2d"), std::optional<std::string>("bpt,bb1d")}) {
+        const std::string why = refusal(grid, "upbp", e);
+        EXPECT_TRUE(contains(why, "beam estimators (pb2d, bb1d) need homogeneous media")) << why;
+        EXPECT_TRUE(contains(why, "heterogeneous medium 'smoke'")) << why;
+        EXPECT_TRUE(contains(why, "--estimators bpt,surf,pp3d")) << why;
+        EXPECT_EQ(refusal(fog, "upbp", e), "");
+    }
+    EXPECT_EQ(refusal(grid, "upbp", std::string("bpt,surf,pp3d")), "");
+    SceneDescription listed = fog;
+    listed.estimators = "bb1d,bpt";
+    JobRequest upbp;
+    upbp.algorithm = "upbp";
+    listed.photon_beams = 64;
+    EXPECT_EQ(RenderJob(scene_choice_of(listed), upbp).integrator_options().estimators, "bpt,bb1d");
+    EXPECT_EQ(RenderJob(scene_choice_of(listed), upbp).integrator_options().photon_beams, 64);
+    JobRequest beams = upbp;
+    beams.algorithm = "vcm";
+    beams.photon_beams = 16;
+    try {
+        RenderJob job(scene_choice_of(fog), beams);
+        ADD_FAILURE() << "--photon-beams accepted for vcm";
+    } catch (const UsageError& e) {
+        EXPECT_TRUE(contains(e.what(), "--photon-beams sets how many of upbp's light paths leave photon beams")) << e.what();
+    }
+    const std::string unknown = refusal(fog, "upbp", std::string("bpt,bb2d"));
+    EXPECT_TRUE(contains(unknown, "unknown estimator 'bb2d'")) << unknown;
+    EXPECT_TRUE(contains(unknown, "Valid estimators: bpt, surf, pp3d, pb2d, bb1d")) << unknown;
+    EXPECT_TRUE(contains(refusal(fog, "vcm", std::string("pb2d")), "--estimators chooses the estimators upbp combines")) << refusal(fog, "vcm", std::string("pb2d"));
+}
+
 // No silent wrong answer: every integrator that does not render media refuses a scene whose
 // shapes or camera refer to one (naming the medium, where it is, and the integrators that do),
 // rather than render it as if the medium were not there; a medium declared and never used, or
@@ -239,11 +293,11 @@ TEST_F(SceneFileMedia, IntegratorsWithoutMediaRefuseScenesWithMedia) {
             }
             EXPECT_TRUE(contains(message, info.name + " does not render participating media")) << message;
             EXPECT_TRUE(contains(message, where)) << message;
-            EXPECT_TRUE(contains(message, "The integrators that render media: lt, bdpt, pm, ppm, sppm, bpm, vcm, volpath, pssmlt, mmlt")) << message;
+            EXPECT_TRUE(contains(message, "The integrators that render media: lt, bdpt, pm, ppm, sppm, bpm, vcm, upbp, volpath, pssmlt, mmlt")) << message;
             ++refusing;
         }
     }
-    EXPECT_EQ(refusing, 2 * (int(integrators().size()) - 10));  // all but lt, bdpt, pm, ppm, sppm, bpm, vcm, volpath, pssmlt, mmlt
+    EXPECT_EQ(refusing, 2 * (int(integrators().size()) - 11));  // all but lt, bdpt, pm, ppm, sppm, bpm, vcm, upbp, volpath, pssmlt, mmlt
     // From the command line: exit code 2, and `pathlab algorithms` says which render media.
     std::ofstream(path("fog.xml")) << "<scene version=\"3.0.0\">\n<medium type=\"homogeneous\" id=\"fog\"/>\n"
                                       "<shape type=\"cube\"><ref name=\"interior\" id=\"fog\"/></shape>\n" + rest + "</scene>\n";
@@ -268,7 +322,7 @@ TEST_F(SceneFileMedia, IntegratorsWithoutMediaRefuseScenesWithMedia) {
     EXPECT_TRUE(contains(other.err, "--volume-estimate chooses how sppm, ppm and pm gather photons in media")) << other.err;
     EXPECT_FALSE(fs::exists(path("bad.exr")));
     const CliResult list = run({"algorithms"});
-    EXPECT_TRUE(contains(list.out, "Participating media (scenes with a <medium>): lt, bdpt, pm, ppm, sppm, bpm, vcm, volpath, pssmlt, mmlt;")) << list.out;
+    EXPECT_TRUE(contains(list.out, "Participating media (scenes with a <medium>): lt, bdpt, pm, ppm, sppm, bpm, vcm, upbp, volpath, pssmlt, mmlt;")) << list.out;
 }
 
 }  // namespace

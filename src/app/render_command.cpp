@@ -143,6 +143,13 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
     app.add_flag("--guiding-rr", o.guiding_rr,
                  "ppg: adjoint-driven Russian roulette and splitting (Vorba and Krivanek 2016): paths whose expected contribution, "
                  "learned with the SD-tree, is small against the pixel's are ended, large ones split (default: the throughput's roulette)");
+    app.add_option("--estimators", o.estimators,
+                   "upbp: the estimators it combines by MIS, comma-separated, of bpt (bdpt's connections), surf (photon merging on "
+                   "surfaces), pp3d (photon points merged at points in media), pb2d (photon points gathered along the camera rays in "
+                   "media), bb1d (photon beams against the camera rays in media); SmallUPBP's names (default: all)");
+    app.add_option("--photon-beams", o.photon_beams,
+                   "upbp: light paths per iteration whose edges in media are kept as photon beams for bb1d (the first K of the "
+                   "iteration's one per pixel; default 256, or the pixel count if fewer)");
     app.add_option("--chains", o.mlt_chains,
                    "pssmlt, mmlt: Markov chains per pass (a fixed number, so the image does not depend on the threads; default 64)");
     app.add_option("--bootstrap", o.mlt_bootstrap,
@@ -227,6 +234,8 @@ std::vector<RenderJob> make_jobs(const RenderCommandOptions& o, bool check_paths
     request.pbgi_spacing = o.pbgi_spacing;
     request.guiding_spp = o.guiding_spp;
     request.guiding_rr = o.guiding_rr;
+    request.estimators = o.estimators;
+    request.photon_beams = o.photon_beams;
     request.first_sample = o.first_sample;
     request.mlt_chains = o.mlt_chains;
     request.mlt_bootstrap = o.mlt_bootstrap;

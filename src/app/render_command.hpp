@@ -57,6 +57,8 @@ struct RenderCommandOptions {
     std::optional<int> pbgi_spacing;
     std::optional<int> guiding_spp;
     bool guiding_rr = false;
+    std::optional<std::string> estimators;
+    std::optional<int64_t> photon_beams;
     std::string checkpoint;          // --checkpoint FILE
     double checkpoint_every = kDefaultCheckpointEvery;  // --checkpoint-every SECONDS
     std::string resume;              // --resume FILE

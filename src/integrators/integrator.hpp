@@ -66,6 +66,8 @@ struct IntegratorOptions {
     // vcm: its two families of strategies (off: merging = bdpt, connections = bpm).
     bool vcm_merging = true;
     bool vcm_connections = true;
+    std::string estimators;  // upbp: the estimators it combines ("": all; vcm.hpp parse_estimators)
+    int64_t photon_beams = 0;  // upbp: light paths per iteration whose edges are photon beams (0: vcm.hpp's default)
     // ic: rays per record, the error threshold a, gradients on, and where to draw the records.
     int ic_rays = 256;
     float ic_error = 0.2f;

@@ -24,6 +24,7 @@ const IntegratorInfo& pbgi_integrator();
 const IntegratorInfo& ppm_integrator();
 const IntegratorInfo& vcm_integrator();
 const IntegratorInfo& bpm_integrator();
+const IntegratorInfo& upbp_integrator();
 const IntegratorInfo& volpath_integrator();
 const IntegratorInfo& pssmlt_integrator();
 const IntegratorInfo& mmlt_integrator();

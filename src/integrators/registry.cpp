@@ -12,7 +12,7 @@ const std::vector<IntegratorInfo>& integrators() {
         direct_brdf_integrator(),    direct_mis_integrator(),   pt_naive_integrator(),       pt_mis3_integrator(),
         pt_mis_integrator(),         light_tracer_integrator(), bdpt_integrator(),
         pm_integrator(),             ppm_integrator(),          sppm_integrator(),           bpm_integrator(),
-        vcm_integrator(),            ic_integrator(),           pbgi_integrator(),           volpath_integrator(),
+        vcm_integrator(),            upbp_integrator(),         ic_integrator(),           pbgi_integrator(),           volpath_integrator(),
         pssmlt_integrator(),         mmlt_integrator(),         ppg_integrator(),
     };
     return table;

@@ -14,6 +14,7 @@
 #include "image/image_io.hpp"
 #include "job/extra_channels.hpp"
 #include "job/usage_error.hpp"
+#include "integrators/photon/vcm.hpp"
 
 namespace pathlab {
 
@@ -44,8 +45,12 @@ std::optional<double> environment_cap(const char* name) {
 // The first medium the scene renders (the camera's, or one on a side of a shape), and where,
 // for the message of an integrator that cannot render media; "" when the scene has none (media
 // declared and never referred to, and media of no extinction, change nothing).
-std::string medium_in_use(const SceneDescription& d) {
-    const auto attenuates = [&](int32_t m) { return m >= 0 && size_t(m) < d.media.size() && has_extinction(d.media[size_t(m)]); };
+// `only_grids`: heterogeneous media only.
+std::string medium_in_use(const SceneDescription& d, bool only_grids = false) {
+    const auto attenuates = [&](int32_t m) {
+        return m >= 0 && size_t(m) < d.media.size() && has_extinction(d.media[size_t(m)]) &&
+               (!only_grids || std::holds_alternative<HeterogeneousMedium>(d.media[size_t(m)]));
+    };
     const auto label = [&](int32_t m) {
         return size_t(m) < d.medium_labels.size() && !d.medium_labels[size_t(m)].empty() ? d.medium_labels[size_t(m)]
                                                                                         : fmt::format("medium {}", m);
@@ -124,6 +129,19 @@ std::string integrator_refusal(const IntegratorInfo& info, const SceneDescriptio
             return fmt::format("{0} does not render participating media, and this scene has the {1}: {0} would render "
                                "the scene as if the medium were not there. The integrators that render media: {2}",
                                info.name, medium, media_integrator_names());
+    if (info.name == "upbp") {
+        bool beams = true;
+        try {
+            const VcmEstimators e = parse_estimators(r.estimators ? *r.estimators : d.estimators.value_or("all"));
+            beams = e.pb2d || e.bb1d;
+        } catch (const std::invalid_argument&) {  // (said when the options are read)
+        }
+        if (const std::string medium = beams ? medium_in_use(d, true) : ""; !medium.empty())
+            return fmt::format("upbp's beam estimators (pb2d, bb1d) need homogeneous media (the transmittance along a beam in closed "
+                               "form), and this scene has the {}: leave them out (--estimators bpt,surf,pp3d) or render it with "
+                               "volpath, lt, bdpt, pm, ppm, sppm, bpm, vcm, pssmlt or mmlt",
+                               medium);
+    }
     if (info.light_paths)
         if (const std::string m = non_reciprocal_material(d); !m.empty())
             return fmt::format("{} scatters light paths with the adjoint BSDF, and this scene's {} has specular transmission, "
@@ -155,13 +173,17 @@ static std::string option_refusal(const IntegratorInfo& info, const JobRequest& 
     };
     const std::string& a = info.name;
     if (r.photons && !one_of({"sppm", "ppm", "pm"})) return fmt::format("--photons sets the light paths of sppm, ppm and pm; {} has no such count", a);
-    if (r.photon_radius && !one_of({"sppm", "ppm", "pm", "vcm", "bpm"}))
-        return fmt::format("--radius sets the photon radius of sppm, ppm, pm, vcm and bpm; {} has none", a);
-    if (r.photon_alpha && !one_of({"sppm", "ppm", "vcm", "bpm"})) return fmt::format("--alpha is the radius reduction of sppm, ppm, vcm and bpm, not {}'s", a);
+    if (r.photon_radius && !one_of({"sppm", "ppm", "pm", "vcm", "bpm", "upbp"}))
+        return fmt::format("--radius sets the photon radius of sppm, ppm, pm, vcm, bpm and upbp; {} has none", a);
+    if (r.photon_alpha && !one_of({"sppm", "ppm", "vcm", "bpm", "upbp"}))
+        return fmt::format("--alpha is the radius reduction of sppm, ppm, vcm, bpm and upbp, not {}'s", a);
+    if (r.estimators && a != "upbp") return fmt::format("--estimators chooses the estimators upbp combines; {} has no such choice", a);
+    if (r.photon_beams && a != "upbp") return fmt::format("--photon-beams sets how many of upbp's light paths leave photon beams; {} has none", a);
+    if (r.photon_beams && *r.photon_beams < 0) return "--photon-beams must be zero (the default count) or positive";
     if (r.volume_beam && !one_of({"sppm", "ppm", "pm"}))
         return fmt::format("--volume-estimate chooses how sppm, ppm and pm gather photons in media; {} has no such choice", a);
-    if (r.mis_power && !one_of({"bdpt", "vcm", "bpm", "mmlt", "pt-mis", "pt-mis3", "direct-mis"}))
-        return fmt::format("--mis chooses the heuristic of bdpt, vcm, bpm, mmlt, pt-mis, pt-mis3 and direct-mis; {} has its own", a);
+    if (r.mis_power && !one_of({"bdpt", "vcm", "bpm", "upbp", "mmlt", "pt-mis", "pt-mis3", "direct-mis"}))
+        return fmt::format("--mis chooses the heuristic of bdpt, vcm, bpm, upbp, mmlt, pt-mis, pt-mis3 and direct-mis; {} has its own", a);
     if (!r.vcm_merging && !r.vcm_connections) return "--no-merging and --no-connections together leave vcm no strategy";
     if ((!r.vcm_merging || !r.vcm_connections) && a != "vcm")
         return fmt::format("--no-merging and --no-connections switch off vcm's strategies, not {}'s", a);
@@ -229,6 +251,16 @@ RenderJob::RenderJob(SceneChoice scene, const JobRequest& r) : choice_(std::move
     options_.mlt_chains = r.mlt_chains.value_or(options_.mlt_chains);
     options_.guiding_spp = r.guiding_spp ? *r.guiding_spp : d.guiding_spp.value_or(options_.guiding_spp);
     options_.guiding_rr = r.guiding_rr || d.guiding_rr.value_or(false);
+    if (info_->name == "upbp") {
+        options_.estimators = r.estimators ? *r.estimators : d.estimators.value_or("all");
+        try {
+            options_.estimators = estimator_names(parse_estimators(options_.estimators));
+        } catch (const std::invalid_argument& e) {
+            throw UsageError(e.what());
+        }
+        if (options_.estimators.empty()) throw UsageError("--estimators is empty: upbp needs at least one of bpt, surf, pp3d, pb2d, bb1d");
+        options_.photon_beams = r.photon_beams ? *r.photon_beams : d.photon_beams.value_or(0);
+    }
     options_.mlt_bootstrap = r.mlt_bootstrap.value_or(options_.mlt_bootstrap);
     options_.mlt_large_step = r.mlt_large_step.value_or(options_.mlt_large_step);
     options_.mlt_sigma = r.mlt_sigma.value_or(options_.mlt_sigma);

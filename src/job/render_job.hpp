@@ -62,6 +62,8 @@ struct JobRequest {
     std::optional<int> pbgi_spacing;          // --pbgi-spacing (pbgi)
     std::optional<int> guiding_spp;           // --guiding-spp (ppg)
     bool guiding_rr = false;                  // --guiding-rr (ppg)
+    std::optional<std::string> estimators;    // --estimators (upbp)
+    std::optional<int64_t> photon_beams;      // --photon-beams (upbp)
     std::optional<LightSamplerKind> light_sampler;  // --light-sampler (next-event estimation; default power)
     std::optional<int> ris_candidates;              // --ris-candidates (ris)
     std::optional<int> mlt_chains;                  // --chains (pssmlt)

@@ -61,6 +61,8 @@ struct SceneDescription {
     std::optional<bool> ic_gradients, ic_clamp_screen, ic_clamp_neighbours;
     std::optional<int> guiding_spp;                                                        // ppg: training_spp
     std::optional<bool> guiding_rr;                                                        // ppg: guiding_rr
+    std::optional<std::string> estimators;                                                 // upbp: estimators
+    std::optional<int64_t> photon_beams;                                                   // upbp: photon_beams
     bool spectral = false;                        // <default name="mode" value="spectral"/>: spectral mode
     // How next-event estimation chooses a light (--light-sampler; not a scene-file setting).
     LightSamplerKind light_sampler = LightSamplerKind::Power;

@@ -126,6 +126,12 @@ void read_plain_integrator(XmlSource& xml, const pugi::xml_node& n, SceneBuilder
         positive("gather_spacing", 1, 64, b.desc.pbgi_spacing);
         positive("training_spp", 0, 1 << 20, b.desc.guiding_spp);  // ppg
         if (plugin.find("guiding_rr") && p.has("guiding_rr")) b.desc.guiding_rr = p.get_bool("guiding_rr");
+        if (plugin.find("estimators") && p.has("estimators")) b.desc.estimators = p.get_string("estimators");
+        if (plugin.find("photon_beams") && p.has("photon_beams")) {
+            const int count = p.get_int("photon_beams");
+            if (count < 0) p.fail("photon_beams", fmt::format("photon_beams must be zero (the default) or positive, got {}", count));
+            b.desc.photon_beams = count;
+        }
         if (plugin.find("cutoff") && p.has("cutoff")) {
             const float c = p.get_float("cutoff");
             if (!(c >= 0 && c <= 4 * kPi)) p.fail("cutoff", fmt::format("cutoff must be a solid angle from 0 to 4 pi, got {}", c));

@@ -67,7 +67,8 @@ Bdpt<T>::~Bdpt() = default;
 
 template <class T>
 void Bdpt<T>::random_walk(const RenderContext& ctx, Ray ray, Sampler& sampler, Colour beta, float pdfW, int max_vertices,
-                          TransportMode mode, Wavelengths wl, Subpath& path, int32_t medium, int hero) const {
+                          TransportMode mode, Wavelengths wl, Subpath& path, int32_t medium, int hero,
+                          std::vector<SubpathBeam<T>>* beams) const {
     const Scene& scene = ctx.scene;
     const bool media = scene.has_media();
     // Media's random numbers and the subpath's spectral MIS state (media_walk.hpp).
@@ -88,7 +89,17 @@ void Bdpt<T>::random_walk(const RenderContext& ctx, Ray ray, Sampler& sampler, C
         } else {
             // Through media and index-matched boundaries to a scattering point or a surface.
             Colour seg(1.0f);
-            const MediumWalk w = walk_media(scene, ray, medium, st, seg, &v.T_in);
+            MediumWalk w;
+            if (!beams) {
+                w = walk_media(scene, ray, medium, st, seg, &v.T_in);
+            } else {
+                const int from = int(prev);
+                const bool dispersed = v.dispersed;
+                w = walk_media(scene, ray, medium, st, seg, &v.T_in,
+                               [&](const Vec3f& o, const Vec3f& d, float length, int32_t m, const Colour& seg_o, const Colour& r_o, float mis_T) {
+                                   beams->push_back({o, d, length, pdfW, mis_T, m, from, dispersed, beta * seg_o, r_o});
+                               });
+            }
             if (w.kind == MediumWalk::kLost) return;
             if (faults_.drop_distance_pdf) v.T_in = 1;
             beta *= seg;
@@ -146,6 +157,7 @@ void Bdpt<T>::random_walk(const RenderContext& ctx, Ray ray, Sampler& sampler, C
             beta *= weight;
             scatter *= weight;
             wo = ps.wo;
+            cur.sin_theta = length(cross(cur.dir, wo));
             pdfW = ps.pdfW;
             pdf_rev = phase_pdf(phase, ps.wo, cur.dir);
         } else {
@@ -203,16 +215,17 @@ int Bdpt<T>::sample_hero(const RenderContext& ctx, size_t pixel, uint64_t pass, 
 
 template <class T>
 void Bdpt<T>::camera_subpath(const RenderContext& ctx, size_t pixel, Sampler& sampler, const Wavelengths& wl, Subpath& path,
-                             const Vec2f* shift, const MergeMis* vm, int hero) const {
+                             const Vec2f* shift, const MergeMis* vm, int hero, std::vector<SubpathBeam<T>>* beams) const {
     const Vec2f jitter = shift ? (sampler.next2d(), *shift) : sampler.next2d();
     const float x = float(pixel % size_t(ctx.width)), y = float(pixel / size_t(ctx.width));
-    camera_subpath_at(ctx, {x + jitter.x, y + jitter.y}, sampler, wl, path, max_camera_vertices(), vm, hero);
+    camera_subpath_at(ctx, {x + jitter.x, y + jitter.y}, sampler, wl, path, max_camera_vertices(), vm, hero, beams);
 }
 
 template <class T>
 void Bdpt<T>::camera_subpath_at(const RenderContext& ctx, Vec2f raster, Sampler& sampler, const Wavelengths& wl, Subpath& path,
-                                int max_vertices, const MergeMis* vm, int hero) const {
+                                int max_vertices, const MergeMis* vm, int hero, std::vector<SubpathBeam<T>>* beams) const {
     path.clear();
+    if (beams) beams->clear();
     Vertex c;
     c.kind = VertexKind::Camera;
     c.p = ctx.camera.position();
@@ -223,14 +236,15 @@ void Bdpt<T>::camera_subpath_at(const RenderContext& ctx, Vec2f raster, Sampler&
     const Ray ray = ctx.camera.generate(raster.x, raster.y);
     // We cos / (pdfA pdfW) = 1 for the pinhole: the camera path starts with throughput 1.
     random_walk(ctx, ray, sampler, Colour(1.0f), ctx.camera.pdf_direction(ray.d), max_vertices, TransportMode::Radiance, wl, path,
-                c.medium, hero);
+                c.medium, hero, beams);
     set_running_mis(path.data(), int(path.size()), /*light_side=*/false, MisRules(options_.mis_power, vm));
 }
 
 template <class T>
 void Bdpt<T>::light_subpath(const RenderContext& ctx, Sampler& sampler, const Wavelengths& wl, Subpath& path, const MergeMis* vm,
-                            int hero, int max_vertices) const {
+                            int hero, int max_vertices, std::vector<SubpathBeam<T>>* beams) const {
     path.clear();
+    if (beams) beams->clear();
     const Scene& scene = ctx.scene;
     const auto start = start_light_path(scene, sampler);
     if (!start) return;
@@ -253,7 +267,10 @@ void Bdpt<T>::light_subpath(const RenderContext& ctx, Sampler& sampler, const Wa
     const Colour beta = l.beta * (es->cos / (choice.pmf * es->pdfA * es->pdfW));
     const Ray ray = (flags & kLightSurface) ? spawn_ray(es->origin, es->normal, es->direction) : Ray{es->origin, es->direction, kInf};
     random_walk(ctx, ray, sampler, beta, es->pdfW, max_vertices < 0 ? max_light_vertices() : max_vertices, TransportMode::Importance, wl,
-                path, l.medium, hero);
+                path, l.medium, hero, beams);
+    if (l.infinite && beams)
+        for (SubpathBeam<T>& b : *beams)
+            if (b.from == 0) b.pdfW = es->pdfA, b.from_infinity = true;
     if (l.infinite) {
         // From infinity the first hit's density is that of the entry disk, projected; the light
         // vertex's own density is that of its direction under light sampling.
@@ -287,6 +304,11 @@ ConnectionDensities Bdpt<T>::connection_densities(const RenderContext& ctx, cons
         d.light_end = (known.pt_to_qs >= 0 ? to_area_density(known.pt_to_qs, *pt, *qs) : pdf_next(scene, ctx.camera, pt_minus, *pt, *qs)) *
                       factor(*qs, known.T);
     if (qs_minus) d.light_prev = pdf_next(scene, ctx.camera, pt, *qs, *qs_minus) * factor(*qs_minus, qs->T_in);
+    if (qs && (qs->kind == VertexKind::Medium || pt->kind == VertexKind::Medium)) {
+        const Vec3f w = normalize(pt->p - qs->p);
+        if (qs->kind == VertexKind::Medium) d.light_end_sin = length(cross(qs->dir, w));
+        if (pt->kind == VertexKind::Medium) d.camera_end_sin = length(cross(pt->dir, w));
+    }
     return d;
 }
 
@@ -302,8 +324,9 @@ float Bdpt<T>::mis_weight(const RenderContext& ctx, SubpathView light, int s, Su
     const ConnectionDensities d = connection_densities(ctx, ys, s, zs, t, known);
     const MisRules rules(options_.mis_power, vm);
     double sum = 0;
-    if (s >= 1) sum += light_side_sum(ys, s - 1, d.light_end, d.light_prev, rules);
-    if (t >= 2) sum += camera_side_sum(zs, t - 1, zs[t - 1].pdf_fwd, d.camera_end, d.camera_end, s >= 1, d.camera_prev, rules);
+    if (s >= 1) sum += light_side_sum(ys, s - 1, d.light_end, d.light_prev, rules, d.light_end_sin);
+    if (t >= 2)
+        sum += camera_side_sum(zs, t - 1, zs[t - 1].pdf_fwd, d.camera_end, d.camera_end, s >= 1, d.camera_prev, rules, d.camera_end_sin);
     return float(1 / (1 + sum));
 }
 
@@ -325,6 +348,8 @@ float Bdpt<T>::mis_weight_oracle(const RenderContext& ctx, SubpathView light_vie
     pt->delta = false;
     if (qs) qs->delta = false;
     pt->pdf_rev = d.camera_end;
+    pt->sin_theta = d.camera_end_sin;
+    if (qs) qs->sin_theta = d.light_end_sin;
     if (pt_minus) pt_minus->pdf_rev = d.camera_prev;
     if (qs) qs->pdf_rev = d.light_end;
     if (qs_minus) qs_minus->pdf_rev = d.light_prev;

@@ -57,6 +57,23 @@ namespace pathlab {
 class StrategyImages;
 
 // Deliberate faults, for the tests that must be able to fail (never set by pathlab itself).
+// A piece of a subpath's edge inside a medium (upbp's query beams on the camera side, photon
+// beams on the light side): it leaves vertex `from` with solid-angle density pdfW (from a light at
+// infinity: the area density of its entry disk, from_infinity) and runs from o along the unit d
+// for `length` (to where the walk sampled the edge's end, or to a boundary), in `medium`, with the
+// subpath's throughput, its channels' densities (PathVertex::r) and the MIS transmittance from
+// vertex `from`, all at o.
+template <class T>
+struct SubpathBeam {
+    Vec3f o, d;
+    float length = 0, pdfW = 0, mis_T = 1;
+    int32_t medium = -1;
+    int from = 0;
+    bool dispersed = false;
+    ColourOf<T> beta{0.0f}, r{1.0f};
+    bool from_infinity = false;
+};
+
 struct BdptFaults {
     bool drop_nee_strategy = false;      // MIS weights leave the s = 1 strategies out of their sums
     bool specular_pdf_rev_missing = false;  // a Dirac vertex's reverse density left unset (0)
@@ -94,6 +111,8 @@ struct EdgeDensities {
 // its camera endpoint z_{t-1} and the one before it, its light endpoint y_{s-1} and the one before.
 struct ConnectionDensities {
     float camera_end = 0, camera_prev = 0, light_end = 0, light_prev = 0;
+    // At an endpoint in a medium: the sine of the angle between its edge and the new one (upbp's bb1d).
+    float camera_end_sin = 0, light_end_sin = 0;
 };
 
 template <class T>
@@ -117,14 +136,18 @@ public:
     // `shift`: with a reconstruction filter, the pass's lattice shift replaces the pixel's jitter.
     // `hero`: in media, the channel that drives distance sampling, shared by the subpaths of a
     // sample (sample_hero; -1: drawn from the subpath's own stream).
+    // `beams`: the pieces of its edges inside media, if asked for (upbp).
     void camera_subpath(const RenderContext& ctx, size_t pixel, Sampler& sampler, const Wavelengths& wl, Subpath& path,
-                        const Vec2f* shift = nullptr, const MergeMis* vm = nullptr, int hero = -1) const;
+                        const Vec2f* shift = nullptr, const MergeMis* vm = nullptr, int hero = -1,
+                        std::vector<SubpathBeam<T>>* beams = nullptr) const;
     // `max_vertices` (mmlt): at most this many vertices (-1: as many as --max-depth allows).
     void light_subpath(const RenderContext& ctx, Sampler& sampler, const Wavelengths& wl, Subpath& path,
-                       const MergeMis* vm = nullptr, int hero = -1, int max_vertices = -1) const;
+                       const MergeMis* vm = nullptr, int hero = -1, int max_vertices = -1,
+                       std::vector<SubpathBeam<T>>* beams = nullptr) const;
     // The camera subpath through the raster position `raster` (mmlt's), of at most max_vertices vertices.
     void camera_subpath_at(const RenderContext& ctx, Vec2f raster, Sampler& sampler, const Wavelengths& wl, Subpath& path,
-                           int max_vertices, const MergeMis* vm = nullptr, int hero = -1) const;
+                           int max_vertices, const MergeMis* vm = nullptr, int hero = -1,
+                           std::vector<SubpathBeam<T>>* beams = nullptr) const;
     // The hero channel of a pixel sample in a scene with media (from a stream of its own; RGB
     // draws one of the three, spectral mode's hero is its first wavelength), else -1.
     static int sample_hero(const RenderContext& ctx, size_t pixel, uint64_t pass, const Wavelengths& wl);
@@ -186,7 +209,7 @@ public:
 private:
     // Extends `path` from its last vertex along `ray` (starting in `medium`); `hero` as for the subpaths.
     void random_walk(const RenderContext& ctx, Ray ray, Sampler& sampler, Colour beta, float pdfW, int max_vertices, TransportMode mode,
-                     Wavelengths wl, Subpath& path, int32_t medium, int hero) const;
+                     Wavelengths wl, Subpath& path, int32_t medium, int hero, std::vector<SubpathBeam<T>>* beams = nullptr) const;
 
     IntegratorOptions options_;
     BdptFaults faults_;

@@ -27,6 +27,7 @@
 // and the ratios p_{i+1} / p_i of neighbouring strategies are pdf_rev / pdf_fwd of one vertex.
 #pragma once
 
+#include <cmath>
 #include <vector>
 
 #include "integrators/common/shading.hpp"
@@ -59,6 +60,7 @@ struct PathVertexBase {
     int32_t medium = -1;
     const MediumInterface* media = nullptr;
     float sigma_mis = 1;     // a medium vertex's extinction (1 elsewhere)
+    float sin_theta = 0;     // a medium vertex with an edge on: |sin| of the angle between its two edges (upbp's bb1d)
     float T_in = 1;          // the MIS transmittance of the edge from the previous vertex
     // The running MIS quantity (set_running_mis): the part of a strategy's MIS sum that comes
     // from this subpath's vertices two or more before this one, as a connection or merge ending
@@ -117,8 +119,12 @@ struct MisVertex {
     float pdf_fwd, pdf_rev;
     bool delta, delta_light;
     VertexKind kind;  // merging happens at surface and medium vertices
+    float sigma_mis = 1;  // a medium vertex's extinction in the densities (the beam estimators leave it out)
+    float sin_theta = 0;  // ... the angle between its two edges (bb1d)
 };
-inline MisVertex mis_vertex(const PathVertexBase& v) { return {v.pdf_fwd, v.pdf_rev, v.delta, v.delta_light, v.kind}; }
+inline MisVertex mis_vertex(const PathVertexBase& v) {
+    return {v.pdf_fwd, v.pdf_rev, v.delta, v.delta_light, v.kind, v.sigma_mis, v.sin_theta};
+}
 
 // Vertex merging (vcm, bpm; Georgiev et al. 2012): the strategies a path can also be sampled by.
 // Merging at vertex x (a non-Dirac surface vertex with at least one light vertex before it and
@@ -130,15 +136,36 @@ inline MisVertex mis_vertex(const PathVertexBase& v) { return {v.pdf_fwd, v.pdf_
 // In a medium (the point-point estimator of UPBP, Krivanek et al. 2014) x is a medium vertex,
 // its densities are per unit volume and the acceptance region is the ball, eta_volume = the
 // number of light paths times 4/3 pi r^3.
+//
+// upbp adds a second strategy at a medium vertex x: the point-beam estimator (P-B2D, Křivánek et
+// al. 2014; Jarosz et al.'s beam radiance estimate), a photon point found within r of the camera
+// subpath's edge through x. That edge's camera side samples x's direction but not its distance
+// (the query beam is the whole edge, up to where the walk sampled its end: covering x with
+// probability T, which stays in the density), so its density is the connection's times the
+// light side's density of x, times eta_beam2d = N pi r^2 over x's extinction sigma.
+// And the beam-beam estimator (B-B1D, Jarosz et al. 2011): a light subpath's edge through x (a
+// photon beam) passing within r of the camera subpath's edge through x, neither side sampling
+// x's distance along its edge, the kernel 1 / (2r) across both and the estimate divided by the
+// sine of the angle between them: eta_beam1d sin(theta) / sigma^2 with eta_beam1d = N 2r.
+// Several strategies at one vertex add h(psi eta_k) each; as h(ab) = h(a) h(b), that is one
+// term h(psi eta_eff) with h(eta_eff) = sum_k h(eta_k) (merge_eta).
 struct MergeMis {
     double eta = 0, eta_volume = 0;
+    double eta_beam2d = 0;    // point-beam (upbp's pb2d): 0 when it takes no part
+    double eta_beam1d = 0;    // beam-beam (upbp's bb1d): 0 when it takes no part
     bool merging = false;     // merging strategies take part
     bool connections = true;  // connection strategies with s >= 1 take part (s = 0 always does)
 };
 
-// Whether merging may happen at a vertex of this kind (if it is not Dirac), and with which eta.
+// Whether merging may happen at a vertex of this kind (if it is not Dirac), and with which eta:
+// every merging strategy there, for the balance (power = false) or power heuristic.
 inline bool merges_at(VertexKind k) { return k == VertexKind::Surface || k == VertexKind::Medium; }
-inline double merge_eta(const MergeMis& vm, VertexKind k) { return k == VertexKind::Medium ? vm.eta_volume : vm.eta; }
+inline double merge_eta(const MergeMis& vm, VertexKind k, float sigma_mis, float sin_theta, bool power) {
+    if (k != VertexKind::Medium) return vm.eta;
+    if (vm.eta_beam2d == 0 && vm.eta_beam1d == 0) return vm.eta_volume;
+    const double sigma = sigma_mis, b2 = vm.eta_beam2d / sigma, b1 = vm.eta_beam1d * double(sin_theta) / (sigma * sigma);
+    return power ? std::sqrt(vm.eta_volume * vm.eta_volume + b2 * b2 + b1 * b1) : vm.eta_volume + b2 + b1;
+}
 
 // The sum over the path's strategies other than (s, t) of (p_i / p_(s,t))^beta (beta = 2 for
 // the power heuristic, else 1): Veach's ratio walk over light(0..s) and camera(0..t), callables
@@ -155,7 +182,7 @@ double mis_ratio_sum(const LightAt& light, int s, const CameraAt& camera, int t,
     for (int i = t - 1; i > 0; --i) {
         const MisVertex c = camera(i);
         // Merging at camera vertex i: ri is here the ratio of the connection ending there.
-        if (merging && merges_at(c.kind) && !c.delta && s + (t - 1 - i) >= 1) sum += h(ri * double(c.pdf_rev) * merge_eta(*vm, c.kind));
+        if (merging && merges_at(c.kind) && !c.delta && s + (t - 1 - i) >= 1) sum += h(ri * double(c.pdf_rev) * merge_eta(*vm, c.kind, c.sigma_mis, c.sin_theta, power));
         ri *= remap0(c.pdf_rev) / remap0(c.pdf_fwd);
         if (connections && !c.delta && !camera(i - 1).delta) sum += h(ri);
     }
@@ -167,7 +194,7 @@ double mis_ratio_sum(const LightAt& light, int s, const CameraAt& camera, int t,
         const bool delta_before = i > 0 ? light(i - 1).delta : l.delta_light;
         if ((connections || i == 0) && !l.delta && !delta_before) sum += h(ri);
         // Merging at light vertex i, now the camera endpoint of the connection (i, s + t - i).
-        if (merging && i >= 1 && merges_at(l.kind) && !l.delta) sum += h(ri * double(l.pdf_fwd) * merge_eta(*vm, l.kind));
+        if (merging && i >= 1 && merges_at(l.kind) && !l.delta) sum += h(ri * double(l.pdf_fwd) * merge_eta(*vm, l.kind, l.sigma_mis, l.sin_theta, power));
     }
     return sum;
 }
@@ -203,14 +230,18 @@ float mis_weight_ratio_walk(const Vertex* light, int s, const Vertex* camera, in
 struct MisRules {
     bool power = false;
     bool merging = false, connections = true;
-    double eta = 0, eta_volume = 0;
-    MisRules(bool power_heuristic, const MergeMis* vm) : power(power_heuristic) {
-        if (vm) merging = vm->merging, connections = vm->connections, eta = vm->eta, eta_volume = vm->eta_volume;
+    MergeMis vm;
+    MisRules(bool power_heuristic, const MergeMis* merge) : power(power_heuristic) {
+        if (merge) merging = merge->merging, connections = merge->connections, vm = *merge;
     }
     double h(double r) const { return power ? r * r : r; }
     // Whether a merge at vertex v is a strategy, and its eta.
     bool merge_at(const PathVertexBase& v) const { return merging && merges_at(v.kind) && !v.delta; }
-    double eta_at(const PathVertexBase& v) const { return v.kind == VertexKind::Medium ? eta_volume : eta; }
+    double eta_at(const PathVertexBase& v) const { return merge_eta(vm, v.kind, v.sigma_mis, v.sin_theta, power); }
+    // ... with the angle between its edges that a strategy gives it (negative: its own).
+    double eta_at(const PathVertexBase& v, float sin_theta) const {
+        return merge_eta(vm, v.kind, v.sigma_mis, sin_theta < 0 ? v.sin_theta : sin_theta, power);
+    }
     static double remap0(double f) { return f != 0 ? f : 1.0; }
 };
 
@@ -244,24 +275,26 @@ void set_running_mis(Vertex* v, int n, bool light_side, const MisRules& m) {
 }
 
 // The light side's part of the MIS sum of a connection ending at y_e (e = s - 1, not Dirac
-// there), with the densities rev_e of y_e and rev_prev of y_{e-1} that the connection gives.
+// there), with the densities rev_e of y_e and rev_prev of y_{e-1} that the connection gives
+// (and the sine of the angle at y_e between its edge and the connection's, for bb1d).
 template <class Vertex>
-double light_side_sum(const Vertex* y, int e, double rev_e, double rev_prev, const MisRules& m) {
+double light_side_sum(const Vertex* y, int e, double rev_e, double rev_prev, const MisRules& m, float sin_e = -1) {
     const double q = m.h(MisRules::remap0(rev_e) / MisRules::remap0(y[e].pdf_fwd));
     if (e == 0) return y[0].delta_light ? 0.0 : q;
     double inner = m.h(MisRules::remap0(rev_prev) / MisRules::remap0(y[e - 1].pdf_fwd)) * y[e].mis_running;
     if (m.connections && !y[e - 1].delta) inner += 1;
-    if (m.merging && merges_at(y[e].kind)) inner += m.h(double(y[e].pdf_fwd) * m.eta_at(y[e]));  // (y_e is connected: not Dirac here)
+    if (m.merging && merges_at(y[e].kind)) inner += m.h(double(y[e].pdf_fwd) * m.eta_at(y[e], sin_e));  // (y_e is connected: not Dirac here)
     return q * inner;
 }
 
 // The camera side's part of the MIS sum of a strategy ending at z_e (e = t - 1 >= 1, not Dirac
 // there): z_e's light-side density rev_e (merging at z_e counts with psi_e, its density from the
 // light side; merge_here: the strategy has a light vertex), and
-// z_{e-1}'s, rev_prev. `fwd_e` is z_e's own density (a merge's camera endpoint has its own).
+// z_{e-1}'s, rev_prev. `fwd_e` is z_e's own density (a merge's camera endpoint has its own);
+// sin_e the sine of the angle at z_e between its edge and the strategy's light side (bb1d).
 template <class Vertex>
 double camera_side_sum(const Vertex* z, int e, double fwd_e, double rev_e, double psi_e, bool merge_here, double rev_prev,
-                       const MisRules& m) {
+                       const MisRules& m, float sin_e = -1) {
     double inner = 0;
     if (e >= 2) {
         inner = m.h(MisRules::remap0(rev_prev) / MisRules::remap0(z[e - 1].pdf_fwd)) * z[e].mis_running;
@@ -269,7 +302,7 @@ double camera_side_sum(const Vertex* z, int e, double fwd_e, double rev_e, doubl
     }
     if (m.connections && !z[e - 1].delta) inner += 1;
     double sum = m.h(MisRules::remap0(rev_e) / MisRules::remap0(fwd_e)) * inner;
-    if (merge_here && m.merging && merges_at(z[e].kind)) sum += m.h(psi_e * m.eta_at(z[e]));
+    if (merge_here && m.merging && merges_at(z[e].kind)) sum += m.h(psi_e * m.eta_at(z[e], sin_e));
     return sum;
 }
 

@@ -14,6 +14,7 @@
 #pragma once
 
 #include <optional>
+#include <type_traits>
 
 #include "integrators/common/shading.hpp"
 #include "integrators/common/transport.hpp"
@@ -69,11 +70,20 @@ inline bool intersect_with_boundaries(const Scene& scene, const Ray& ray, Inters
     return scene.has_media() ? scene.intersect(ray, hit, kMaskAll, media) : scene.intersect(ray, hit);
 }
 
+// The pieces of a walk (what upbp's beam estimators query) are not kept unless asked for.
+struct NoPieces {
+    template <class... A> void operator()(const A&...) const {}
+};
+
 // Follows `ray` from medium `medium` through media and index-matched boundaries. `seg` is
 // multiplied by the free-flight weights (and st.r by the channels' densities); `mis_T`, if
-// given, by the MIS transmittance of the pieces walked.
-template <class T>
-MediumWalk walk_media(const Scene& scene, Ray ray, int32_t medium, MediumState<T>& st, ColourOf<T>& seg, float* mis_T = nullptr) {
+// given, by the MIS transmittance of the pieces walked. Each piece in a medium goes to
+// on_piece(o, d, length, medium, seg, r, mis_T) before it is walked: from o along the unit d for
+// `length` (to where the walk scattered, or to the piece's end), with seg, st.r and the MIS
+// transmittance (1 without mis_T) as they stood at o.
+template <class T, class OnPiece = NoPieces>
+MediumWalk walk_media(const Scene& scene, Ray ray, int32_t medium, MediumState<T>& st, ColourOf<T>& seg, float* mis_T = nullptr,
+                      OnPiece&& on_piece = {}) {
     for (int crossings = 0; crossings < kMaxCrossings; ++crossings) {
         MediumWalk w;
         w.dir = ray.d;
@@ -83,8 +93,11 @@ MediumWalk walk_media(const Scene& scene, Ray ray, int32_t medium, MediumState<T
             const float len = length(ray.d);
             const Vec3f d = ray.d / len;
             const float tmax = hit ? w.isect.t * len : kInf;
+            [[maybe_unused]] const ColourOf<T> seg_before = seg, r_before = st.r;
             const FreeFlight ff = sample_free_flight(medium_view(scene.medium(medium), st.wl), ray.o, d, tmax, st.hero_channel(),
                                                      st.rng(), seg, st.r, st.majorant_factor);
+            if constexpr (!std::is_same_v<std::decay_t<OnPiece>, NoPieces>)
+                on_piece(ray.o, d, ff.scattered ? ff.t : tmax, medium, seg_before, r_before, mis_T ? *mis_T : 1.0f);
             if (mis_T) *mis_T *= mis_transmittance(scene.medium(medium), ray.o, d, ff.scattered ? ff.t : tmax);
             if (ff.scattered) {
                 w.kind = MediumWalk::kMedium;

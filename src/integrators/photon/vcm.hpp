@@ -47,6 +47,21 @@
 // photon or camera vertex was reached through one counts lane 0 times 4, once for the whole path
 // (MergeSum against the camera's wavelengths, then hero_only() when the camera side is the
 // dispersed one).
+//
+// upbp (Křivánek, Georgiev, Hachisuka, Vévoda, Šik, Nowrouzezahrai and Jarosz 2014, "Unifying
+// points, beams, and paths in volumetric light transport simulation") is this class with a
+// choice of estimators (--estimators, SmallUPBP's names): bpt (the connections), surf (merging on
+// surfaces), pp3d (merging at points in media: the ball above) and pb2d, the point-beam estimator:
+// every piece of every camera subpath edge inside a medium (a query beam, from its vertex to
+// where the walk sampled the edge's end: a "short" beam) gathers the medium photons within r of
+// it (Jarosz, Zwicker and Jensen 2008's beam radiance estimate with a fixed radius; BallTree):
+// photon y at distance s along the beam adds
+//   phase(y, -d, wi_y) beta_y beta_beam T(s) / (P(s) N pi r^2),
+// P(s) the probability that the walk reached s (T(s) for the channel that sampled it, whose
+// channels' mean the spectral MIS divides by, as for a connection). Its MIS density leaves out the
+// camera side's distance density of y but not P(s): eta_beam2d / sigma (path_vertex.hpp). s = 0
+// (the camera subpath hitting a light) always takes part, so every subset renders the whole image.
+// pb2d needs homogeneous media (the closed-form T(s)); a scene with a grid medium is refused.
 #pragma once
 
 #include <tbb/enumerable_thread_specific.h>
@@ -55,6 +70,8 @@
 
 #include "integrators/bidir/bdpt.hpp"
 #include "integrators/integrator.hpp"
+#include "integrators/photon/ball_tree.hpp"
+#include "integrators/photon/beam_tree.hpp"
 #include "integrators/photon/photon.hpp"
 #include "integrators/photon/photon_grid.hpp"
 #include "render/pass_image.hpp"
@@ -73,8 +90,24 @@ struct MergeVertex : Photon<T> {
     bool prev_delta = false; // the vertex before it scattered by a Dirac lobe
 };
 
+// The estimators of the vcm family, by SmallUPBP's names: bdpt's connections (bpt), merging on
+// surfaces (surf), at points in media (pp3d), photon points along camera beams (pb2d) and photon
+// beams against camera beams (bb1d).
+struct VcmEstimators {
+    bool bpt = true, surf = true, pp3d = true, pb2d = false, bb1d = false;
+    bool merging() const { return surf || pp3d || pb2d || bb1d; }
+};
+// A comma-separated list of estimator names ("" or "all": every one); std::invalid_argument
+// names the valid ones.
+VcmEstimators parse_estimators(const std::string& list);
+// The list's names, in the canonical order (for messages and the render's identity).
+std::string estimator_names(const VcmEstimators& e);
+
 // Deliberate faults, for the tests that must be able to fail.
 struct VcmFaults {
+    bool beam_without_transmittance = false;  // pb2d leaves the beam's T(s) out of a photon's contribution (keeps 1 / P(s))
+    bool beam_kernel_as_ball = false;         // pb2d divides by N 4/3 pi r^3 instead of N pi r^2 (not in the MIS)
+    bool beam_beam_without_sine = false;      // bb1d leaves 1 / sin(theta) out of its estimate (not of the MIS)
     bool no_pi_in_kernel = false;  // the merge divides by N r^2 instead of N pi r^2 (also in the MIS)
     bool merge_weight_without_light_pdf = false;  // a merge's own density lacks the light side's density of its vertex
     bool volume_kernel_as_disc = false;  // a merge in a medium divides by N pi r^2 (the surfaces' kernel; also in the MIS)
@@ -105,15 +138,41 @@ public:
     // direction with solid-angle density pdf_to_light and the camera's from it with pdf_to_camera:
     // O(1), from the running quantities of both subpaths (made with the same `vm`).
     // camera_prev_g: to_area_density(1, z_{t-1}, z_{t-2}) if known (negative: computed here).
+    // own_eta: the merge's own eta (negative: the point estimator's at z_{t-1}, eta or eta_volume).
     float merge_weight(const MergeVertex<T>& photon, float pdf_to_light, float pdf_to_camera, const std::vector<Vertex>& camera,
-                       int t, const MergeMis& vm, float camera_prev_g = -1) const;
+                       int t, const MergeMis& vm, float camera_prev_g = -1, double own_eta = -1) const;
+    // The point-beam estimate (pb2d) along one query beam of the camera subpath, MIS-weighted
+    // against every strategy in `vm` (times the beam's throughput). `scratch` holds the camera
+    // subpath up to the beam's vertex and the merge vertex on the beam.
+    Colour beam_merge(const Scene& scene, const std::vector<Vertex>& camera, const SubpathBeam<T>& beam, float r, const MergeMis& vm,
+                      const Wavelengths& wl, std::vector<Vertex>& scratch) const;
+    // The MIS weight of pb2d merging photon y_{s-1} on the camera beam from z_{a} at distance
+    // `along`, by the running quantities and by the ratio walk (the tests' oracle).
+    float beam_merge_weight(const Scene& scene, const Vertex* y, int s, const std::vector<Vertex>& camera, const SubpathBeam<T>& beam,
+                            float along, const MergeMis& vm, bool oracle) const;
+    // The beam-beam estimate (bb1d) of the iteration's photon beams along one query beam,
+    // MIS-weighted (times both beams' throughputs).
+    Colour beam_beam(const Scene& scene, const std::vector<Vertex>& camera, const SubpathBeam<T>& beam, float r, const MergeMis& vm,
+                     const Wavelengths& wl, std::vector<Vertex>& scratch) const;
+    // The MIS weight of bb1d joining the light subpath y's beam `light_beam` (from y_{from}) at
+    // distance along_light with the camera beam at distance along_camera, by the running
+    // quantities and by the ratio walk (the tests' oracle).
+    float beam_beam_weight(const Scene& scene, const Vertex* y, const SubpathBeam<T>& light_beam, float along_light,
+                           const std::vector<Vertex>& camera, const SubpathBeam<T>& camera_beam, float along_camera, const MergeMis& vm,
+                           bool oracle) const;
+    const VcmEstimators& estimators() const { return estimators_; }
     // The MIS weight of merging photon y_{s-1} (light subpath y[0..s)) at camera vertex z_{t-1},
     // by the running quantities as the render does, and by Veach's ratio walk (the tests' oracle).
     float merge_weight(const Scene& scene, const Vertex* y, int s, const std::vector<Vertex>& camera, int t, const MergeMis& vm) const;
     float merge_weight_oracle(const Scene& scene, const Vertex* y, int s, const std::vector<Vertex>& camera, int t,
-                              const MergeMis& vm) const;
-    // The merge densities N pi r^2 (surfaces) and N 4/3 pi r^3 (media) of N light paths and radius r.
+                              const MergeMis& vm, double own_eta = -1) const;
+    // The merge densities N pi r^2 (surfaces) and N 4/3 pi r^3 (media) of N light paths and
+    // radius r, and pb2d's N pi r^2, for the estimators chosen.
     MergeMis merge_mis(size_t light_paths, double r) const;
+    // bb1d: how many of an iteration's light paths (the first ones) leave photon beams: a beam
+    // meets many camera beams, and SmallUPBP too lets fewer paths than the pixels make them.
+    size_t photon_beam_paths(size_t light_paths) const;
+    static constexpr size_t kDefaultPhotonBeamPaths = 256;
 
     const Bdpt<T>& bdpt() const { return bdpt_; }
     size_t photon_count() const { return photons_.size(); }
@@ -122,7 +181,25 @@ public:
     size_t memory_bytes() const;
 
 private:
+    // pb2d's tree of the iteration's medium photons, balls of radius r.
+    void build_volume_tree(float r);
+    // A photon beam of the iteration: a piece of light path `path`'s edge in a medium, and the
+    // running MIS quantity of a light vertex on it (that of the vertex after beam.from).
+    struct LightBeam {
+        SubpathBeam<T> beam;
+        uint32_t path = 0;
+        float mis_running = 0;
+    };
+    // The merge vertex (a photon) that light beam b has at distance `along`, and the light
+    // vertex it stands for (for the MIS).
+    MergeVertex<T> photon_on_beam(const Scene& scene, const Vertex* y, const SubpathBeam<T>& b, float along, float mis_running,
+                                  Vertex& x) const;
+    const Vertex* light_path(uint32_t j) const;
+    // The merge vertex that stands for a photon on a camera beam (pb2d) at distance `along`.
+    void place_on_beam(const Scene& scene, const SubpathBeam<T>& beam, float along, const Vertex& from, Vertex& x) const;
+
     IntegratorOptions options_;
+    VcmEstimators estimators_;
     VcmFaults faults_;
     Bdpt<T> bdpt_;  // the subpaths, the connections and their weights
     // One iteration's light subpaths (for the connections of their own pixels), per chunk of
@@ -134,8 +211,20 @@ private:
     std::vector<MergeVertex<T>> photons_;  // made in path order, then sorted into the grid's cells
     std::vector<Colour> photon_r_;         // in media: each photon's subpath's distance densities (PathVertex::r), in the same order
     PhotonGrid grid_;
+    BallTree volume_tree_;                  // pb2d: the medium photons (indices into photons_ in volume_index_)
+    std::vector<uint32_t> volume_index_;
+    std::vector<Vec3f> volume_position_;
+    std::vector<std::vector<LightBeam>> chunk_beams_;  // bb1d: per chunk of light paths, in path order
+    std::vector<LightBeam> light_beams_;               // ... all of them, in path order
+    BeamTree beam_tree_;
+    size_t light_per_chunk_ = 1;
     PassImage pass_;
     tbb::enumerable_thread_specific<std::pair<std::vector<Vertex>, std::vector<Vertex>>> subpaths_;  // camera, light
+    struct BeamScratch {
+        std::vector<SubpathBeam<T>> beams;
+        std::vector<Vertex> camera;
+    };
+    tbb::enumerable_thread_specific<BeamScratch> beam_scratch_;
 };
 extern template class Vcm<RgbTransport>;
 extern template class Vcm<SpectralTransport>;

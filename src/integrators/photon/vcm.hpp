@@ -59,9 +59,13 @@
 //   phase(y, -d, wi_y) beta_y beta_beam T(s) / (P(s) N pi r^2),
 // P(s) the probability that the walk reached s (T(s) for the channel that sampled it, whose
 // channels' mean the spectral MIS divides by, as for a connection). Its MIS density leaves out the
-// camera side's distance density of y but not P(s): eta_beam2d / sigma (path_vertex.hpp). s = 0
-// (the camera subpath hitting a light) always takes part, so every subset renders the whole image.
-// pb2d needs homogeneous media (the closed-form T(s)); a scene with a grid medium is refused.
+// camera side's distance density of y but not P(s): eta_beam2d / sigma (path_vertex.hpp). And
+// bb1d, the beam-beam estimator (Jarosz et al. 2011): the light subpaths' pieces of edges in media
+// (photon beams, of the first --photon-beams light paths; BeamTree) against every query beam, a
+// pair whose lines pass within r adding beta_c T_c / P_c beta_l T_l / P_l sigma_s phase /
+// (K 2r sin theta), with the MIS density eta_beam1d sin theta / sigma^2. s = 0 (the camera subpath
+// hitting a light) always takes part, so every subset renders the whole image. pb2d and bb1d need
+// homogeneous media (the closed-form T(s)); a scene with a grid medium is refused for them.
 #pragma once
 
 #include <tbb/enumerable_thread_specific.h>

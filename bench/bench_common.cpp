@@ -27,13 +27,14 @@ RenderResult run(const Scene& scene, const std::string& algorithm, int size, int
         else if (key == "rr_depth") r.rr_depth = std::stoi(value);
         else if (key == "guiding_spp") r.guiding_spp = std::stoi(value);
         else if (key == "guiding_rr") r.guiding_rr = value != "0";
+        else if (key == "beam_radius") r.beam_radius = std::stof(value);
         else if (key == "estimators") {
             std::string list = value;
             std::replace(list.begin(), list.end(), '+', ',');
             r.estimators = list;
         } else
             throw std::runtime_error(
-                fmt::format("{}: unknown setting '{}' (radius, max_depth, rr_depth, guiding_spp, guiding_rr, estimators)", algorithm, key));
+                fmt::format("{}: unknown setting '{}' (radius, max_depth, rr_depth, guiding_spp, guiding_rr, estimators, beam_radius)", algorithm, key));
         at = next;
     }
     r.width = r.height = size;

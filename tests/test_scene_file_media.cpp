@@ -244,6 +244,8 @@ TEST_F(SceneFileMedia, UpbpRefusesGridsForItsPointBeamEstimatorOnly) {
     listed.photon_beams = 64;
     EXPECT_EQ(RenderJob(scene_choice_of(listed), upbp).integrator_options().estimators, "bpt,bb1d");
     EXPECT_EQ(RenderJob(scene_choice_of(listed), upbp).integrator_options().photon_beams, 64);
+    listed.beam_radius = 0.5f;
+    EXPECT_EQ(RenderJob(scene_choice_of(listed), upbp).integrator_options().beam_radius, 0.5f);
     JobRequest beams = upbp;
     beams.algorithm = "vcm";
     beams.photon_beams = 16;
@@ -252,6 +254,14 @@ TEST_F(SceneFileMedia, UpbpRefusesGridsForItsPointBeamEstimatorOnly) {
         ADD_FAILURE() << "--photon-beams accepted for vcm";
     } catch (const UsageError& e) {
         EXPECT_TRUE(contains(e.what(), "--photon-beams sets how many of upbp's light paths leave photon beams")) << e.what();
+    }
+    beams.photon_beams.reset();
+    beams.beam_radius = 0.1f;
+    try {
+        RenderJob job(scene_choice_of(fog), beams);
+        ADD_FAILURE() << "--beam-radius accepted for vcm";
+    } catch (const UsageError& e) {
+        EXPECT_TRUE(contains(e.what(), "--beam-radius sets the radius of upbp's beam estimators")) << e.what();
     }
     const std::string unknown = refusal(fog, "upbp", std::string("bpt,bb2d"));
     EXPECT_TRUE(contains(unknown, "unknown estimator 'bb2d'")) << unknown;

@@ -147,6 +147,9 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
                    "upbp: the estimators it combines by MIS, comma-separated, of bpt (bdpt's connections), surf (photon merging on "
                    "surfaces), pp3d (photon points merged at points in media), pb2d (photon points gathered along the camera rays in "
                    "media), bb1d (photon beams against the camera rays in media); SmallUPBP's names (default: all)");
+    app.add_option("--beam-radius", o.beam_radius,
+                   "upbp: the first radius of its beam estimators (pb2d, bb1d), in scene units, reduced as --radius is (default: "
+                   "--radius's)");
     app.add_option("--photon-beams", o.photon_beams,
                    "upbp: light paths per iteration whose edges in media are kept as photon beams for bb1d (the first K of the "
                    "iteration's one per pixel; default 256, or the pixel count if fewer)");
@@ -236,6 +239,7 @@ std::vector<RenderJob> make_jobs(const RenderCommandOptions& o, bool check_paths
     request.guiding_rr = o.guiding_rr;
     request.estimators = o.estimators;
     request.photon_beams = o.photon_beams;
+    request.beam_radius = o.beam_radius;
     request.first_sample = o.first_sample;
     request.mlt_chains = o.mlt_chains;
     request.mlt_bootstrap = o.mlt_bootstrap;

@@ -59,6 +59,7 @@ struct RenderCommandOptions {
     bool guiding_rr = false;
     std::optional<std::string> estimators;
     std::optional<int64_t> photon_beams;
+    std::optional<float> beam_radius;
     std::string checkpoint;          // --checkpoint FILE
     double checkpoint_every = kDefaultCheckpointEvery;  // --checkpoint-every SECONDS
     std::string resume;              // --resume FILE

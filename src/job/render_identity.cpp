@@ -76,7 +76,8 @@ std::string options_text(const IntegratorOptions& o) {
                               hex_float(o.mlt_sigma))) +
            (o.guiding_spp == defaults.guiding_spp ? "" : fmt::format(" guiding_spp={}", o.guiding_spp)) + (o.guiding_rr ? " guiding_rr=1" : "") +
            (o.estimators.empty() ? "" : " estimators=" + o.estimators) +
-           (o.photon_beams == 0 ? "" : fmt::format(" photon_beams={}", o.photon_beams));  // the text of the defaults as it always was
+           (o.photon_beams == 0 ? "" : fmt::format(" photon_beams={}", o.photon_beams)) +
+           (o.beam_radius == 0 ? "" : " beam_radius=" + hex_float(o.beam_radius));  // the text of the defaults as it always was
 }
 
 std::string metadata_key(const std::string& field) {

@@ -180,6 +180,9 @@ static std::string option_refusal(const IntegratorInfo& info, const JobRequest& 
     if (r.estimators && a != "upbp") return fmt::format("--estimators chooses the estimators upbp combines; {} has no such choice", a);
     if (r.photon_beams && a != "upbp") return fmt::format("--photon-beams sets how many of upbp's light paths leave photon beams; {} has none", a);
     if (r.photon_beams && *r.photon_beams < 0) return "--photon-beams must be zero (the default count) or positive";
+    if (r.beam_radius && a != "upbp") return fmt::format("--beam-radius sets the radius of upbp's beam estimators; {} has none", a);
+    if (r.beam_radius && !(*r.beam_radius >= 0 && std::isfinite(*r.beam_radius)))
+        return "--beam-radius must be zero (the photon radius) or a positive length in scene units";
     if (r.volume_beam && !one_of({"sppm", "ppm", "pm"}))
         return fmt::format("--volume-estimate chooses how sppm, ppm and pm gather photons in media; {} has no such choice", a);
     if (r.mis_power && !one_of({"bdpt", "vcm", "bpm", "upbp", "mmlt", "pt-mis", "pt-mis3", "direct-mis"}))
@@ -260,6 +263,7 @@ RenderJob::RenderJob(SceneChoice scene, const JobRequest& r) : choice_(std::move
         }
         if (options_.estimators.empty()) throw UsageError("--estimators is empty: upbp needs at least one of bpt, surf, pp3d, pb2d, bb1d");
         options_.photon_beams = r.photon_beams ? *r.photon_beams : d.photon_beams.value_or(0);
+        options_.beam_radius = r.beam_radius ? *r.beam_radius : d.beam_radius.value_or(0.0f);
     }
     options_.mlt_bootstrap = r.mlt_bootstrap.value_or(options_.mlt_bootstrap);
     options_.mlt_large_step = r.mlt_large_step.value_or(options_.mlt_large_step);

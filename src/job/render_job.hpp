@@ -64,6 +64,7 @@ struct JobRequest {
     bool guiding_rr = false;                  // --guiding-rr (ppg)
     std::optional<std::string> estimators;    // --estimators (upbp)
     std::optional<int64_t> photon_beams;      // --photon-beams (upbp)
+    std::optional<float> beam_radius;         // --beam-radius (upbp)
     std::optional<LightSamplerKind> light_sampler;  // --light-sampler (next-event estimation; default power)
     std::optional<int> ris_candidates;              // --ris-candidates (ris)
     std::optional<int> mlt_chains;                  // --chains (pssmlt)

@@ -63,6 +63,7 @@ struct SceneDescription {
     std::optional<bool> guiding_rr;                                                        // ppg: guiding_rr
     std::optional<std::string> estimators;                                                 // upbp: estimators
     std::optional<int64_t> photon_beams;                                                   // upbp: photon_beams
+    std::optional<float> beam_radius;                                                      // upbp: beam_radius
     bool spectral = false;                        // <default name="mode" value="spectral"/>: spectral mode
     // How next-event estimation chooses a light (--light-sampler; not a scene-file setting).
     LightSamplerKind light_sampler = LightSamplerKind::Power;

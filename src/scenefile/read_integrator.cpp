@@ -132,6 +132,11 @@ void read_plain_integrator(XmlSource& xml, const pugi::xml_node& n, SceneBuilder
             if (count < 0) p.fail("photon_beams", fmt::format("photon_beams must be zero (the default) or positive, got {}", count));
             b.desc.photon_beams = count;
         }
+        if (plugin.find("beam_radius") && p.has("beam_radius")) {
+            const float r = p.get_float("beam_radius");
+            if (!(r >= 0 && std::isfinite(r))) p.fail("beam_radius", fmt::format("beam_radius must be zero (the photon radius) or positive, got {}", r));
+            b.desc.beam_radius = r;
+        }
         if (plugin.find("cutoff") && p.has("cutoff")) {
             const float c = p.get_float("cutoff");
             if (!(c >= 0 && c <= 4 * kPi)) p.fail("cutoff", fmt::format("cutoff must be a solid angle from 0 to 4 pi, got {}", c));

@@ -305,7 +305,7 @@ ConnectionDensities Bdpt<T>::connection_densities(const RenderContext& ctx, cons
                       factor(*qs, known.T);
     if (qs_minus) d.light_prev = pdf_next(scene, ctx.camera, pt, *qs, *qs_minus) * factor(*qs_minus, qs->T_in);
     if (qs && (qs->kind == VertexKind::Medium || pt->kind == VertexKind::Medium)) {
-        const Vec3f w = normalize(pt->p - qs->p);
+        const Vec3f w = qs->infinite ? -qs->dir : normalize(pt->p - qs->p);  // (a light at infinity: its direction)
         if (qs->kind == VertexKind::Medium) d.light_end_sin = length(cross(qs->dir, w));
         if (pt->kind == VertexKind::Medium) d.camera_end_sin = length(cross(pt->dir, w));
     }

@@ -118,7 +118,8 @@ size_t Vcm<T>::photon_beam_paths(size_t light_paths) const {
 }
 
 template <class T>
-MergeMis Vcm<T>::merge_mis(size_t light_paths, double r) const {
+MergeMis Vcm<T>::merge_mis(size_t light_paths, double r, double r_beam) const {
+    if (r_beam < 0) r_beam = r;
     MergeMis vm;
     vm.merging = estimators_.merging();
     vm.connections = estimators_.bpt;
@@ -126,8 +127,8 @@ MergeMis Vcm<T>::merge_mis(size_t light_paths, double r) const {
     const double disc = double(light_paths) * pi * r * r;
     vm.eta = estimators_.surf ? disc : 0.0;
     vm.eta_volume = !estimators_.pp3d ? 0.0 : faults_.volume_kernel_as_disc ? disc : double(light_paths) * 4.0 / 3.0 * pi * r * r * r;
-    vm.eta_beam2d = estimators_.pb2d ? disc : 0.0;
-    vm.eta_beam1d = estimators_.bb1d ? double(photon_beam_paths(light_paths)) * 2 * r : 0.0;
+    vm.eta_beam2d = estimators_.pb2d ? double(light_paths) * pi * r_beam * r_beam : 0.0;
+    vm.eta_beam1d = estimators_.bb1d ? double(photon_beam_paths(light_paths)) * 2 * r_beam : 0.0;
     return vm;
 }
 
@@ -520,18 +521,20 @@ PassCounters Vcm<T>::render_passes(const RenderContext& ctx, Film& film, uint64_
         const uint64_t pass = first + uint64_t(k);
         const Wavelengths wl = T::pass_wavelengths(ctx.seed, ctx.sampler, pass);
         const float r = float(progressive_radius(r1, alpha, pass + 1));
-        const MergeMis vm = merge_mis(pixels, r);
+        // The beams' radius shrinks as the others' (--beam-radius sets its first value).
+        const float r_beam = options_.beam_radius > 0 ? float(double(options_.beam_radius) * r / r1) : r;
+        const MergeMis vm = merge_mis(pixels, r, r_beam);
         // In media, one hero channel for every subpath of the iteration (see vcm.hpp).
         const int hero = Bdpt<T>::sample_hero(ctx, pixels, pass, wl);
         rays += trace_light_paths(ctx, pass, wl, vm, hero);
         if (vm.merging) grid_.build_sorted(photons_, r, &photon_r_);
-        if (vm.eta_beam2d > 0) build_volume_tree(r);
+        if (vm.eta_beam2d > 0) build_volume_tree(r_beam);
         if (vm.eta_beam1d > 0) {
             std::vector<BeamTree::Segment> segments(light_beams_.size());
             for (size_t i = 0; i < segments.size(); ++i)
                 segments[i] = {light_beams_[i].beam.o, light_beams_[i].beam.d, light_beams_[i].beam.length};
             // Pieces of 4 r: a query's boxes hold little more than the cylinders around the pieces.
-            beam_tree_.build(segments, r, 4 * r);
+            beam_tree_.build(segments, r_beam, 4 * r_beam);
         }
         if (progress) progress((double(k) + 0.25) / count);
         pass_.begin(pixels, chunks);
@@ -580,9 +583,9 @@ PassCounters Vcm<T>::render_passes(const RenderContext& ctx, Film& film, uint64_
                     if (beams)
                         for (const SubpathBeam<T>& b : *beams) {
                             if (vm.eta_beam2d > 0)
-                                if (const Colour m = beam_merge(ctx.scene, camera, b, r, vm, wl, scratch.camera); !is_black(m)) add(m, false, {});
+                                if (const Colour m = beam_merge(ctx.scene, camera, b, r_beam, vm, wl, scratch.camera); !is_black(m)) add(m, false, {});
                             if (vm.eta_beam1d > 0)
-                                if (const Colour m = beam_beam(ctx.scene, camera, b, r, vm, wl, scratch.camera); !is_black(m)) add(m, false, {});
+                                if (const Colour m = beam_beam(ctx.scene, camera, b, r_beam, vm, wl, scratch.camera); !is_black(m)) add(m, false, {});
                         }
                     pass_.pixel(pixel) += film_colour(own, wl);
                 }
@@ -625,6 +628,8 @@ const IntegratorInfo& vcm_integrator() {
 const IntegratorInfo& upbp_integrator() {
     static const IntegratorInfo info = [] {
         std::vector<ParamInfo> params = vcm_params();
+        params.push_back({"beam_radius", ParamType::Float, "0",
+                          "the first radius of pb2d and bb1d, reduced as initial_radius is (0: initial_radius's; --beam-radius wins)"});
         params.push_back({"photon_beams", ParamType::Integer, "0",
                           "light paths per iteration whose edges in media are photon beams for bb1d (0: 256, or the pixel count if "
                           "fewer; --photon-beams wins)"});

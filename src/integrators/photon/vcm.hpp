@@ -171,8 +171,9 @@ public:
     float merge_weight_oracle(const Scene& scene, const Vertex* y, int s, const std::vector<Vertex>& camera, int t,
                               const MergeMis& vm, double own_eta = -1) const;
     // The merge densities N pi r^2 (surfaces) and N 4/3 pi r^3 (media) of N light paths and
-    // radius r, and pb2d's N pi r^2, for the estimators chosen.
-    MergeMis merge_mis(size_t light_paths, double r) const;
+    // radius r, pb2d's N pi r_beam^2 and bb1d's K 2 r_beam (negative r_beam: r), for the
+    // estimators chosen.
+    MergeMis merge_mis(size_t light_paths, double r, double r_beam = -1) const;
     // bb1d: how many of an iteration's light paths (the first ones) leave photon beams: a beam
     // meets many camera beams, and SmallUPBP too lets fewer paths than the pixels make them.
     size_t photon_beam_paths(size_t light_paths) const;

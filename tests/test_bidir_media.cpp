@@ -156,7 +156,7 @@ bool homogeneous(const SceneDescription& d) {
 }
 
 RenderResult upbp_render(const SceneDescription& d, const std::string& estimators, uint64_t iterations, uint64_t seed, VcmFaults faults = {},
-                         int64_t photon_beams = 0, float beam_fraction = 0) {
+                         int64_t photon_beams = 0, float beam_fraction = 0.03f) {
     IntegratorOptions o = depth_options();
     o.photon_radius = 0.03f * Scene::build(d)->scene_sphere().radius;
     o.beam_radius = beam_fraction * Scene::build(d)->scene_sphere().radius;
@@ -178,9 +178,12 @@ TEST(BidirMedia, UpbpAndEachBeamEstimatorAloneAgreeWithVolpath) {
     // Photon beams from 25 of the 100 light paths of an iteration (N in bb1d's kernel and MIS is 25).
     const AgreementResult few = agreement(upbp_render(scenes[0].d, "bpt,bb1d", 1024, 26, {}, 25), reference(0));
     EXPECT_TRUE(few.agree) << "upbp --estimators bpt,bb1d --photon-beams 25: " << few.describe();
-    // The beams with a radius of their own (6% of the scene's against the points' 3%).
+    // The beams with a radius of their own (6% of the scene's against the points' 3%), and the
+    // default, a quarter of the points'.
     const AgreementResult own = agreement(upbp_render(scenes[0].d, "all", 1024, 27, {}, 0, 0.06f), reference(0));
     EXPECT_TRUE(own.agree) << "upbp --beam-radius: " << own.describe();
+    const AgreementResult quarter = agreement(upbp_render(scenes[0].d, "all", 1024, 28, {}, 0, 0.0f), reference(0));
+    EXPECT_TRUE(quarter.agree) << "upbp, the default beam radius: " << quarter.describe();
 }
 
 // The tests of the test: pb2d without the beam's transmittance to the photon (its probability

@@ -148,8 +148,8 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
                    "surfaces), pp3d (photon points merged at points in media), pb2d (photon points gathered along the camera rays in "
                    "media), bb1d (photon beams against the camera rays in media); SmallUPBP's names (default: all)");
     app.add_option("--beam-radius", o.beam_radius,
-                   "upbp: the first radius of its beam estimators (pb2d, bb1d), in scene units, reduced as --radius is (default: "
-                   "--radius's)");
+                   "upbp: the first radius of its beam estimators (pb2d, bb1d), in scene units, reduced as --radius is (default: a "
+                   "quarter of --radius's)");
     app.add_option("--photon-beams", o.photon_beams,
                    "upbp: light paths per iteration whose edges in media are kept as photon beams for bb1d (the first K of the "
                    "iteration's one per pixel; default 256, or the pixel count if fewer)");

@@ -68,7 +68,7 @@ struct IntegratorOptions {
     bool vcm_connections = true;
     std::string estimators;  // upbp: the estimators it combines ("": all; vcm.hpp parse_estimators)
     int64_t photon_beams = 0;  // upbp: light paths per iteration whose edges are photon beams (0: vcm.hpp's default)
-    float beam_radius = 0;     // upbp: pb2d's and bb1d's first radius (0: photon_radius's)
+    float beam_radius = 0;     // upbp: pb2d's and bb1d's first radius (0: a quarter of the photon radius)
     // ic: rays per record, the error threshold a, gradients on, and where to draw the records.
     int ic_rays = 256;
     float ic_error = 0.2f;

@@ -178,6 +178,7 @@ public:
     // meets many camera beams, and SmallUPBP too lets fewer paths than the pixels make them.
     size_t photon_beam_paths(size_t light_paths) const;
     static constexpr size_t kDefaultPhotonBeamPaths = 256;
+    static constexpr float kBeamRadiusDivisor = 4;  // the beams' radius against the points' by default
 
     const Bdpt<T>& bdpt() const { return bdpt_; }
     size_t photon_count() const { return photons_.size(); }

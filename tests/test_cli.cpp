@@ -148,7 +148,7 @@ TEST_F(Cli, BdptOptionsAreCheckedAndTheStrategiesWritten) {
     EXPECT_TRUE(contains(r.err, "unknown MIS heuristic 'cubic'. Valid heuristics: balance, power")) << r.err;
     r = run({"-s", "4", "-a", "lt", "--mis", "power", "-o", path("x.exr")});
     EXPECT_EQ(r.code, 2);
-    EXPECT_TRUE(contains(r.err, "--mis chooses the heuristic of bdpt, vcm, bpm, upbp, mmlt, pt-mis, pt-mis3 and direct-mis; lt has its own")) << r.err;
+    EXPECT_TRUE(contains(r.err, "--mis chooses the heuristic of bdpt, vcm, bpm, upbp, mmlt, pt-mis, pt-mis3, direct-mis and volpath; lt has its own")) << r.err;
     r = run({"-s", "4", "-a", "lt", "--strategies", path("s"), "-o", path("x.exr")});
     EXPECT_EQ(r.code, 2);
     EXPECT_TRUE(contains(r.err, "--strategies writes the strategies of bdpt, not of lt")) << r.err;

@@ -225,6 +225,23 @@ TEST(Volpath, WithAndWithoutMisAgree) {
     EXPECT_TRUE(r.agree) << r.describe();
 }
 
+// --mis power (Mitsuba 3's volpath weighs its light and phase/BSDF samples so): another
+// estimator of the same image, in the medium and on the surfaces, not the balance heuristic's bytes.
+TEST(Volpath, ThePowerHeuristicAgreesWithTheBalanceHeuristic) {
+    SceneDescription d = make_builtin_scene(4);
+    d.media.push_back(HomogeneousMedium{Rgb(0.4f, 0.5f, 0.6f), Rgb(0.3f, 0.4f, 0.5f), HgPhase{0.3f}});
+    d.meshes.push_back(fog_box(0));
+    IntegratorOptions o;
+    o.max_depth = 4;
+    IntegratorOptions p = o;
+    p.mis_power = true;
+    const auto balance = make_volpath(o), power = make_volpath(p);
+    const RenderResult a = render_integrator(d, *balance, 12, 12, 1024, 1), b = render_integrator(d, *power, 12, 12, 1024, 2);
+    const AgreementResult r = test_agreement(a.film.mean(), a.film.standard_error(), b.film.mean(), b.film.standard_error(), kAgreement);
+    EXPECT_TRUE(r.agree) << r.describe();
+    EXPECT_FALSE(bit_identical(render_integrator(d, *power, 12, 12, 64, 1).film.mean(), render_integrator(d, *balance, 12, 12, 64, 1).film.mean()));
+}
+
 TEST(Volpath, OneAndTwoThreadsGiveTheSameBytes) {
     for (const char* f : {"scenes/fog-box.xml", "scenes/smoke.xml"}) {
         const SceneDescription d = load_scene_file(source_path(f));

@@ -111,7 +111,7 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
     app.add_option("--ris-candidates", o.ris_candidates,
                    fmt::format("--light-sampler ris: the light samples drawn to keep one (1 to {}; default {})", kMaxRisCandidates,
                                kDefaultRisCandidates));
-    app.add_option("--mis", o.mis, "bdpt, vcm, bpm, pt-mis, pt-mis3, direct-mis: the MIS heuristic, balance or power (Mitsuba's path tracer's)")->capture_default_str();
+    app.add_option("--mis", o.mis, "bdpt, vcm, bpm, upbp, mmlt, pt-mis, pt-mis3, direct-mis, volpath: the MIS heuristic, balance or power (Mitsuba's path tracers')")->capture_default_str();
     app.add_option("--strategies", o.strategies_dir,
                    "bdpt: also write one image per strategy (s, t), weighted and unweighted, and montages, into this directory "
                    "(placeholders as for -o)");

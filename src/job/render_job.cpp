@@ -185,8 +185,8 @@ static std::string option_refusal(const IntegratorInfo& info, const JobRequest& 
         return "--beam-radius must be zero (the photon radius) or a positive length in scene units";
     if (r.volume_beam && !one_of({"sppm", "ppm", "pm"}))
         return fmt::format("--volume-estimate chooses how sppm, ppm and pm gather photons in media; {} has no such choice", a);
-    if (r.mis_power && !one_of({"bdpt", "vcm", "bpm", "upbp", "mmlt", "pt-mis", "pt-mis3", "direct-mis"}))
-        return fmt::format("--mis chooses the heuristic of bdpt, vcm, bpm, upbp, mmlt, pt-mis, pt-mis3 and direct-mis; {} has its own", a);
+    if (r.mis_power && !one_of({"bdpt", "vcm", "bpm", "upbp", "mmlt", "pt-mis", "pt-mis3", "direct-mis", "volpath"}))
+        return fmt::format("--mis chooses the heuristic of bdpt, vcm, bpm, upbp, mmlt, pt-mis, pt-mis3, direct-mis and volpath; {} has its own", a);
     if (!r.vcm_merging && !r.vcm_connections) return "--no-merging and --no-connections together leave vcm no strategy";
     if ((!r.vcm_merging || !r.vcm_connections) && a != "vcm")
         return fmt::format("--no-merging and --no-connections switch off vcm's strategies, not {}'s", a);

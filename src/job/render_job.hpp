@@ -41,7 +41,7 @@ struct JobRequest {
     uint64_t default_spp = 64;
     uint64_t first_sample = 0;     // --first-sample N: the index of the first pass (disjoint ranges merge into one render)
     double checkpoint_every = kDefaultCheckpointEvery;  // --checkpoint-every SECONDS (0: only at the end and when interrupted)
-    bool mis_power = false;        // --mis power (bdpt, vcm, bpm, pt-mis, pt-mis3, direct-mis)
+    bool mis_power = false;        // --mis power (bdpt, vcm, bpm, upbp, mmlt, pt-mis, pt-mis3, direct-mis, volpath)
     std::string strategies_dir;    // --strategies DIR (bdpt)
     int strategies_depth = 4;      // --strategies-depth N (bdpt)
     std::optional<int64_t> photons;       // --photons N (sppm, pm)

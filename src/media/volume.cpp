@@ -34,13 +34,18 @@ Volume Volume::of_grid(VoxelGrid g, const Transform& unit_to_world) {
 }
 
 Volume read_constvolume(Properties& p) {
-    // Mitsuba 3 bounds a heterogeneous medium by its volume's box, the unit cube to_world places,
-    // even for a constant: rendering it unbounded would be another scene (30% darker in
-    // Mitsuba's test_hetero_spectral_sigmat_no_scattering).
-    if (p.get_transform("to_world"))
-        p.fail("to_world", "a constvolume's to_world (which bounds the medium to the placed unit cube in Mitsuba 3) is not supported: "
-                           "remove it for a medium that fills its shape, or use a gridvolume");
-    return Volume::constant_value(p.get_rgb("value"));
+    // Mitsuba 3 bounds a heterogeneous medium by its volume's box, and a constvolume's box is the
+    // unit cube its to_world places (mitsuba3 src/volumes/const.cpp: bbox() of to_world's unit
+    // cube); without to_world pathlab's constant fills the medium's shape. Placed, it is a grid of
+    // one voxel: the value inside the cube, 0 outside (VoxelGrid::lookup).
+    const Rgb value = p.get_rgb("value");
+    const std::optional<Transform> to_world = p.get_transform("to_world");
+    if (!to_world) return Volume::constant_value(value);
+    VoxelGrid one;
+    one.res = {1, 1, 1};
+    one.channels = 3;
+    one.data = {value.x, value.y, value.z};
+    return Volume::of_grid(std::move(one), *to_world);
 }
 
 Volume read_gridvolume(Properties& p, const std::string& base_dir, bool allow_files, std::vector<std::string>* files_read) {

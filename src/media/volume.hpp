@@ -44,7 +44,7 @@ inline const PluginInfo& constvolume_plugin() {
     static const PluginInfo info{"volume", "constvolume", "the same value everywhere",
                                  {{"value", ParamType::Rgb, "1", "the value (a float or an RGB triple)"},
                                   {"to_world", ParamType::Transform, "",
-                                   "refused: in Mitsuba 3 it bounds a heterogeneous medium to the placed unit cube, which pathlab does not do"}}};
+                                   "bounds the medium to the unit cube it places (Mitsuba 3's convention; 0 outside); without it the value fills the medium's shape"}}};
     return info;
 }
 inline const PluginInfo& gridvolume_plugin() {

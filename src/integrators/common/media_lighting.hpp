@@ -1,7 +1,8 @@
 // Direct light where a path scatters in a scene with media (a surface, or a point in a medium),
 // as volpath gathers it at every vertex and the photon methods (sppm, ppm, pm) at their visible
 // points: a light sample whose shadow ray carries its transmittance, and a BSDF or phase sample
-// whose walk through the media may reach an emitter, combined by the balance heuristic. The
+// whose walk through the media may reach an emitter, combined by the balance heuristic (the
+// power heuristic with `power`, volpath's --mis power). The
 // sample's walk is also the path's continuation (volpath goes on along it).
 #pragma once
 
@@ -24,7 +25,7 @@ struct ScatterVertex {
 // the same arithmetic at a surface), with the shadow ray's transmittance.
 template <class T>
 ColourOf<T> estimate_light(const Scene& scene, const ScatterVertex& v, Sampler& sampler, MediumState<T>& st, bool mis,
-                           WavelengthsOf<T>& wl) {
+                           WavelengthsOf<T>& wl, bool power = false) {
     using Colour = ColourOf<T>;
     const auto nee = sample_nee(scene, v.p, v.sp ? v.sp->frame.n : Vec3f(0.0f), sampler, nee_candidates(scene, v.sp, wl),
                                 [&](const LightSample& c, int) {
@@ -63,7 +64,7 @@ ColourOf<T> estimate_light(const Scene& scene, const ScatterVertex& v, Sampler& 
     if (scene.media_separated(medium, scene.light_medium(choice.index))) return Colour(0.0f);  // blocked: no ray needed
     const Colour Tr = shadow_transmittance(scene, shadow, medium, st);
     if (is_black(Tr)) return Colour(0.0f);
-    const float weight = !ls->delta ? (mis ? balance_heuristic(nee->pdf_source, pdf_scatter) : 1.0f) : 1.0f;
+    const float weight = !ls->delta ? (mis ? mis_heuristic(power, nee->pdf_source, pdf_scatter) : 1.0f) : 1.0f;
     const Colour contribution = f * light_colour(scene, choice.index, ls->Le, wl) * (cosine * weight / nee->pdf);
     return scene.has_media() ? contribution * Tr : contribution;
 }
@@ -109,7 +110,7 @@ struct ScatterSample {
 // walk finds; the caller adds beta * next_seg * found / density.
 template <class T>
 ScatterSample<T> sample_scatter(const Scene& scene, const ScatterVertex& v, Sampler& sampler, MediumState<T>& st, bool mis,
-                                WavelengthsOf<T>& wl) {
+                                WavelengthsOf<T>& wl, bool power = false) {
     using Colour = ColourOf<T>;
     ScatterSample<T> n;
     int light;
@@ -125,7 +126,7 @@ ScatterSample<T> sample_scatter(const Scene& scene, const ScatterVertex& v, Samp
         const Colour f = bsdf_sample_colour(sp, *s, wl);
         n.weight = f * (std::abs(s->wo.z) / s->pdfW);
         const EmitterHit e = emission_found(scene, n.next, sp.p, sp.frame.n, light);
-        const float weight = s->delta ? 1.0f : (mis ? balance_heuristic(s->pdfW, e.pdf_light) : 0.0f);
+        const float weight = s->delta ? 1.0f : (mis ? mis_heuristic(power, s->pdfW, e.pdf_light) : 0.0f);
         if (!is_black(e.Le)) n.found = f * light_colour(scene, light, e.Le, wl) * (std::abs(s->wo.z) * weight / s->pdfW);
     } else {
         const PhaseSample ps = phase_sample(*v.phase, v.wi, sampler.next2d());
@@ -135,7 +136,7 @@ ScatterSample<T> sample_scatter(const Scene& scene, const ScatterVertex& v, Samp
         n.medium = v.medium;
         n.next = walk_media(scene, n.ray, n.medium, st, n.next_seg);
         const EmitterHit e = emission_found(scene, n.next, v.p, Vec3f(0.0f), light);
-        const float weight = mis ? balance_heuristic(ps.pdfW, e.pdf_light) : 0.0f;
+        const float weight = mis ? mis_heuristic(power, ps.pdfW, e.pdf_light) : 0.0f;
         if (!is_black(e.Le)) n.found = Colour(ps.p) * light_colour(scene, light, e.Le, wl) * (weight / ps.pdfW);
         n.weight = Colour(ps.p / ps.pdfW);
     }

@@ -4,7 +4,8 @@
 //    scatter, sampled by delta tracking (free-flight sampling, media/medium.hpp), and a
 //    boundary only changes the medium; it ends at a scattering point, a surface or the sky;
 //  - at a scattering point the phase function plays the BSDF's part: a light sample and a
-//    phase sample, combined by the balance heuristic, the phase sample continuing the path;
+//    phase sample, combined by the balance heuristic (--mis power: the power heuristic, as
+//    Mitsuba 3's volpath), the phase sample continuing the path;
 //  - a light sample's shadow ray crosses boundaries and media too, and its contribution is
 //    multiplied by their transmittance (closed form, or ratio tracking in grids), estimated
 //    with the random numbers of a second stream;
@@ -68,10 +69,10 @@ public:
                 v.phase = &medium_phase(scene.medium(w.medium));
             }
             // The MIS pair: a light sample, and a BSDF or phase sample whose walk may find emission.
-            const Colour direct = estimate_light(scene, v, sampler, st, mis, wl);
+            const Colour direct = estimate_light(scene, v, sampler, st, mis, wl, rules_.power_mis());
             L += beta * direct / st.density();
 
-            const ScatterSample<T> n = sample_scatter(scene, v, sampler, st, mis, wl);
+            const ScatterSample<T> n = sample_scatter(scene, v, sampler, st, mis, wl, rules_.power_mis());
             if (!n.sampled) break;  // pt-mis: no BSDF sample, nothing found, and the path ends
             L += beta * n.next_seg * n.found / st.density();
             const MediumWalk& next = n.next;

@@ -80,7 +80,7 @@ inline std::string dispersive_room(bool behind_glass, int size) {
     std::string text = R"(<scene version="3.0.0">
   <sensor type="perspective"><float name="fov" value="55"/>
     <transform name="to_world"><lookat origin="0, -4, 1.3" target="0, 0, 0.9" up="0, 0, 1"/></transform>
-    <film type="hdrfilm"><integer name="width" value="SIZE"/><integer name="height" value="SIZE"/></film></sensor>
+    <film type="hdrfilm"><integer name="width" value="SIZE"/><integer name="height" value="SIZE"/><rfilter type="box"/></film></sensor>
   <shape type="rectangle"><transform name="to_world"><scale value="3"/></transform>
     <bsdf type="diffuse"><rgb name="reflectance" value="0.8, 0.65, 0.45"/></bsdf></shape>
   <shape type="rectangle"><transform name="to_world"><scale value="3"/><rotate x="1" angle="90"/><translate y="2" z="1.5"/></transform>

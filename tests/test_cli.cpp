@@ -272,7 +272,7 @@ std::string write_scene(const std::string& file, const std::string& integrator =
                            "  <default name=\"r\" value=\"0.5\"/>\n"
                            "  <integrator type=\"" << integrator << "\"/>\n"
                            "  <sensor type=\"perspective\"><transform name=\"to_world\"><lookat origin=\"0,-3,0\" target=\"0,0,0\" up=\"0,0,1\"/></transform>\n"
-                           "    <film type=\"hdrfilm\"><integer name=\"width\" value=\"20\"/><integer name=\"height\" value=\"10\"/></film>\n"
+                           "    <film type=\"hdrfilm\"><integer name=\"width\" value=\"20\"/><integer name=\"height\" value=\"10\"/><rfilter type=\"box\"/></film>\n"
                            "    <sampler type=\"independent\"><integer name=\"sample_count\" value=\"3\"/></sampler></sensor>\n"
                            "  <shape type=\"sphere\"><float name=\"radius\" value=\"$r\"/></shape>\n"
                            "  <emitter type=\"constant\"/>\n"

@@ -41,7 +41,7 @@ protected:
         std::ofstream(path(name)) << "<scene version=\"3.0.0\">\n"
                                      "  <default name=\"r\" value=\"0.5\"/>\n"
                                      "  <sensor type=\"perspective\"><transform name=\"to_world\"><lookat origin=\"0,-3,0\" target=\"0,0,0\" up=\"0,0,1\"/></transform>\n"
-                                     "    <film type=\"hdrfilm\"><integer name=\"width\" value=\"12\"/><integer name=\"height\" value=\"8\"/></film></sensor>\n"
+                                     "    <film type=\"hdrfilm\"><integer name=\"width\" value=\"12\"/><integer name=\"height\" value=\"8\"/><rfilter type=\"box\"/></film></sensor>\n"
                                      "  <shape type=\"sphere\"><float name=\"radius\" value=\"$r\"/></shape>\n"
                                      "  <emitter type=\"constant\"/>\n"
                                      "</scene>\n";
@@ -247,7 +247,7 @@ TEST_F(Lab, TheSceneHashCoversIncludedFilesAndMeshesAndIsTheRendersOwn) {
     std::ofstream(path("parts/tri.obj")) << "v 0 0 0\nv 1 0 0\nv 0 0 1\nf 1 2 3\n";
     std::ofstream(path("inc.xml")) << "<scene version=\"3.0.0\">\n"
                                       "  <sensor type=\"perspective\"><transform name=\"to_world\"><lookat origin=\"0,-3,0\" target=\"0,0,0\" up=\"0,0,1\"/></transform>\n"
-                                      "    <film type=\"hdrfilm\"><integer name=\"width\" value=\"8\"/><integer name=\"height\" value=\"6\"/></film></sensor>\n"
+                                      "    <film type=\"hdrfilm\"><integer name=\"width\" value=\"8\"/><integer name=\"height\" value=\"6\"/><rfilter type=\"box\"/></film></sensor>\n"
                                       "  <include filename=\"parts/light.xml\"/>\n"
                                       "  <shape type=\"obj\"><string name=\"filename\" value=\"parts/tri.obj\"/></shape>\n"
                                       "</scene>\n";

@@ -86,7 +86,7 @@ TEST(SceneFile, CameraAxesMatchMitsubaConventions) {
     const SceneDescription d = load(scene_with(
         "<sensor type=\"perspective\"><float name=\"fov\" value=\"30\"/><string name=\"fov_axis\" value=\"y\"/>"
         "<transform name=\"to_world\"><lookat origin=\"0,0,5\" target=\"0,0,0\" up=\"0,1,0\"/></transform>"
-        "<film type=\"hdrfilm\"><integer name=\"width\" value=\"64\"/><integer name=\"height\" value=\"32\"/></film>"
+        "<film type=\"hdrfilm\"><integer name=\"width\" value=\"64\"/><integer name=\"height\" value=\"32\"/><rfilter type=\"box\"/></film>"
         "</sensor>"));
     EXPECT_EQ(d.camera.position, Vec3f(0, 0, 5));
     EXPECT_EQ(d.camera.forward, Vec3f(0, 0, -1));
@@ -205,7 +205,7 @@ TEST(SceneFile, MicrofacetAndFresnelMaterials) {
 TEST(SceneFileErrors, MicrofacetAndFresnelParameters) {
     const std::vector<std::pair<std::string, std::string>> cases = {
         {R"(<bsdf type="roughconductor"><string name="material" value="Unobtainium"/></bsdf>)",
-         "unknown conductor material 'Unobtainium'; known: none, Au, Ag, Cu, Al, Cr"},
+         "unknown conductor material 'Unobtainium'; known: none, Au, Ag, Cu, Al, Cr, a-C"},
         {R"(<bsdf type="conductor"><string name="material" value="Au"/><rgb name="eta" value="1"/></bsdf>)",
          "either material or eta and k"},
         {R"(<bsdf type="roughconductor"><float name="alpha" value="0.1"/><float name="alpha_u" value="0.1"/>

@@ -200,7 +200,7 @@ TEST(SceneFileStructure, RefsAliasesAndVersions) {
     <transform name="toWorld"><lookat origin="0,0,5" target="0,0,0" up="0,1,0"/></transform>
     <sampler type="ldsampler"><integer name="sampleCount" value="16"/></sampler>
     <film type="hdrfilm"><integer name="width" value="32"/><integer name="height" value="24"/>
-      <string name="fileFormat" value="pfm"/><boolean name="banner" value="false"/></film></sensor>
+      <string name="fileFormat" value="pfm"/><boolean name="banner" value="false"/><rfilter type="box"/></film></sensor>
   <shape type="obj"><string name="filename" value="scenes/meshes/floor.obj"/><boolean name="faceNormals" value="true"/></shape>
 </scene>)", "old.xml", source_path(""));
     EXPECT_EQ(old.max_depth, 4);
@@ -301,7 +301,7 @@ SceneDescription pixel_squares_scene(const std::string& rfilter) {
 }
 
 TEST(SceneFileFilters, TentImageIsTheBoxImageConvolvedWithTheTent) {
-    const RenderResult box = test::render_scene(pixel_squares_scene(""), "direct-mis", 8, 8, 16, 5);
+    const RenderResult box = test::render_scene(pixel_squares_scene("<rfilter type=\"box\"/>"), "direct-mis", 8, 8, 16, 5);
     const RenderResult tent = test::render_scene(pixel_squares_scene("<rfilter type=\"tent\"/>"), "direct-mis", 8, 8, 256, 5);
     const Image b = box.film.mean(), t = tent.film.mean(), se = tent.film.standard_error();
     // The box image is the squares' radiance, exactly.
@@ -330,6 +330,27 @@ TEST(SceneFileFilters, TentImageIsTheBoxImageConvolvedWithTheTent) {
             }
         }
     EXPECT_GT(tested, 20);
+}
+
+// A <film> without an <rfilter> has Mitsuba's default filter, the Gaussian of standard deviation
+// 0.5 pixels (Mitsuba 3 and 0.6 render such a scene so); a scene without a <film> renders on
+// pathlab's own film (box).
+TEST(SceneFileFilters, AFilmWithoutAnRfilterHasMitsubasGaussian) {
+    const auto filter_of = [](const std::string& film) {
+        return load_scene_text("<scene version=\"3.0.0\"><sensor type=\"perspective\">" + film + "</sensor><shape type=\"sphere\"/></scene>",
+                               "f.xml", ".")
+            .filter;
+    };
+    const FilterDesc unnamed = filter_of("<film type=\"hdrfilm\"/>"), given = filter_of("<film type=\"hdrfilm\"><rfilter type=\"gaussian\"/></film>");
+    EXPECT_EQ(unnamed.type, "gaussian");
+    EXPECT_EQ(unnamed.stddev, 0.5);
+    EXPECT_EQ(unnamed.radius, 2.0);
+    EXPECT_EQ(given.type, unnamed.type);
+    EXPECT_EQ(given.stddev, unnamed.stddev);
+    EXPECT_EQ(given.radius, unnamed.radius);
+    EXPECT_TRUE(filter_of("").is_box());
+    EXPECT_EQ(filter_of("").radius, 0.5);
+    EXPECT_TRUE(filter_of("<film type=\"hdrfilm\"><rfilter type=\"box\"/></film>").is_box());
 }
 
 TEST(SceneFileFilters, BoxIsTodaysFilmAndFilteredRendersAreDeterministic) {
@@ -616,7 +637,28 @@ TEST(SceneFileMeshes, InstancesRenderAsTheGeometryWrittenOut) {
     EXPECT_TRUE(test::bit_identical(ra.film.mean(), rb.film.mean()));
     EXPECT_EQ(ra.stats.rays, rb.stats.rays);
     // A rotated instance (not exact in object space) agrees within the noise.
-    EXPECT_NE(error_of(R"(<scene version="3"><shape type="shapegroup" id="g"><shape type="sphere"/></shape></scene>)").find("exact sphere"),
+    // An exact sphere in a group: each instance places a copy (Mitsuba's instancing test has one),
+    // the same sphere as written out; an instance that would make it an ellipsoid is refused.
+    const SceneDescription placed = load_scene_text(R"(<scene version="3"><shape type="shapegroup" id="g">
+          <shape type="sphere"><transform name="to_world"><scale value="0.5"/><translate x="-1"/></transform></shape></shape>
+        <shape type="instance"><ref id="g"/></shape>
+        <shape type="instance"><ref id="g"/><transform name="to_world"><rotate y="1" angle="90"/><scale value="2"/><translate z="3"/></transform></shape>
+        </scene>)", "s.xml", ".");
+    const SceneDescription written = load_scene_text(R"(<scene version="3">
+        <shape type="sphere"><transform name="to_world"><scale value="0.5"/><translate x="-1"/></transform></shape>
+        <shape type="sphere"><transform name="to_world"><scale value="0.5"/><translate x="-1"/><rotate y="1" angle="90"/><scale value="2"/>
+          <translate z="3"/></transform></shape></scene>)", "s.xml", ".");
+    ASSERT_EQ(placed.spheres.size(), 2u);
+    EXPECT_TRUE(placed.instances.empty());  // a group of spheres only: nothing for Embree to instance
+    for (size_t i = 0; i < 2; ++i) {
+        EXPECT_NEAR(length(placed.spheres[i].center - written.spheres[i].center), 0.0f, 1e-5f) << i;
+        EXPECT_NEAR(placed.spheres[i].radius, written.spheres[i].radius, 1e-6f) << i;
+        for (int k = 0; k < 3; ++k) EXPECT_NEAR(length(placed.spheres[i].axes[size_t(k)] - written.spheres[i].axes[size_t(k)]), 0.0f, 1e-5f) << i;
+    }
+    EXPECT_NEAR(placed.spheres[1].radius, 1.0f, 1e-6f);
+    EXPECT_NE(error_of(R"(<scene version="3"><shape type="shapegroup" id="g"><shape type="sphere"/></shape>
+        <shape type="instance"><ref id="g"/><transform name="to_world"><scale x="2"/></transform></shape></scene>)")
+                  .find("an instance can only rotate, scale uniformly and translate"),
               std::string::npos);
     EXPECT_NE(error_of(R"(<scene version="3"><shape type="shapegroup" id="g"><shape type="cube"><emitter type="area"/></shape></shape></scene>)")
                   .find("cannot emit"),
@@ -709,7 +751,7 @@ TEST(SceneFileSensors, WindowsClippingLensAndOrthographicRays) {
 TEST(SceneFileSensors, DefaultFieldOfViewIsMitsubasFiftyMillimetreLensOnTheDiagonal) {
     const auto camera_of = [](const std::string& sensor, int w, int h) {
         return load_scene_text(fmt::format(R"(<scene version="3.0.0"><sensor type="perspective">{}
-            <film type="hdrfilm"><integer name="width" value="{}"/><integer name="height" value="{}"/></film></sensor><shape type="sphere"/></scene>)",
+            <film type="hdrfilm"><integer name="width" value="{}"/><integer name="height" value="{}"/><rfilter type="box"/></film></sensor><shape type="sphere"/></scene>)",
                                            sensor, w, h),
                                "s.xml", ".")
             .camera;

@@ -111,7 +111,7 @@ const char* const kSkyLitSphere = R"(<scene version="3.0.0">
   <default name="mode" value="spectral"/>
   <sensor type="perspective"><float name="fov" value="10"/>
     <transform name="to_world"><lookat origin="0, 0, 5" target="0, 0, 0" up="0, 1, 0"/></transform>
-    <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/></film>
+    <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/><rfilter type="box"/></film>
   </sensor>
   <emitter type="constant">SKY</emitter>
   <shape type="sphere"><float name="radius" value="1"/><bsdf type="diffuse"><rgb name="reflectance" value="0.8, 0.2, 0.1"/></bsdf></shape>
@@ -149,7 +149,7 @@ TEST(SpectralEmitters, ABlackBodyPointLightAgreesWithRgbMode) {
     const std::string text = R"(<scene version="3.0.0">
   <sensor type="perspective"><float name="fov" value="30"/>
     <transform name="to_world"><lookat origin="0, 0, 5" target="0, 0, 0" up="0, 1, 0"/></transform>
-    <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/></film>
+    <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/><rfilter type="box"/></film>
   </sensor>
   <emitter type="point"><point name="position" x="1" y="2" z="4"/>
     <spectrum type="blackbody" name="intensity"><float name="temperature" value="3500"/></spectrum></emitter>

@@ -56,7 +56,7 @@ const char* const kGreySphere = R"(<scene version="3.0.0">
   <integrator type="path"><integer name="max_depth" value="2"/></integrator>
   <sensor type="perspective"><float name="fov" value="10"/>
     <transform name="to_world"><lookat origin="0, 0, 5" target="0, 0, 0" up="0, 1, 0"/></transform>
-    <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/></film>
+    <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/><rfilter type="box"/></film>
   </sensor>
   <emitter type="constant"><rgb name="radiance" value="1"/></emitter>
   <shape type="sphere"><float name="radius" value="1"/><bsdf type="diffuse"><rgb name="reflectance" value="$v"/></bsdf></shape>
@@ -411,7 +411,7 @@ TEST(SpectralMode, NonDispersiveGlassAgreesWithRgbMode) {
     const std::string text = R"(<scene version="3.0.0">
   <sensor type="perspective"><float name="fov" value="50"/>
     <transform name="to_world"><lookat origin="0, -3, 1.2" target="0, 0, 0.5" up="0, 0, 1"/></transform>
-    <film type="hdrfilm"><integer name="width" value="24"/><integer name="height" value="24"/></film></sensor>
+    <film type="hdrfilm"><integer name="width" value="24"/><integer name="height" value="24"/><rfilter type="box"/></film></sensor>
   <shape type="rectangle"><transform name="to_world"><scale value="3"/></transform>
     <bsdf type="diffuse"><rgb name="reflectance" value="0.6"/></bsdf></shape>
   <shape type="sphere"><point name="center" value="0, 0, 0.5"/><float name="radius" value="0.5"/>

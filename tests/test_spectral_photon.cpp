@@ -48,7 +48,7 @@ std::unique_ptr<Scene> glass_scene(const std::string& floor, const std::string& 
     const std::string text = fmt::format(R"(<scene version="3.0.0">
   <sensor type="perspective"><float name="fov" value="50"/>
     <transform name="to_world"><lookat origin="0, -3, 1.2" target="0, 0, 0.5" up="0, 0, 1"/></transform>
-    <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/></film></sensor>
+    <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/><rfilter type="box"/></film></sensor>
   <shape type="rectangle"><transform name="to_world"><scale value="3"/></transform>
     <bsdf type="diffuse"><rgb name="reflectance" value="{}"/></bsdf></shape>
   <shape type="sphere"><point name="center" value="0, 0, 0.5"/><float name="radius" value="0.5"/>

@@ -187,7 +187,7 @@ TEST(Spot, ProjectedTexturesRender) {
         return load_scene_text(R"(<scene version="3.0.0">
             <sensor type="perspective"><float name="fov" value="70"/>
                 <transform name="to_world"><lookat origin="0, 0, 3" target="0, 0, 0" up="0, 1, 0"/></transform>
-                <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/></film></sensor>
+                <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/><rfilter type="box"/></film></sensor>
             <shape type="rectangle"><transform name="to_world"><scale value="3"/></transform><bsdf type="diffuse"/></shape>
             <emitter type="spot"><rgb name="intensity" value=")" + intensity + R"("/><float name="cutoff_angle" value="35"/>)" + texture + R"(
                 <transform name="to_world"><lookat origin="0, 0, 2" target="0, 0, 0" up="0, 1, 0"/></transform></emitter></scene>)",

@@ -155,10 +155,11 @@ std::string integrator_refusal(const IntegratorInfo& info, const SceneDescriptio
                            "pm, eyelight) or a perspective sensor",
                            info.name, d.camera.kind == CameraKind::ThinLens ? "thinlens" : "orthographic");
     if (!info.any_filter && !(d.filter.is_box() && d.filter.radius == 0.5))
-        return fmt::format("{} adds its samples to the film without a reconstruction filter; the scene's rfilter '{}' "
+        return fmt::format("{} adds its samples to the film without a reconstruction filter; the scene's rfilter '{}'{} "
                            "works with the pixel integrators (path, direct, pt-naive, pm, ic, eyelight, ...); use "
                            "<rfilter type=\"box\"/> for {}",
-                           info.name, d.filter.type, info.name);
+                           info.name, d.filter.type,
+                           d.filter.type == "gaussian" ? " (also Mitsuba's default, for a <film> that names no <rfilter>)" : "", info.name);
     return "";
 }
 

@@ -99,7 +99,9 @@ private:
 // its own pixel); the others spread samples through render/pixel_filter.hpp.
 inline const PluginInfo& hdrfilm_plugin() {
     static const PluginInfo info{
-        "film", "hdrfilm", "the image: its size, window and reconstruction filter (<rfilter>: box, tent, gaussian, mitchell, catmullrom, lanczos)",
+        "film", "hdrfilm",
+        "the image: its size, window and reconstruction filter (<rfilter>: box, tent, gaussian, mitchell, catmullrom, lanczos; none: "
+        "Mitsuba's default, the gaussian)",
         {{"width", ParamType::Integer, "768", "pixels"},
          {"height", ParamType::Integer, "576", "pixels"},
          {"file_format", ParamType::String, "openexr", "openexr, rgbe or pfm: the format of the default output (-o sets others)", "fileFormat"},

@@ -115,6 +115,10 @@ void read_film(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b) {
         p.check_all_used();
         return 0;
     });
+    // A <film> without an <rfilter> has Mitsuba's default filter, a Gaussian of standard deviation
+    // 0.5 pixels (mitsuba3 src/render/film.cpp; Mitsuba 0.6 alike), as its author saw the scene
+    // rendered; a scene without a <film> renders on pathlab's own film (box).
+    b.desc.filter = FilterDesc{"gaussian", 4 * 0.5, 0.5};
     for (const pugi::xml_node& c : xml.plugin_children(n)) {
         if (std::string(c.name()) != "rfilter") xml.fail(c, fmt::format("unsupported element <{}> in <film>; supported: <rfilter>", c.name()));
         read_rfilter(xml, c, b);

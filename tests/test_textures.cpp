@@ -16,6 +16,8 @@
 #include "scenefile/scene_file.hpp"
 #include "textures/registry.hpp"
 #include "textures/srgb.hpp"
+#include "integrators/common/shading.hpp"
+#include "scene/scene.hpp"
 
 namespace pathlab {
 namespace {
@@ -375,7 +377,7 @@ TEST_F(TextureFiles, RefusalsSayWhatIsWrongAndWhere) {
         {"<bsdf type=\"diffuse\">" + checker_as("colour") + "</bsdf>", "", "parameter 'colour' of <bsdf type=\"diffuse\"> cannot be a texture"},
         {"<bsdf type=\"diffuse\"><texture type=\"checkerboard\"/></bsdf>", "", "needs the name of the parameter it gives (reflectance)"},
         {"<bsdf type=\"diffuse\"><texture type=\"noise\" name=\"reflectance\"/></bsdf>", "",
-         "unsupported texture type 'noise'; supported: bitmap, checkerboard, rawconstant"},
+         "unsupported texture type 'noise'; supported: bitmap, checkerboard, rawconstant, mesh_attribute"},
         {"<bsdf type=\"diffuse\"><texture type=\"bitmap\" name=\"reflectance\"/></bsdf>", "", "needs <string name=\"filename\""},
         {"<bsdf type=\"diffuse\"><texture type=\"bitmap\" name=\"reflectance\"><string name=\"filename\" value=\"t.png\"/>"
          "<string name=\"filter_type\" value=\"trilinear\"/></texture></bsdf>",
@@ -425,6 +427,118 @@ TEST_F(TextureFiles, RefusalsSayWhatIsWrongAndWhere) {
     EXPECT_EQ(error_of("<bsdf type=\"bumpmap\"><ref id=\"h\"/><ref id=\"d\"/></bsdf>",
                        "<bsdf type=\"diffuse\" id=\"d\"/><texture type=\"checkerboard\" id=\"h\"/>"),
               "");
+}
+
+
+// ---- mesh attributes ----------------------------------------------------------------------
+
+// Mitsuba 3's mesh_attribute: a PLY's extra vertex and face properties, named as Mitsuba names
+// them, spread to the corners of the triangles its polygons become, and looked up at a hit with
+// its barycentrics (closed forms on a quad).
+TEST_F(TextureFiles, MeshAttributesFromPlyPropertiesAreLookedUpAtTheHit) {
+    write("quad.ply", R"(ply
+format ascii 1.0
+element vertex 4
+property float x
+property float y
+property float z
+property float color_0
+property float color_1
+property float color_2
+element face 1
+property list uchar int vertex_indices
+property float weight_0
+property uchar r
+property uchar g
+property uchar b
+end_header
+0 0 0 0.1 0.2 0.3
+1 0 0 0.4 0.5 0.6
+1 1 0 0.7 0.8 0.9
+0 1 0 1.0 0.0 0.5
+4 0 1 2 3 0.25 51 102 255
+)");
+    const auto scene_with = [&](const std::string& bsdf) {
+        return load_scene_text(R"(<scene version="3.0.0"><shape type="ply"><string name="filename" value="quad.ply"/>)" + bsdf +
+                                   "</shape></scene>",
+                               path("scene.xml"), dir_.string());
+    };
+    const SceneDescription d = scene_with(R"(<bsdf type="diffuse"><texture type="mesh_attribute" name="reflectance">
+        <string name="name" value="vertex_color"/></texture></bsdf>)");
+    ASSERT_EQ(d.meshes.size(), 1u);
+    const MeshAttributes& a = d.meshes[0].attributes;
+    ASSERT_EQ(a.size(), 3u);
+    EXPECT_EQ(a[0].name, "vertex_color");
+    EXPECT_FALSE(a[0].per_face);
+    EXPECT_EQ(a[0].channels, 3);
+    // Triangles (0, 1, 2) and (0, 2, 3): their corners' colours.
+    EXPECT_EQ(a[0].values, (std::vector<float>{0.1f, 0.2f, 0.3f, 0.4f, 0.5f, 0.6f, 0.7f, 0.8f, 0.9f,  //
+                                               0.1f, 0.2f, 0.3f, 0.7f, 0.8f, 0.9f, 1.0f, 0.0f, 0.5f}));
+    EXPECT_EQ(a[1].name, "face_color");  // r, g, b of unsigned chars, over 255
+    EXPECT_EQ(a[1].values, (std::vector<float>{0.2f, 0.4f, 1.0f, 0.2f, 0.4f, 1.0f}));
+    EXPECT_EQ(a[2].name, "face_weight");
+    EXPECT_TRUE(a[2].per_face);
+    EXPECT_EQ(a[2].values, (std::vector<float>{0.25f, 0.25f}));
+
+    // At (0.75, 0.25) in triangle (0, 1, 2): barycentrics 0.25, 0.5, 0.25, colour (0.4, 0.5, 0.6).
+    const auto reflectance_at = [](const SceneDescription& desc, float x, float y) {
+        const std::unique_ptr<Scene> scene = Scene::build(desc);
+        Intersection hit;
+        EXPECT_TRUE(scene->intersect(Ray{Vec3f(x, y, 1), Vec3f(0, 0, -1)}, hit));
+        const ShadingPoint sp = make_shading_point(*scene, hit, Vec3f(0, 0, -1));
+        return std::get<PhongMaterial>(sp.material->model_at(sp.uv)).diffuse;
+    };
+    const SceneDescription constant = scene_with(R"(<bsdf type="diffuse"><rgb name="reflectance" value="0.4, 0.5, 0.6"/></bsdf>)");
+    const Rgb expected = std::get<PhongMaterial>(constant.materials[0].model).diffuse, got = reflectance_at(d, 0.75f, 0.25f);
+    EXPECT_NEAR(got.x, expected.x, 1e-6f);
+    EXPECT_NEAR(got.y, expected.y, 1e-6f);
+    EXPECT_NEAR(got.z, expected.z, 1e-6f);
+    // The face's own value, times scale, anywhere on it: a blend's weight.
+    const SceneDescription blend = scene_with(R"(<bsdf type="blendbsdf"><texture type="mesh_attribute" name="weight">
+        <string name="name" value="face_weight"/><float name="scale" value="0.5"/></texture><bsdf type="diffuse"/><bsdf type="conductor"/></bsdf>)");
+    const std::unique_ptr<Scene> scene = Scene::build(blend);
+    for (const Vec2f at : {Vec2f(0.75f, 0.25f), Vec2f(0.1f, 0.8f)}) {
+        Intersection hit;
+        ASSERT_TRUE(scene->intersect(Ray{Vec3f(at.x, at.y, 1), Vec3f(0, 0, -1)}, hit));
+        const ShadingPoint sp = make_shading_point(*scene, hit, Vec3f(0, 0, -1));
+        EXPECT_FLOAT_EQ(std::get<BlendMaterial>(sp.material->model_at(sp.uv)).weight, 0.125f);
+    }
+    // What a shape must have for its BSDF's mesh_attribute textures.
+    const auto error_with = [&](const std::string& scene) -> std::string {
+        try {
+            load_scene_text("<scene version=\"3.0.0\">" + scene + "</scene>", path("scene.xml"), dir_.string());
+        } catch (const SceneFileError& e) {
+            return e.what();
+        }
+        return "";
+    };
+    const std::string ply = R"(<shape type="ply"><string name="filename" value="quad.ply"/>)";
+    const std::string tex = R"(<texture type="mesh_attribute" name="reflectance"><string name="name" value="NAME"/></texture>)";
+    const auto tex_of = [&](const std::string& n) { return std::string(tex).replace(tex.find("NAME"), 4, n); };
+    for (const auto& [scene, message] : std::vector<std::pair<std::string, std::string>>{
+             {ply + "<bsdf type=\"diffuse\">" + tex_of("vertex_normal") + "</bsdf></shape>",
+              "reads the mesh attribute 'vertex_normal' (mesh_attribute), which mesh 'quad.ply' does not have; it has: vertex_color, "
+              "face_color, face_weight"},
+             {"<shape type=\"sphere\"><bsdf type=\"diffuse\">" + tex_of("vertex_color") + "</bsdf></shape>", "and a sphere has none"},
+             {"<shape type=\"rectangle\"><bsdf type=\"diffuse\">" + tex_of("vertex_color") + "</bsdf></shape>",
+              "it has: none (only PLY files give attributes)"},
+             {ply + R"(<bsdf type="blendbsdf"><texture type="mesh_attribute" name="weight"><string name="name" value="vertex_color"/></texture>
+                  <bsdf type="diffuse"/><bsdf type="diffuse"/></bsdf></shape>)",
+              "the mesh attribute 'vertex_color' has 3 channels, and the parameter reading it takes one value"},
+             {"<bsdf type=\"diffuse\" id=\"m\">" + tex_of("vertex_color") + "</bsdf><shape type=\"shapegroup\" id=\"g\">" + ply +
+                  "<ref id=\"m\"/></shape></shape>",
+              "which an instance's mesh does not keep"},
+             {"<bsdf type=\"diffuse\">" + tex_of("color") + "</bsdf>", "a mesh attribute's name starts with vertex_ or face_, not 'color'"},
+         }) {
+        const std::string e = error_with(scene);
+        EXPECT_NE(e.find(message), std::string::npos) << e;
+        EXPECT_NE(e.find("scene.xml:1:"), std::string::npos) << e;
+    }
+    write("bright.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nproperty float "
+                        "glow\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0 0\n1 0 0 2\n0 1 0 1\n3 0 1 2\n");
+    const std::string e = error_with(R"(<shape type="ply"><string name="filename" value="bright.ply"/><bsdf type="diffuse">)" +
+                                     tex_of("vertex_glow") + "</bsdf></shape>");
+    EXPECT_NE(e.find("the mesh attribute 'vertex_glow' of mesh 'bright.ply' has values from 0 to 2"), std::string::npos) << e;
 }
 
 }  // namespace

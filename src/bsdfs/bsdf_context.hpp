@@ -16,6 +16,7 @@
 
 #include "core/frame.hpp"
 #include "core/vec.hpp"
+#include "textures/mesh_attribute.hpp"
 
 namespace pathlab {
 
@@ -23,7 +24,7 @@ enum class TransportMode : unsigned char { Radiance, Importance };
 
 struct BsdfContext {
     Vec3f p;                  // the hit point
-    Vec2f uv{0.0f, 0.0f};     // surface coordinates; (0, 0) where the shape has none
+    SurfaceUv uv;             // surface coordinates, (0, 0) where the shape has none; a mesh's attributes at the hit
     Frame frame;              // shading frame: n the shading normal, s the tangent, t the bitangent
     Vec3f ng;                 // unit geometric normal, on the side of frame.n
     TransportMode mode = TransportMode::Radiance;

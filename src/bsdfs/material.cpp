@@ -61,7 +61,7 @@ void Material::prepare() {
     surface_coordinates = varies || tangent_frame;
 }
 
-MaterialModel Material::model_at(const Vec2f& uv) const {
+MaterialModel Material::model_at(const SurfaceUv& uv) const {
     MaterialModel m = model;
     std::visit(
         [&](auto& x) {
@@ -85,7 +85,7 @@ MaterialModel Material::model_at(const Vec2f& uv) const {
     return m;
 }
 
-Frame Material::shading_frame(const Vec3f& n, const Vec3f& ng, bool back, const Vec3f& dpdu, const Vec3f& dpdv, const Vec2f& uv) const {
+Frame Material::shading_frame(const Vec3f& n, const Vec3f& ng, bool back, const Vec3f& dpdu, const Vec3f& dpdv, const SurfaceUv& uv) const {
     const Frame f = perturbed() ? perturbed_frame(*textures, n, ng, dpdu, dpdv, uv) : pathlab::tangent_frame(n, dpdu);
     if (!back) return f;
     Frame r;
@@ -116,13 +116,13 @@ Rgb Material::eval_and_pdf_varying(const BsdfContext& ctx, const Vec3f& wi, cons
 // material that varies is evaluated at the composite's uv (its radiance-mode model there: the
 // transport mode is applied once, by the composite's Material).
 namespace {
-Rgb eval_at(const Material& m, const Vec2f& uv, const Vec3f& wi, const Vec3f& wo) {
+Rgb eval_at(const Material& m, const SurfaceUv& uv, const Vec3f& wi, const Vec3f& wo) {
     return m.varies ? eval_of(m.model_at(uv), wi, wo) : m.eval(wi, wo);
 }
-float pdf_at(const Material& m, const Vec2f& uv, const Vec3f& wi, const Vec3f& wo) {
+float pdf_at(const Material& m, const SurfaceUv& uv, const Vec3f& wi, const Vec3f& wo) {
     return m.varies ? pdf_of(m.model_at(uv), wi, wo) : m.pdf(wi, wo);
 }
-std::optional<BsdfSample> sample_at(const Material& m, const Vec2f& uv, const Vec3f& wi, const Vec2f& u) {
+std::optional<BsdfSample> sample_at(const Material& m, const SurfaceUv& uv, const Vec3f& wi, const Vec2f& u) {
     if (!m.varies) return m.sample(wi, u);
     return std::visit([&](const auto& x) { return x.sample(wi, u); }, m.model_at(uv));
 }
@@ -185,6 +185,23 @@ std::optional<BsdfSample> Material::sample_adjusted(const BsdfContext& ctx, cons
     };
     if (!varies) return adjust(model);
     return adjust(model_at(ctx.uv));
+}
+
+std::vector<Material::AttributeUse> Material::mesh_attributes_read() const {
+    std::vector<AttributeUse> out;
+    const auto add = [&](const std::shared_ptr<const Texture>& t, bool scalar) {
+        if (const auto* a = t ? std::get_if<MeshAttributeTexture>(&t->model()) : nullptr) out.push_back({a->name, scalar});
+    };
+    if (textures) {
+        for (const TextureBinding& b : textures->bindings) add(b.texture, b.scalar);
+        add(textures->perturbation_texture, textures->perturbation == FramePerturbation::BumpMap);
+    }
+    const auto nested = [&](const Material& inner) {
+        for (AttributeUse& u : inner.mesh_attributes_read()) out.push_back(std::move(u));
+    };
+    if (const auto* b = std::get_if<BlendMaterial>(&model)) nested(*b->first), nested(*b->second);
+    if (const auto* m = std::get_if<MaskMaterial>(&model)) nested(*m->inner);
+    return out;
 }
 
 float Material::importance_factor(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo) const {

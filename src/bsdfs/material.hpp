@@ -24,6 +24,8 @@
 #include <memory>
 #include <optional>
 #include <variant>
+#include <string>
+#include <vector>
 
 #include "bsdfs/bsdf_context.hpp"
 #include "bsdfs/conductor.hpp"
@@ -53,11 +55,11 @@ struct Material;
 struct BlendMaterial {
     std::shared_ptr<const Material> first, second;
     float weight = 0.5f;  // of `second`
-    Vec2f uv = Vec2f(0, 0);  // where the nested BSDFs are evaluated (textured ones only)
+    SurfaceUv uv = {};  // where the nested BSDFs are evaluated (textured ones only)
 
     static constexpr int kSlotWeight = 0;
     void set_texel(int, const Rgb& v) { weight = v.x; }
-    void set_uv(const Vec2f& at) { uv = at; }
+    void set_uv(const SurfaceUv& at) { uv = at; }
 
     Rgb eval(const Vec3f& wi, const Vec3f& wo) const;
     float pdf(const Vec3f& wi, const Vec3f& wo) const;
@@ -70,11 +72,11 @@ struct BlendMaterial {
 struct MaskMaterial {
     std::shared_ptr<const Material> inner;
     float opacity = 0.5f;
-    Vec2f uv = Vec2f(0, 0);
+    SurfaceUv uv = {};
 
     static constexpr int kSlotOpacity = 0;
     void set_texel(int, const Rgb& v) { opacity = v.x; }
-    void set_uv(const Vec2f& at) { uv = at; }
+    void set_uv(const SurfaceUv& at) { uv = at; }
 
     Rgb eval(const Vec3f& wi, const Vec3f& wo) const;
     float pdf(const Vec3f& wi, const Vec3f& wo) const;
@@ -143,12 +145,12 @@ struct Material {
     void prepare();
     bool perturbed() const { return textures && textures->perturbation != FramePerturbation::None; }
     // The model at surface coordinates uv: the textured parameters set to their values there.
-    MaterialModel model_at(const Vec2f& uv) const;
+    MaterialModel model_at(const SurfaceUv& uv) const;
     // The shading frame at a hit whose front-side unit shading and geometric normals are n, ng
     // (for tangent_frame materials; the others use Frame(n)): tangent_frame() or
     // perturbed_frame() of material_textures.hpp, reversed (n -> -n) for the back of a
     // two-sided material, which is the same tilted surface seen from behind.
-    Frame shading_frame(const Vec3f& n, const Vec3f& ng, bool back, const Vec3f& dpdu, const Vec3f& dpdv, const Vec2f& uv) const;
+    Frame shading_frame(const Vec3f& n, const Vec3f& ng, bool back, const Vec3f& dpdu, const Vec3f& dpdv, const SurfaceUv& uv) const;
 
     Rgb eval(const Vec3f& wi, const Vec3f& wo) const {
         return visit_model(model, [&](const auto& m) { return m.eval(wi, wo); });
@@ -233,6 +235,14 @@ struct Material {
             return (lobes() & kLobeTransmission) != 0;
         return is_dielectric();
     }
+
+    // The mesh attributes its textures read (mesh_attribute), nested materials included, each
+    // with whether a float parameter reads it (one channel needed): what a shape must have.
+    struct AttributeUse {
+        std::string name;
+        bool scalar = false;
+    };
+    std::vector<AttributeUse> mesh_attributes_read() const;
 
     // The context's adjustments (material.cpp: out of line, so that the hot path's visit of the
     // model stays the only one in the integrators' code and is inlined there).

@@ -29,7 +29,7 @@ Frame frame_along(const Vec3f& n, const Vec3f& dpdu) {
 Frame tangent_frame(const Vec3f& n, const Vec3f& dpdu) { return frame_along(n, dpdu); }
 
 Frame perturbed_frame(const MaterialTextures& t, const Vec3f& n, const Vec3f& ng, const Vec3f& dpdu, const Vec3f& dpdv,
-                      const Vec2f& uv) {
+                      const SurfaceUv& uv) {
     const Frame base = frame_along(n, dpdu);
     if (!t.perturbation_texture) return base;
     Vec3f p(0.0f);

@@ -48,6 +48,6 @@ Frame tangent_frame(const Vec3f& n, const Vec3f& dpdu);
 // n' turned to the side of ng if it points below; then s' = the tangent s of tangent_frame(n,
 // dp/du) made orthogonal to n', and t' = n' x s'. Degenerate inputs (a zero normal, non-finite texels) leave the frame unperturbed.
 Frame perturbed_frame(const MaterialTextures& t, const Vec3f& n, const Vec3f& ng, const Vec3f& dpdu, const Vec3f& dpdv,
-                      const Vec2f& uv);
+                      const SurfaceUv& uv);
 
 }  // namespace pathlab

@@ -61,7 +61,7 @@ struct DenseMetal {
 const DenseMetal& dense_metal(const MeasuredConductor* metal) {
     static const std::vector<DenseMetal> table = [] {
         std::vector<DenseMetal> t;
-        for (const char* name : {"Au", "Ag", "Cu", "Al", "Cr"}) {
+        for (const char* name : {"Au", "Ag", "Cu", "Al", "Cr", "a-C"}) {
             const MeasuredConductor* m = measured_conductor(name);
             t.push_back({m, DenseSpectrum(m->eta), DenseSpectrum(m->k)});
         }
@@ -160,7 +160,7 @@ Spectrum4 model_value(const MaterialModel& model, const MaterialSpectra* spectra
         const Spectrum4 c = reflectance(p->base_color, nullptr, wl);
         return p->terms(wi, wo, unused).value(c, sqrt(c));
     }
-    const auto nested = [&](const Material& m, const Vec2f& uv) {
+    const auto nested = [&](const Material& m, const SurfaceUv& uv) {
         return model_value(m.varies ? m.model_at(uv) : m.model, m.spectra.get(), wi, wo, wl);
     };
     if (const auto* b = std::get_if<BlendMaterial>(&model))
@@ -188,7 +188,7 @@ LobeColour delta_lobe_colour(const MaterialModel& model, const MaterialSpectra* 
     }
     if (const auto* p = std::get_if<PlasticMaterial>(&model))
         return {p->coat.specular_reflectance, reflectance(p->coat.specular_reflectance, specular_of(spectra), wl)};
-    const auto nested = [&](const Material& m, const Vec2f& uv) {
+    const auto nested = [&](const Material& m, const SurfaceUv& uv) {
         return delta_lobe_colour(m.varies ? m.model_at(uv) : m.model, m.spectra.get(), wi, wo, wl);
     };
     if (const auto* b = std::get_if<BlendMaterial>(&model))  // at most one of the two has Dirac lobes (spectral_unsupported_model)

@@ -64,6 +64,7 @@ size_t ply_type_size(const std::string& type) {
 
 struct PlyProperty {
     std::string name;
+    std::string type;       // a value's type (a list's items')
     size_t size = 0;        // a value's bytes (binary)
     size_t count_size = 0;  // a list's count's bytes; 0: not a list
     bool count_signed = false;
@@ -73,6 +74,13 @@ struct PlyElement {
     std::string name;
     uint64_t count = 0;
     std::vector<PlyProperty> properties;
+};
+
+// What check_ply_file found: the format, the elements and where the body starts.
+struct PlyLayout {
+    bool binary = false, big_endian = false;
+    std::vector<PlyElement> elements;
+    uint64_t header_bytes = 0, body = 0;
 };
 
 // The body of a PLY file, read forward through a buffer.
@@ -129,7 +137,7 @@ private:
     size_t at_ = 0, end_ = 0;
 };
 
-void check_ply_file(const std::string& path) {
+PlyLayout check_ply_file(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
     if (!in) throw MeshLoadError(fmt::format("cannot read mesh '{}'", path));
     const uint64_t file_size = std::filesystem::file_size(path);
@@ -179,11 +187,11 @@ void check_ply_file(const std::string& path) {
                 words >> count_type >> item_type;
                 if (!ply_type_size(count_type) || !ply_type_size(item_type)) fail(line, "a list property needs two known types");
                 if (count_type.find("float") != std::string::npos || count_type == "double") fail(line, "a list's count must have an integer type");
-                p.size = ply_type_size(item_type), p.count_size = ply_type_size(count_type);
+                p.size = ply_type_size(item_type), p.count_size = ply_type_size(count_type), p.type = item_type;
                 p.count_signed = count_type[0] != 'u';
             } else {
                 if (!ply_type_size(type)) fail(line, fmt::format("unknown property type '{}'", type));
-                p.size = ply_type_size(type);
+                p.size = ply_type_size(type), p.type = type;
             }
             words >> p.name;
             elements.back().properties.push_back(p);
@@ -266,13 +274,165 @@ void check_ply_file(const std::string& path) {
                 }
             }
     }
+    return {binary, big_endian, std::move(elements), header_bytes, body};
+}
+
+// A binary PLY value of `type` (size bytes, already in the file's byte order reversed to
+// little-endian) as a double.
+double ply_binary_value(const unsigned char* b, const std::string& type) {
+    const auto as = [&]<class V>(V) {
+        V v;
+        std::memcpy(&v, b, sizeof v);
+        return double(v);
+    };
+    if (type == "char" || type == "int8") return as(int8_t());
+    if (type == "uchar" || type == "uint8") return as(uint8_t());
+    if (type == "short" || type == "int16") return as(int16_t());
+    if (type == "ushort" || type == "uint16") return as(uint16_t());
+    if (type == "int" || type == "int32") return as(int32_t());
+    if (type == "uint" || type == "uint32") return as(uint32_t());
+    if (type == "float" || type == "float32") return as(float());
+    return as(double());
+}
+
+// The vertex and face properties a PLY file has beyond what Assimp reads (positions, normals,
+// texture coordinates, the faces' indices), as Mitsuba 3 names them (core/mesh_attributes.hpp):
+// "<base>_0", "<base>_1", ... one attribute of that many channels (1 or 3 are kept); r, g, b
+// (or red, green, blue) "color", an unsigned char one divided by 255; any other single value an
+// attribute of its own. Vertex values are spread to the corners of the triangles Assimp's faces
+// become (fans (0, i, i + 1), in the file's order), face values to each triangle of their face.
+MeshAttributes read_ply_attributes(const std::string& path, const PlyLayout& layout) {
+    static const char* const kRead[] = {"x", "y", "z", "nx", "ny", "nz", "u", "v", "s", "t", "texture_u", "texture_v", "texture_s",
+                                        "texture_t", "vertex_indices", "vertex_index", "alpha", "a"};
+    struct Group {
+        std::string name;
+        std::vector<int> properties;  // the element's property indices, channel by channel
+        bool bytes = false;            // unsigned char colour: divided by 255
+    };
+    const auto groups_of = [&](const PlyElement& e, const std::string& prefix) {
+        std::vector<Group> groups;
+        const auto find = [&](const std::string& n) {
+            for (size_t i = 0; i < e.properties.size(); ++i)
+                if (e.properties[i].name == n && !e.properties[i].count_size) return int(i);
+            return -1;
+        };
+        std::vector<bool> used(e.properties.size(), false);
+        for (const auto& rgb : {std::array<const char*, 3>{"r", "g", "b"}, std::array<const char*, 3>{"red", "green", "blue"}}) {
+            const int r = find(rgb[0]), g = find(rgb[1]), b = find(rgb[2]);
+            if (r < 0 || g < 0 || b < 0) continue;
+            const bool bytes = e.properties[size_t(r)].type == "uchar" || e.properties[size_t(r)].type == "uint8";
+            groups.push_back({prefix + "color", {r, g, b}, bytes});
+            used[size_t(r)] = used[size_t(g)] = used[size_t(b)] = true;
+        }
+        for (size_t i = 0; i < e.properties.size(); ++i) {
+            const PlyProperty& p = e.properties[i];
+            if (used[i] || p.count_size || std::any_of(std::begin(kRead), std::end(kRead), [&](const char* k) { return p.name == k; })) continue;
+            const size_t cut = p.name.rfind('_');
+            if (cut != std::string::npos && p.name.substr(cut + 1) == "0") {  // base_0, base_1, ...
+                const std::string base = p.name.substr(0, cut);
+                Group g{prefix + base, {}, false};
+                for (int k = 0;; ++k) {
+                    const int j = find(base + "_" + std::to_string(k));
+                    if (j < 0) break;
+                    g.properties.push_back(j);
+                    used[size_t(j)] = true;
+                }
+                if (g.properties.size() == 1 || g.properties.size() == 3) groups.push_back(std::move(g));
+                continue;
+            }
+            if (cut != std::string::npos && p.name.find_first_not_of("0123456789", cut + 1) == std::string::npos) continue;  // base_k of a group
+            groups.push_back({prefix + p.name, {int(i)}, false});
+            used[i] = true;
+        }
+        return groups;
+    };
+    const PlyElement* vertex = nullptr;
+    const PlyElement* face = nullptr;
+    for (const PlyElement& e : layout.elements) {
+        if (e.name == "vertex" && !vertex) vertex = &e;
+        if (e.name == "face" && !face) face = &e;
+    }
+    if (!vertex || !face) return {};
+    const std::vector<Group> vertex_groups = groups_of(*vertex, "vertex_"), face_groups = groups_of(*face, "face_");
+    if (vertex_groups.empty() && face_groups.empty()) return {};
+
+    std::ifstream in(path, std::ios::binary);
+    in.seekg(std::streamoff(layout.header_bytes));
+    PlyBody reader(in, layout.body);
+    std::string word;
+    const auto value = [&](const PlyProperty& p) {
+        if (!layout.binary) {
+            reader.word(word);
+            double v = 0;
+            std::from_chars(word.data() + (word.starts_with('+') ? 1 : 0), word.data() + word.size(), v);
+            return v;
+        }
+        unsigned char b[8] = {};
+        reader.bytes(b, p.size);
+        if (layout.big_endian) std::reverse(b, b + p.size);
+        return ply_binary_value(b, p.type);
+    };
+    const auto count = [&](const PlyProperty& p) {
+        if (!layout.binary) {
+            reader.word(word);
+            return uint64_t(std::stoull(word));
+        }
+        unsigned char b[8] = {};
+        reader.bytes(b, p.count_size);
+        if (layout.big_endian) std::reverse(b, b + p.count_size);
+        uint64_t u = 0;
+        for (size_t k = 0; k < p.count_size; ++k) u |= uint64_t(b[k]) << (8 * k);
+        return u;
+    };
+    // Every element's values, kept for the vertex and face elements (check_ply_file walked the
+    // same body, so the counts and lists hold).
+    std::vector<std::vector<double>> vertex_values(vertex->properties.size()), face_values(face->properties.size());
+    std::vector<std::vector<uint32_t>> polygons;
+    for (const PlyElement& e : layout.elements) {
+        const bool is_vertex = &e == vertex, is_face = &e == face;
+        for (uint64_t i = 0; i < e.count; ++i)
+            for (size_t k = 0; k < e.properties.size(); ++k) {
+                const PlyProperty& p = e.properties[k];
+                if (!p.count_size) {
+                    const double v = value(p);
+                    if (is_vertex) vertex_values[k].push_back(v);
+                    if (is_face) face_values[k].push_back(v);
+                    continue;
+                }
+                const uint64_t n = count(p);
+                std::vector<uint32_t> list;
+                for (uint64_t j = 0; j < n; ++j) list.push_back(uint32_t(value(p)));
+                if (is_face && (p.name == "vertex_indices" || p.name == "vertex_index")) polygons.push_back(std::move(list));
+            }
+    }
+    MeshAttributes out;
+    const auto spread = [&](const Group& g, bool per_face) {
+        MeshAttribute a{g.name, per_face, int(g.properties.size()), {}};
+        const auto& values = per_face ? face_values : vertex_values;
+        const auto channel = [&](size_t c, size_t item) {
+            const double v = values[size_t(g.properties[c])][item];
+            return float(g.bytes ? v / 255.0 : v);
+        };
+        for (size_t f = 0; f < polygons.size(); ++f) {
+            const std::vector<uint32_t>& poly = polygons[f];
+            for (size_t i = 1; i + 1 < poly.size(); ++i)
+                for (const uint32_t corner : {poly[0], poly[i], poly[i + 1]}) {
+                    for (size_t c = 0; c < g.properties.size(); ++c) a.values.push_back(per_face ? channel(c, f) : channel(c, corner));
+                    if (per_face) break;
+                }
+        }
+        out.push_back(std::move(a));
+    };
+    for (const Group& g : vertex_groups) spread(g, false);
+    for (const Group& g : face_groups) spread(g, true);
+    return out;
 }
 
 }  // namespace
 
 MeshDesc load_ply_mesh(const std::string& path) {
     require_regular_file(path);
-    check_ply_file(path);
+    const PlyLayout layout = check_ply_file(path);
     Assimp::Importer importer;
     // No post-processing: Assimp's own steps would triangulate differently, join identical
     // vertices or reorder; the fan below is Mitsuba's.
@@ -304,6 +464,15 @@ MeshDesc load_ply_mesh(const std::string& path) {
         }
     }
     check_finite(m, path);
+    m.attributes = read_ply_attributes(path, layout);
+    for (const MeshAttribute& a : m.attributes) {
+        const size_t items = a.per_face ? m.triangles.size() : 3 * m.triangles.size();
+        if (a.values.size() != items * size_t(a.channels))
+            throw MeshLoadError(fmt::format("mesh '{}': its attribute '{}' does not match the {} triangles Assimp read", path, a.name,
+                                            m.triangles.size()));
+        for (const float v : a.values)
+            if (!std::isfinite(v)) throw MeshLoadError(fmt::format("mesh '{}': its attribute '{}' has a non-finite value", path, a.name));
+    }
     return m;
 }
 

@@ -9,6 +9,7 @@
 
 #include "core/transform.hpp"
 #include "core/vec.hpp"
+#include "core/mesh_attributes.hpp"
 
 namespace pathlab {
 
@@ -42,6 +43,7 @@ struct MeshDesc {
     UvMap uv_map = UvMap::Vertices;
     Transform to_world, to_object;  // UvMap::Disk: the unit disk's placement and its inverse
     std::string id = {}; // the shape's id ("" for none): names its emitter's parameters (diff/)
+    MeshAttributes attributes = {};  // the file's extra vertex and face values (PLY), for mesh_attribute textures
 };
 
 struct SphereDesc {

@@ -102,8 +102,10 @@ std::unique_ptr<Scene> Scene::build(const SceneDescription& desc) {
         s->light_spectra_.resize(s->lights_.size());
         s->light_spectra_.back() = spectrum;
     };
+    std::vector<int> emitter_of;  // the emitter each light belongs to (the light sampler's uniform choice)
     for (size_t i = 0; i < desc.lights.size(); ++i) {
         std::visit([&](const auto& light) { s->lights_.emplace_back(light); }, desc.lights[i]);
+        emitter_of.push_back(int(s->lights_.size()) - 1);
         if (is_environment(s->lights_.back())) s->environment_ = int(s->lights_.size()) - 1;
         add_spectrum(desc.light_spectra, i);
     }
@@ -126,6 +128,7 @@ std::unique_ptr<Scene> Scene::build(const SceneDescription& desc) {
             rec.first_light = int32_t(s->lights_.size());
             for (const auto& t : m.triangles) {
                 s->lights_.emplace_back(TriangleLight(m.positions[t[0]], m.positions[t[1]], m.positions[t[2]], m.emission));
+                emitter_of.push_back(rec.first_light);  // the mesh is one emitter
                 add_spectrum(desc.mesh_emission_spectra, i);
             }
         }
@@ -141,6 +144,7 @@ std::unique_ptr<Scene> Scene::build(const SceneDescription& desc) {
         if (!is_black(sp.emission)) {
             rec.first_light = int32_t(s->lights_.size());
             s->lights_.emplace_back(SphereLight{sp.center, sp.radius, sp.flip_normals, sp.emission});
+            emitter_of.push_back(int(s->lights_.size()) - 1);
             add_spectrum(desc.sphere_emission_spectra, i);
         }
         s->geometry_[id] = rec;
@@ -174,7 +178,7 @@ std::unique_ptr<Scene> Scene::build(const SceneDescription& desc) {
     }
 
     s->light_distribution_ = LightDistribution(s->lights_, s->scene_sphere());
-    s->light_sampler_ = LightSampler(s->lights_, s->scene_sphere(), desc.light_sampler, desc.ris_candidates);
+    s->light_sampler_ = LightSampler(s->lights_, s->scene_sphere(), desc.light_sampler, desc.ris_candidates, emitter_of);
     if (s->has_media_) {
         // A point of each light on its emitting side (the middle of its emission sampling's domain).
         const float offset = 1e-4f * s->radius_;
@@ -295,13 +299,25 @@ Scene::SurfaceCoordinates Scene::surface_coordinates(const Intersection& hit) co
     }
     const MeshDesc& m = *rec.mesh;
     const auto& tri = m.triangles[hit.prim_id];
+    if (!m.attributes.empty()) {  // mesh_attribute textures: the triangle and the hit's barycentrics in it
+        const Vec3f e1 = m.positions[tri[1]] - m.positions[tri[0]], e2 = m.positions[tri[2]] - m.positions[tri[0]];
+        const Vec3f q = hit.p - m.positions[tri[0]];
+        const float d11 = dot(e1, e1), d12 = dot(e1, e2), d22 = dot(e2, e2), q1 = dot(q, e1), q2 = dot(q, e2);
+        const float det = d11 * d22 - d12 * d12;
+        const float b1 = det > 0 ? std::clamp((d22 * q1 - d12 * q2) / det, 0.0f, 1.0f) : 0.0f;
+        const float b2 = det > 0 ? std::clamp((d11 * q2 - d12 * q1) / det, 0.0f, 1.0f - b1) : 0.0f;
+        c.uv.attributes = &m.attributes;
+        c.uv.tri = hit.prim_id;
+        c.uv.b1 = b1;
+        c.uv.b2 = b2;
+    }
     if (m.uv_map == UvMap::Disk) {
         // Mitsuba 3's disk: the hit in the unit disk's space in polar coordinates, uv = (r, phi / 2 pi).
         const Vec3d local = m.to_object.point(Vec3d(hit.p));
         const double r = std::hypot(local.x, local.y);
         double phi = std::atan2(local.y, local.x);
         if (phi < 0) phi += 2 * M_PI;
-        c.uv = Vec2f(float(r), float(phi / (2 * M_PI)));
+        static_cast<Vec2f&>(c.uv) = Vec2f(float(r), float(phi / (2 * M_PI)));
         const double cs = r > 0 ? local.x / r : 1, sn = r > 0 ? local.y / r : 0;
         c.dpdu = Vec3f(m.to_world.vector({cs, sn, 0}));
         c.dpdv = Vec3f(m.to_world.vector(Vec3d(-sn, cs, 0) * (2 * M_PI * r)));

@@ -12,6 +12,7 @@
 #include "lights/light_distribution.hpp"
 #include "lights/light_sampler.hpp"
 #include "scene/scene_description.hpp"
+#include "textures/mesh_attribute.hpp"
 
 namespace pathlab {
 
@@ -78,7 +79,7 @@ public:
     // and disks, Mitsuba 3's) and the derivatives dp/du, dp/dv (on a mesh from its triangle's
     // texture coordinates; without them, two unit tangents from the geometric normal).
     struct SurfaceCoordinates {
-        Vec2f uv;
+        SurfaceUv uv;  // on a mesh with attributes (mesh_attribute textures) also the triangle and barycentrics
         Vec3f dpdu, dpdv;
     };
     SurfaceCoordinates surface_coordinates(const Intersection& hit) const;

@@ -14,7 +14,8 @@ namespace {
 
 const PluginInfo& shapegroup_plugin() {
     static const PluginInfo info{"shape", "shapegroup",
-                                 "meshes (nested <shape>s, not spheres or emitters) stored once and placed by instances; needs an id", {}};
+                                 "meshes and spheres (nested <shape>s, not emitters) placed by instances (meshes stored once; spheres copied, "
+                                 "their instances rotated, scaled uniformly, moved); needs an id", {}};
     return info;
 }
 const PluginInfo& instance_plugin() {
@@ -24,7 +25,42 @@ const PluginInfo& instance_plugin() {
 }
 
 // `group`: the shape belongs to a shapegroup (its mesh goes there).
-void read_shape_into(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b, std::vector<MeshDesc>* group);
+// `group`: the shape belongs to a shapegroup (its mesh goes there; a sphere to `group_spheres`).
+void read_shape_into(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b, std::vector<MeshDesc>* group,
+                     std::vector<SphereDesc>* group_spheres = nullptr);
+
+// A material whose textures read the mesh's own attributes (mesh_attribute) needs a mesh that
+// has each of them (one channel where a float parameter reads it), with values in [0, 1] (the
+// range its texture declared when it was read, before any mesh was known).
+void check_mesh_attributes(XmlSource& xml, const pugi::xml_node& n, const SceneBuilder& b, uint32_t material, const ShapeDesc& shape,
+                           bool in_group) {
+    const Material& m = b.desc.materials[material];
+    std::vector<Material::AttributeUse> uses = m.mesh_attributes_read();
+    if (m.back >= 0)
+        for (Material::AttributeUse& u : b.desc.materials[size_t(m.back)].mesh_attributes_read()) uses.push_back(std::move(u));
+    if (uses.empty()) return;
+    const MeshDesc* mesh = std::get_if<MeshDesc>(&shape);
+    if (!mesh) xml.fail(n, fmt::format("its BSDF reads the mesh attribute '{}' (mesh_attribute), and a sphere has none", uses[0].name));
+    if (in_group)
+        xml.fail(n, fmt::format("its BSDF reads the mesh attribute '{}' (mesh_attribute), which an instance's mesh does not keep: place the shape "
+                                "on its own",
+                                uses[0].name));
+    for (const Material::AttributeUse& u : uses) {
+        const MeshAttribute* a = find_attribute(mesh->attributes, u.name);
+        if (!a) {
+            std::vector<std::string> names;
+            for (const MeshAttribute& x : mesh->attributes) names.push_back(x.name);
+            xml.fail(n, fmt::format("its BSDF reads the mesh attribute '{}' (mesh_attribute), which mesh '{}' does not have; it has: {}", u.name,
+                                    mesh->name, names.empty() ? std::string("none (only PLY files give attributes)") : fmt::format("{}", fmt::join(names, ", "))));
+        }
+        if (u.scalar && a->channels != 1)
+            xml.fail(n, fmt::format("the mesh attribute '{}' has {} channels, and the parameter reading it takes one value", u.name, a->channels));
+        if (a->min_value() < 0 || a->max_value() > 1)
+            xml.fail(n, fmt::format("the mesh attribute '{}' of mesh '{}' has values from {} to {}; a mesh_attribute texture takes values in [0, 1] "
+                                    "(its scale multiplies them)",
+                                    u.name, mesh->name, a->min_value(), a->max_value()));
+    }
+}
 
 void read_shapegroup(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b) {
     const auto id = xml.optional_attr(n, "id");
@@ -33,14 +69,17 @@ void read_shapegroup(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b) {
     reading([&] { return p.check_all_used(), 0; });
     ShapeGroupDesc g;
     g.name = *id;
+    std::vector<SphereDesc> spheres;
     for (const pugi::xml_node& c : xml.plugin_children(n)) {
         if (std::string(c.name()) != "shape") xml.fail(c, fmt::format("unsupported element <{}> in a shapegroup; supported: <shape>", c.name()));
         const std::string type = c.attribute("type").value();
         if (type == "shapegroup" || type == "instance") xml.fail(c, "shapegroups and instances cannot be nested in a shapegroup");
-        read_shape_into(xml, c, b, &g.meshes);
+        read_shape_into(xml, c, b, &g.meshes, &spheres);
     }
-    if (g.meshes.empty()) xml.fail(n, "an empty shapegroup");
+    if (g.meshes.empty() && spheres.empty()) xml.fail(n, "an empty shapegroup");
     b.desc.groups.push_back(std::move(g));
+    b.group_spheres.resize(b.desc.groups.size());
+    b.group_spheres.back() = std::move(spheres);
     b.name(xml, n, *id, "shapegroup", uint32_t(b.desc.groups.size() - 1));
 }
 
@@ -60,7 +99,27 @@ void read_instance(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b) {
         p.check_all_used();
         return 0;
     });
-    b.desc.instances.push_back(inst);
+    // The group's exact spheres, placed here: a sphere stays a sphere under a rotation, a uniform
+    // scale and a translation (Mitsuba 3 instances them the same way), and only then.
+    static const std::vector<SphereDesc> kNone;
+    const std::vector<SphereDesc>& spheres = *group < b.group_spheres.size() ? b.group_spheres[*group] : kNone;
+    if (!spheres.empty()) {
+        const Transform& t = inst.to_world;
+        const Vec3d x = t.vector({1, 0, 0}), y = t.vector({0, 1, 0}), z = t.vector({0, 0, 1});
+        const double s = length(x);
+        const auto close = [&](double a) { return std::abs(a - s) <= 1e-5 * s; };
+        if (!(s > 0) || !close(length(y)) || !close(length(z)) || std::abs(dot(x, y)) > 1e-5 * s * s || std::abs(dot(y, z)) > 1e-5 * s * s ||
+            std::abs(dot(z, x)) > 1e-5 * s * s)
+            xml.fail(n, "this shapegroup holds an exact sphere, which an instance can only rotate, scale uniformly and translate (a shear "
+                        "or a non-uniform scale makes an ellipsoid): use a sphere mesh (obj, ply) in the group");
+        for (SphereDesc sphere : spheres) {
+            sphere.center = Vec3f(t.point(Vec3d(sphere.center)));
+            sphere.radius = float(sphere.radius * s);
+            for (Vec3f& a : sphere.axes) a = Vec3f(normalize(t.vector(Vec3d(a))));
+            b.desc.spheres.push_back(sphere);
+        }
+    }
+    if (!b.desc.groups[*group].meshes.empty()) b.desc.instances.push_back(inst);
 }
 
 }  // namespace
@@ -71,7 +130,8 @@ void read_shape(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b) { read
 
 namespace {
 
-void read_shape_into(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b, std::vector<MeshDesc>* group) {
+void read_shape_into(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b, std::vector<MeshDesc>* group,
+                     std::vector<SphereDesc>* group_spheres) {
     xml.check_attributes(n, {"type", "id", "name"});
     const std::string type = xml.attr(n, "type");
     if (type == "shapegroup" && !group) return read_shapegroup(xml, n, b);
@@ -178,14 +238,17 @@ void read_shape_into(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b, s
         p.check_all_used();
         return s;
     });
+    check_mesh_attributes(xml, n, b, *material, shape, group != nullptr);
     if (group) {
         if (emitter) xml.fail(n, "a shape in a shapegroup cannot emit light (pathlab samples emitters one by one)");
         if (media.changes_medium() || media.index_matched) xml.fail(n, "a shape in a shapegroup cannot bound media (place it on its own)");
-        if (std::holds_alternative<SphereDesc>(shape))
-            xml.fail(n, "an exact sphere cannot be in a shapegroup; place spheres one by one, or use a sphere mesh (obj, ply)");
     }
     if (auto* sphere = std::get_if<SphereDesc>(&shape)) {
         sphere->material = *material;
+        if (group) {  // in the group's space; each instance places a copy (read_instance)
+            group_spheres->push_back(*sphere);
+            return;
+        }
         sphere->emission = emission;
         sphere->media = media;
         if (const auto id = xml.optional_attr(n, "id")) sphere->id = *id;

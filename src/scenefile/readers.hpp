@@ -37,6 +37,9 @@ struct SceneBuilder {
     std::optional<uint32_t> default_material;
     bool have_sensor = false, have_integrator = false;
     ShapeContext shapes;
+    // The exact spheres of each shapegroup (by its index in desc.groups): Embree instances
+    // only the meshes, so each instance places its own copies of the spheres (read_shape.cpp).
+    std::vector<std::vector<SphereDesc>> group_spheres;
 
     uint32_t add_material(const Material& m) {
         desc.materials.push_back(m);

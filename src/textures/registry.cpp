@@ -1,5 +1,6 @@
 #include "textures/registry.hpp"
 
+#include <cmath>
 #include <filesystem>
 
 #include <fmt/format.h>
@@ -84,6 +85,27 @@ Texture read_rawconstant(Properties& p, const TextureContext&) {
     return Texture(ConstantTexture{Rgb(v.x, v.y, v.z)});
 }
 
+// Mitsuba 3's mesh_attribute: the value of the mesh's own attribute (a PLY's extra vertex or
+// face property) at the hit; which mesh is known only when a shape uses the material, so the
+// shape's reader checks the attribute (scenefile/read_shape.cpp).
+const PluginInfo& mesh_attribute_plugin() {
+    static const PluginInfo info{"texture", "mesh_attribute",
+                                 "the mesh's own attribute at the hit (a PLY's extra vertex property interpolated, or the face's): "
+                                 "values in [0, 1]",
+                                 {{"name", ParamType::String, "", "vertex_NAME or face_NAME, e.g. vertex_color (required)"},
+                                  {"scale", ParamType::Float, "1", "multiplies the attribute"}}};
+    return info;
+}
+Texture read_mesh_attribute(Properties& p, const TextureContext&) {
+    if (!p.has("name")) p.fail("<texture type=\"mesh_attribute\"> needs <string name=\"name\" value=\"vertex_color\"/> (or another attribute)");
+    const std::string name = p.get_string("name");
+    if (!name.starts_with("vertex_") && !name.starts_with("face_"))
+        p.fail("name", fmt::format("a mesh attribute's name starts with vertex_ or face_, not '{}'", name));
+    const float scale = p.get_float("scale");
+    if (!(scale >= 0) || !std::isfinite(scale)) p.fail("scale", fmt::format("scale must be finite and not negative, got {}", scale));
+    return Texture(MeshAttributeTexture{name, scale});
+}
+
 }  // namespace
 
 const std::vector<TexturePlugin>& texture_plugins() {
@@ -91,6 +113,7 @@ const std::vector<TexturePlugin>& texture_plugins() {
         {bitmap_plugin, read_bitmap},
         {checkerboard_plugin, read_checkerboard},
         {rawconstant_plugin, read_rawconstant},
+        {mesh_attribute_plugin, read_mesh_attribute},
     };
     return table;
 }

@@ -24,6 +24,7 @@
 #include "lights/envmap.hpp"
 #include "lights/ies.hpp"
 #include "lights/point.hpp"
+#include "lights/projector.hpp"
 #include "lights/sphere.hpp"
 #include "lights/spot.hpp"
 #include "lights/triangle.hpp"
@@ -31,7 +32,7 @@
 namespace pathlab {
 
 using Light = std::variant<PointLight, TriangleLight, SphereLight, EnvironmentLight, DirectionalLight, EnvMapLight, SpotLight,
-                           IesLight>;
+                           IesLight, ProjectorLight>;
 
 inline uint32_t light_flags(const Light& light) {
     return std::visit([](const auto& l) { return l.flags; }, light);

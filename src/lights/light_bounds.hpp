@@ -106,6 +106,10 @@ inline LightBounds light_bounds(const Light& light, const SceneSphere& sphere) {
         add(spot->position);
         b.w = spot->frame.n;
         b.set_angles(spot->cutoff, 0);
+    } else if (const auto* projector = std::get_if<ProjectorLight>(&light)) {
+        add(projector->position);
+        b.w = projector->axes.n;
+        b.set_angles(projector->half_angle(), 0);
     } else if (const auto* point = std::get_if<PointLight>(&light)) {
         add(point->position);
         b.set_angles(kPi, kPi / 2);

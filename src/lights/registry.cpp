@@ -21,6 +21,7 @@ const std::vector<EmitterPlugin>& emitter_plugins() {
         {point_plugin, free_light<PointLight, read_point_light>},
         {spot_plugin, free_light_with_files<SpotLight, read_spot_light>},
         {ies_plugin, free_light_with_files<IesLight, read_ies_light>},
+        {projector_plugin, free_light_with_files<ProjectorLight, read_projector_light>},
         {constant_plugin, free_light<EnvironmentLight, read_constant_light>},
         {envmap_plugin, free_light_with_files<EnvMapLight, read_envmap_light>},
         {directional_plugin, free_light<DirectionalLight, read_directional_light>},

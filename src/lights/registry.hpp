@@ -15,7 +15,7 @@
 namespace pathlab {
 
 // Lights that are not attached to geometry (area emitters come from a shape's emission).
-using FreeLight = std::variant<PointLight, EnvironmentLight, DirectionalLight, EnvMapLight, SpotLight, IesLight>;
+using FreeLight = std::variant<PointLight, EnvironmentLight, DirectionalLight, EnvMapLight, SpotLight, IesLight, ProjectorLight>;
 
 struct EmitterPlugin {
     const PluginInfo& (*info)();

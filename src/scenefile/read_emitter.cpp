@@ -26,22 +26,25 @@ std::shared_ptr<const EmissionSpectrum> emitter_spectrum(Properties& p) {
 void read_free_emitter(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b) {
     xml.check_attributes(n, {"type", "id", "name"});
     const std::string type = xml.attr(n, "type");
-    // Mitsuba 3's spot takes a projected texture: a nested <texture name="texture"> or a <ref> to one.
+    // Mitsuba 3's spot takes a projected texture (a nested <texture name="texture"> or a <ref> to
+    // one), its projector an image (<texture name="irradiance">).
     std::shared_ptr<const Texture> texture;
+    const char* slot = type == "spot" ? "texture" : type == "projector" ? "irradiance" : nullptr;
+    const char* what = type == "spot" ? "projected texture" : "image";
     for (const pugi::xml_node& c : xml.plugin_children(n)) {
         const bool is_texture = std::string(c.name()) == "texture" || std::string(c.name()) == "ref";
-        if (type != "spot" || !is_texture)
-            xml.fail(c, type == "spot" ? "a spot emitter's only nested plugin is its <texture name=\"texture\">"
-                                       : "an <emitter> has no nested plugins");
-        if (std::string(c.attribute("name").value()) != "texture")
-            xml.fail(c, "a spot's projected texture must be named \"texture\" (<texture name=\"texture\" ...>)");
-        if (texture) xml.fail(c, "a spot takes one projected texture");
+        if (!slot || !is_texture)
+            xml.fail(c, slot ? fmt::format("a {} emitter's only nested plugin is its <texture name=\"{}\">", type, slot)
+                             : std::string("an <emitter> has no nested plugins"));
+        if (std::string(c.attribute("name").value()) != slot)
+            xml.fail(c, fmt::format("a {}'s {} must be named \"{}\" (<texture name=\"{}\" ...>)", type, what, slot, slot));
+        if (texture) xml.fail(c, fmt::format("a {} takes one {}", type, what));
         texture = texture_child(xml, c, b);
     }
     const EmitterPlugin* plugin = find_emitter_plugin(type);
     if (plugin && !plugin->read) xml.fail(n, "an area emitter belongs inside a <shape>");
     if (!plugin)
-        xml.fail(n, fmt::format("unsupported emitter type '{}'; supported: point, spot, ies, constant, envmap, directional (and "
+        xml.fail(n, fmt::format("unsupported emitter type '{}'; supported: point, spot, projector, ies, constant, envmap, directional (and "
                                 "area inside a shape)",
                                 type));
     Properties p = xml.properties(n, plugin->info());

@@ -104,7 +104,7 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
     app.add_option_function<int>("--rr-depth", [&o](const int& v) { o.rr_depth = v, o.rr_depth_given = true; },
                                  "Bounces before Russian roulette starts (default: the scene file's, else 3)");
     app.add_option("--light-sampler", o.light_sampler,
-                   "How next-event estimation chooses a light: uniform, power (default: in proportion to power), bvh (a "
+                   "How next-event estimation chooses a light: uniform (every emitter alike, a mesh's triangles by area), power (default: in proportion to power), bvh (a "
                    "light tree, by each light's bound at the shading point: for many lights) or ris (bvh's choices as "
                    "candidates, one kept by its unshadowed contribution); for the integrators that sample lights at their "
                    "shading points (pathlab algorithms)");

@@ -1,5 +1,6 @@
 // The light-selection distribution: a light is chosen with probability proportional to its
-// power (uniformly if all are 0), by the same rule for next-event estimation and light paths.
+// power (uniformly if all are 0), by the same rule for next-event estimation and light paths;
+// or to other weights (light_sampler.hpp's uniform choice of emitters).
 #pragma once
 
 #include <algorithm>
@@ -19,9 +20,14 @@ class LightDistribution {
 public:
     LightDistribution() = default;
     LightDistribution(const std::vector<Light>& lights, const SceneSphere& sphere) {
-        const size_t n = lights.size();
-        pmf_.resize(n);
-        for (size_t i = 0; i < n; ++i) pmf_[i] = std::max(0.0f, light_power(lights[i], sphere));
+        std::vector<float> power(lights.size());
+        for (size_t i = 0; i < lights.size(); ++i) power[i] = std::max(0.0f, light_power(lights[i], sphere));
+        *this = LightDistribution(std::move(power));
+    }
+    // Proportional to the given non-negative weights (uniformly if all are 0).
+    explicit LightDistribution(std::vector<float> weights) {
+        const size_t n = weights.size();
+        pmf_ = std::move(weights);
         const double total = std::accumulate(pmf_.begin(), pmf_.end(), 0.0);
         for (float& p : pmf_) p = total > 0 ? float(p / total) : 1.0f / float(n);
         cdf_.resize(n);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <map>
 
 namespace pathlab {
 
@@ -44,9 +45,26 @@ float split_cost(const LightBounds& b) {
 
 }  // namespace
 
-LightSampler::LightSampler(const std::vector<Light>& lights, const SceneSphere& sphere, LightSamplerKind kind, int candidates)
+LightSampler::LightSampler(const std::vector<Light>& lights, const SceneSphere& sphere, LightSamplerKind kind, int candidates,
+                           const std::vector<int>& emitter_of)
     : kind_(kind), count_(int(lights.size())), candidates_(kind == LightSamplerKind::Ris ? candidates : 1) {
     if (kind_ == LightSamplerKind::Power) power_ = LightDistribution(lights, sphere);
+    if (kind_ == LightSamplerKind::Uniform) {
+        // 1 / (the number of emitters) each, shared among an emitter's lights by their areas.
+        const auto emitter = [&](size_t i) { return emitter_of.empty() ? int(i) : emitter_of[i]; };
+        const auto area = [&](size_t i) {
+            const auto* t = std::get_if<TriangleLight>(&lights[i]);
+            return t ? double(t->area) : 1.0;
+        };
+        std::map<int, double> emitter_area;
+        for (size_t i = 0; i < lights.size(); ++i) emitter_area[emitter(i)] += area(i);
+        std::vector<float> weights(lights.size());
+        for (size_t i = 0; i < lights.size(); ++i) {
+            const double total = emitter_area[emitter(i)];
+            weights[i] = total > 0 ? float(area(i) / total) : 0.0f;
+        }
+        uniform_ = LightDistribution(std::move(weights));
+    }
     if (kind_ != LightSamplerKind::Bvh && kind_ != LightSamplerKind::Ris) return;
     std::vector<Item> items;
     trails_.assign(lights.size(), {});
@@ -145,7 +163,7 @@ LightChoice LightSampler::choose(const Vec3f& p, const Vec3f& n, float u) const 
     if (count_ == 0) return {};
     switch (kind_) {
         case LightSamplerKind::Power: return power_.choose(u);
-        case LightSamplerKind::Uniform: return {std::min(int(u * float(count_)), count_ - 1), 1.0f / float(count_)};
+        case LightSamplerKind::Uniform: return uniform_.choose(u);
         case LightSamplerKind::Bvh:
         case LightSamplerKind::Ris: break;
     }
@@ -177,7 +195,7 @@ float LightSampler::pmf(const Vec3f& p, const Vec3f& n, int light) const {
     if (light < 0 || light >= count_) return 0.0f;
     switch (kind_) {
         case LightSamplerKind::Power: return power_.pmf(light);
-        case LightSamplerKind::Uniform: return 1.0f / float(count_);
+        case LightSamplerKind::Uniform: return uniform_.pmf(light);
         case LightSamplerKind::Bvh:
         case LightSamplerKind::Ris: break;
     }

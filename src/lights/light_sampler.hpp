@@ -1,5 +1,6 @@
 // Choosing the light that next-event estimation samples at a point (--light-sampler):
-//   uniform  every light with the same probability
+//   uniform  every emitter with the same probability, an emitting mesh's triangles by their areas
+//            (Mitsuba 3's choice: a mesh lamp is one emitter, however many triangles it has)
 //   power    in proportion to its power (light_distribution.hpp; light paths always start so)
 //   bvh      down a bounding volume hierarchy over the lights at finite positions, each step
 //            choosing a child in proportion to its importance at the point (light_bounds.hpp),
@@ -34,8 +35,10 @@ inline constexpr int kMaxRisCandidates = 64;
 class LightSampler {
 public:
     LightSampler() = default;
+    // emitter_of[i]: the emitter light i belongs to (an emitting mesh is one emitter of many
+    // triangle lights); empty: every light is its own.
     LightSampler(const std::vector<Light>& lights, const SceneSphere& sphere, LightSamplerKind kind,
-                 int candidates = kDefaultRisCandidates);
+                 int candidates = kDefaultRisCandidates, const std::vector<int>& emitter_of = {});
 
     LightSamplerKind kind() const { return kind_; }
     // The light samples next-event estimation draws to keep one (ris); 1 for the other kinds.
@@ -70,7 +73,8 @@ private:
     LightSamplerKind kind_ = LightSamplerKind::Power;
     int count_ = 0;
     int candidates_ = 1;
-    LightDistribution power_;
+    LightDistribution power_;    // power: by power
+    LightDistribution uniform_;  // uniform: every emitter alike, an emitting mesh's triangles by area (Mitsuba 3's choice)
     std::vector<Node> nodes_;
     std::vector<Trail> trails_;  // by light
     std::vector<int> infinite_;  // the lights at infinity

@@ -490,7 +490,8 @@ TEST(SpectralDispersion, PrismMinimumDeviationMatchesClosedForm) {
 // (src/bsdfs/ior.hpp). The two are different reductions of different data: the registry
 // averages Palik's eta and k per channel (averaging eta and k is not averaging R, and gold's
 // spectral yellow lies outside sRGB: its red comes out above 1), here Johnson and Christy's
-// (Au, Ag, Cu, Cr) and Rakic's (Al) R is integrated. What must agree is how bright each metal is
+// (Au, Ag, Cu, Cr) and Rakic's (Al) R is integrated (a-C's registry colours are its own measured eta
+// and k through the observer, as Mitsuba 3 makes them: again not R's average). What must agree is how bright each metal is
 // and its hue: the luminance (Rec. 709 weights) within 0.05, and the channel order of the
 // coloured metals (Au, Cu: red > green > blue). Cr is the exception in brightness: Johnson and
 // Christy measured evaporated films, 10 points less reflective than Palik's bulk data (R at
@@ -498,7 +499,7 @@ TEST(SpectralDispersion, PrismMinimumDeviationMatchesClosedForm) {
 // of 0.06 failed for Au (green 0.074), Ag (blue 0.071) and Cr (0.14); the measured figures are
 // in docs/spectral.md. A transcription error (a swapped column, um for nm) moves R by far more.
 TEST(SpectralMetals, ReflectanceColoursAgreeWithTheRgbRegistry) {
-    for (const char* name : {"Au", "Ag", "Cu", "Al", "Cr"}) {
+    for (const char* name : {"Au", "Ag", "Cu", "Al", "Cr", "a-C"}) {
         const MeasuredConductor* m = measured_conductor(name);
         ASSERT_NE(m, nullptr) << name;
         EXPECT_LT(m->eta.wavelengths.front(), 360);

@@ -202,7 +202,7 @@ TEST(SpectralMaterials, NamedMetalsUseTheirMeasuredIndices) {
   <shape type="sphere"><ref id="smooth"/></shape>
   <shape type="sphere"><ref id="rough"/><point name="center" x="3" y="0" z="0"/></shape>
 </scene>)";
-    for (const char* metal : {"Au", "Ag", "Cu", "Al", "Cr"}) {
+    for (const char* metal : {"Au", "Ag", "Cu", "Al", "Cr", "a-C"}) {
         const SceneDescription d = load_scene_text(text, "metals.xml", ".", {{"metal", metal}});
         const MeasuredConductor* data = measured_conductor(metal);
         ASSERT_EQ(std::get<ConductorMaterial>(d.materials[0].model).measured, data) << metal;
@@ -279,7 +279,7 @@ TEST(SpectralMaterials, HeroOnlyRoughGlassAgreesWithTheConstantIndex) {
   <default name="mode" value="spectral"/>
   <sensor type="perspective"><float name="fov" value="25"/>
     <transform name="to_world"><lookat origin="0, 1, 5" target="0, 0, 0" up="0, 1, 0"/></transform>
-    <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/></film>
+    <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/><rfilter type="box"/></film>
   </sensor>
   <emitter type="constant"><rgb name="radiance" value="0.3, 0.5, 0.9"/></emitter>
   <shape type="sphere"><point name="center" x="0" y="3" z="1"/><float name="radius" value="0.5"/>
@@ -314,7 +314,7 @@ TEST(SpectralMaterials, ReflectanceSpectraAreUsedAsGiven) {
   <default name="mode" value="spectral"/>
   <sensor type="perspective"><float name="fov" value="10"/>
     <transform name="to_world"><lookat origin="0, 0, 5" target="0, 0, 0" up="0, 1, 0"/></transform>
-    <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/></film>
+    <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/><rfilter type="box"/></film>
   </sensor>
   <emitter type="constant"><blackbody name="radiance" temperature="2000K" scale="0.2"/></emitter>
   <shape type="sphere"><float name="radius" value="1"/>
@@ -376,7 +376,7 @@ TEST(SpectralMaterials, GreyPlasticsAgreeWithRgbMode) {
     const std::string text = R"(<scene version="3.0.0">
   <sensor type="perspective"><float name="fov" value="20"/>
     <transform name="to_world"><lookat origin="0, 0, 5" target="0, 0, 0" up="0, 1, 0"/></transform>
-    <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/></film>
+    <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/><rfilter type="box"/></film>
   </sensor>
   <emitter type="constant"><rgb name="radiance" value="1"/></emitter>
   <shape type="sphere"><point name="center" x="2" y="2" z="1"/><float name="radius" value="0.5"/>

@@ -2,7 +2,7 @@
 // conductor (complex index of refraction, per RGB channel).
 //
 // XML (Mitsuba 3 names; Mitsuba 0.6 camelCase spellings accepted):
-//   material              string  a metal by name: none, Au, Ag, Cu, Al, Cr        default none
+//   material              string  a metal by name: none, Au, Ag, Cu, Al, Cr, a-C   default none
 //   eta, k                rgb     complex index of refraction, instead of material default 0, 1
 //   specular_reflectance  rgb     scales the reflectance (not physical)            default 1
 // material="none" (eta = 0, k = 1) reflects everything at every angle: a perfect mirror.

@@ -28,7 +28,7 @@ inline const std::map<std::string, float>& named_iors() {
 struct ComplexIor {
     Rgb eta, k;
     // Spectral mode's eta(lambda) and k(lambda) of a metal given by name (spectral/metals.hpp:
-    // Au, Ag, Cu, Al, Cr), null otherwise; RGB mode uses eta and k.
+    // Au, Ag, Cu, Al, Cr, a-C), null otherwise; RGB mode uses eta and k.
     const MeasuredConductor* measured = nullptr;
 };
 
@@ -43,9 +43,19 @@ inline std::optional<ComplexIor> named_conductor(const std::string& name) {
     if (name == "Cu") return ComplexIor{{0.2004377f, 0.9240334f, 1.1022120f}, {3.9129485f, 2.4528477f, 2.1421880f}};
     if (name == "Al") return ComplexIor{{1.6574600f, 0.8803690f, 0.5212287f}, {9.2238692f, 6.2695232f, 4.8370012f}};
     if (name == "Cr") return ComplexIor{{4.3696829f, 2.9167025f, 1.6547005f}, {5.2064338f, 4.2313645f, 3.7549468f}};
+    // Metals known by their measurements only (a-C): the measured spectra's colours, as Mitsuba 3
+    // makes a named conductor's RGB (mitsuba3 include/mitsuba/render/ior.h: the spectrum through
+    // the CIE observer, no illuminant, unbounded).
+    if (const MeasuredConductor* m = measured_conductor(name)) {
+        const auto rgb = [](const SampledSpectrum& s) {
+            const Vec3d c = spectrum_to_linear_srgb(s, SpectrumUse::Unbounded);
+            return Rgb(float(c.x), float(c.y), float(c.z));
+        };
+        return ComplexIor{rgb(m->eta), rgb(m->k)};
+    }
     return std::nullopt;
 }
-inline const char* kNamedConductors = "none, Au, Ag, Cu, Al, Cr";
+inline const char* kNamedConductors = "none, Au, Ag, Cu, Al, Cr, a-C";
 
 
 // A dielectric's index from parameter `name`: a number in [1, 10) or a name of named_iors().
@@ -78,7 +88,7 @@ inline ComplexIor read_conductor_ior(Properties& p) {
 }
 
 inline const ParamInfo kConductorMaterialParam{"material", ParamType::String, "none",
-                                               "a metal by name: none (a perfect mirror, eta = 0, k = 1), Au, Ag, Cu, Al, Cr"};
+                                               "a metal by name: none (a perfect mirror, eta = 0, k = 1), Au, Ag, Cu, Al, Cr, a-C (amorphous carbon)"};
 inline const ParamInfo kConductorEtaParam{"eta", ParamType::Rgb, "0", "complex index of refraction, real part (instead of material)"};
 inline const ParamInfo kConductorKParam{"k", ParamType::Rgb, "1", "complex index of refraction, imaginary part"};
 inline const std::string kIorNames =

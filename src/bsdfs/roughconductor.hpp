@@ -6,7 +6,7 @@
 //   distribution          string  ggx or beckmann                                  default beckmann
 //   alpha                 float   roughness (isotropic)                            default 0.1
 //   alpha_u, alpha_v      float   anisotropic roughness along the tangent and bitangent (instead of alpha)
-//   material              string  a metal by name: none, Au, Ag, Cu, Al, Cr        default none
+//   material              string  a metal by name: none, Au, Ag, Cu, Al, Cr, a-C   default none
 //   eta, k                rgb     complex index of refraction, instead of material default 0, 1
 //   specular_reflectance  rgb     R, scales the reflectance (not physical)         default 1
 //   sample_visible        boolean accepted for compatibility; visible normals are always sampled

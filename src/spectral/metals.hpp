@@ -8,6 +8,8 @@
 //               Cr, Mn, Fe, Co, Ni, and Pd", Phys. Rev. B 9, 5056-5070 (1974)
 //   Al          A. D. Rakic, "Algorithm for the determination of intrinsic optical constants of
 //               metal films: application to aluminum", Appl. Opt. 34, 4755-4767 (1995)
+//   a-C         amorphous carbon: LLNL CXRO, D. L. Windt et al., Appl. Opt. 27, 246 (1988) and
+//               Palik's handbook, as compiled by luxpop.com (Mitsuba 3 names it so)
 // Only the measurements from just below 360 nm to just above 830 nm are kept.
 #pragma once
 
@@ -23,8 +25,8 @@ struct MeasuredConductor {
     SampledSpectrum eta, k;
 };
 
-// Au, Ag, Cu, Al or Cr; nullptr for another name.
+// Au, Ag, Cu, Al, Cr or a-C; nullptr for another name.
 const MeasuredConductor* measured_conductor(const std::string& name);
-inline const char* kMeasuredConductors = "Au, Ag, Cu, Al, Cr";
+inline const char* kMeasuredConductors = "Au, Ag, Cu, Al, Cr, a-C";
 
 }  // namespace pathlab

@@ -9,16 +9,32 @@
 # channel in XYZ, Sidak-corrected alpha 0.01, pass when 99.75% of the pixel-channels pass).
 # One line per scene, then a summary; the renders are kept in OUT (default: a temporary folder).
 #
-# Usage: scripts/mitsuba-suite.sh DIR [OUT] [-- extra pathlab options, e.g. --threads 2]
+# The z-test divides by the variance of Mitsuba's estimator, so an unbiased estimator that is
+# noisier fails it. By default the scenes are rendered with Mitsuba 3's estimator choices where
+# pathlab's differ: lights chosen uniformly (--light-sampler uniform; pathlab's default picks
+# them by power) and the power heuristic (--mis power) in path, direct and volpath, as Mitsuba's
+# path tracers weigh their samples. --pathlab-defaults renders with pathlab's own defaults
+# instead (the same expected image, other variances).
+#
+# Usage: scripts/mitsuba-suite.sh DIR [OUT] [--pathlab-defaults] [-- extra pathlab options, e.g. --threads 2]
 set -u
+usage="usage: $0 MITSUBA_DATA_DIR [OUT] [--pathlab-defaults] [-- pathlab options]  (MITSUBA_DATA_DIR/tests/scenes must exist)"
 if [ $# -lt 1 ] || [ ! -d "$1/tests/scenes" ]; then
-    echo "usage: $0 MITSUBA_DATA_DIR [OUT] [-- pathlab options]  (MITSUBA_DATA_DIR/tests/scenes must exist)" >&2
+    echo "$usage" >&2
     exit 2
 fi
 data=$(cd "$1" && pwd)
 shift
 out=""
-if [ $# -gt 0 ] && [ "$1" != "--" ]; then out=$1; shift; fi
+as_mitsuba=1
+while [ $# -gt 0 ] && [ "$1" != "--" ]; do
+    case "$1" in
+        --pathlab-defaults) as_mitsuba=0 ;;
+        -*) echo "$0: unknown option '$1'" >&2; echo "$usage" >&2; exit 2 ;;
+        *) [ -z "$out" ] || { echo "$usage" >&2; exit 2; }; out=$1 ;;
+    esac
+    shift
+done
 [ $# -gt 0 ] && [ "$1" = "--" ] && shift
 here=$(cd "$(dirname "$0")/.." && pwd)
 pathlab=${PATHLAB:-$here/build/pathlab}
@@ -27,6 +43,11 @@ pathlab=${PATHLAB:-$here/build/pathlab}
 mkdir -p "$out"
 
 pass=0 fail=0 broken=0 skipped=0
+if [ $as_mitsuba -eq 1 ]; then
+    echo "estimators: Mitsuba 3's choices (lights chosen uniformly, the power heuristic; --pathlab-defaults for pathlab's)"
+else
+    echo "estimators: pathlab's defaults"
+fi
 printf '%-58s %-14s %s\n' "scene" "result" "detail"
 for scene in "$data"/tests/scenes/*/*.xml; do
     folder=$(dirname "$scene")
@@ -46,7 +67,13 @@ for scene in "$data"/tests/scenes/*/*.xml; do
     spp=$((2000000 / (w * h)))
     img=$out/$(basename "$folder")-$name.exr
     start=$(date +%s.%N)
-    if ! err=$("$pathlab" "$scene" -D "integrator=$integrator" --spp "$spp" --seed 0 -q -o "$img" "$@" 2>&1 >/dev/null); then
+    choices=()
+    if [ $as_mitsuba -eq 1 ]; then
+        case "$integrator" in
+            path | direct | volpath | volpathmis) choices=(--light-sampler uniform --mis power) ;;
+        esac
+    fi
+    if ! err=$("$pathlab" "$scene" -D "integrator=$integrator" --spp "$spp" --seed 0 -q -o "$img" "${choices[@]}" "$@" 2>&1 >/dev/null); then
         printf '%-58s %-14s %s\n' "$label" "CANNOT RENDER" "$(printf '%s' "$err" | grep -m1 -i 'error' | sed "s|$data/||g")"
         broken=$((broken + 1))
         continue

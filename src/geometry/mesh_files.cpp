@@ -401,7 +401,10 @@ MeshAttributes read_ply_attributes(const std::string& path, const PlyLayout& lay
                 }
                 const uint64_t n = count(p);
                 std::vector<uint32_t> list;
-                for (uint64_t j = 0; j < n; ++j) list.push_back(uint32_t(value(p)));
+                for (uint64_t j = 0; j < n; ++j) {
+                    const double v = value(p);  // (an index out of range is refused below)
+                    list.push_back(v >= 0 && v < 4294967295.0 ? uint32_t(v) : 0xffffffffu);
+                }
                 if (is_face && (p.name == "vertex_indices" || p.name == "vertex_index")) polygons.push_back(std::move(list));
             }
     }
@@ -415,6 +418,9 @@ MeshAttributes read_ply_attributes(const std::string& path, const PlyLayout& lay
         };
         for (size_t f = 0; f < polygons.size(); ++f) {
             const std::vector<uint32_t>& poly = polygons[f];
+            for (const uint32_t v : poly)
+                if (v >= vertex->count)
+                    throw MeshLoadError(fmt::format("mesh '{}': face {} refers to vertex {}, and the file has {}", path, f + 1, v, vertex->count));
             for (size_t i = 1; i + 1 < poly.size(); ++i)
                 for (const uint32_t corner : {poly[0], poly[i], poly[i + 1]}) {
                     for (size_t c = 0; c < g.properties.size(); ++c) a.values.push_back(per_face ? channel(c, f) : channel(c, corner));

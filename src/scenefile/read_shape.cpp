@@ -24,7 +24,6 @@ const PluginInfo& instance_plugin() {
     return info;
 }
 
-// `group`: the shape belongs to a shapegroup (its mesh goes there).
 // `group`: the shape belongs to a shapegroup (its mesh goes there; a sphere to `group_spheres`).
 void read_shape_into(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b, std::vector<MeshDesc>* group,
                      std::vector<SphereDesc>* group_spheres = nullptr);

@@ -285,7 +285,7 @@ TEST_F(Hostile, CorruptedVdbFilesLoadOrFailCleanly) {
             // OpenVDB's own files of other forms (half floats, zip, vec3s, several grids and an
             // instance, tiles): changed at random, cut anywhere.
             std::vector<std::string> grids(cases.size(), "");
-            for (const std::string& name : {"half", "zip", "raw", "multi", "tiles"}) {
+            for (const std::string name : {"half", "zip", "raw", "multi", "tiles"}) {
                 std::ifstream fixture(path(name + std::string(".vdb")), std::ios::binary);
                 const std::string bytes((std::istreambuf_iterator<char>(fixture)), std::istreambuf_iterator<char>());
                 if (bytes.empty()) throw std::runtime_error("no fixture " + std::string(name));

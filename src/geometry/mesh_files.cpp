@@ -137,6 +137,13 @@ private:
     size_t at_ = 0, end_ = 0;
 };
 
+// n bytes of a binary PLY integer, in little-endian order, as an unsigned number.
+uint64_t ply_unsigned(const unsigned char* b, size_t n) {
+    uint64_t u = 0;
+    for (size_t k = 0; k < n; ++k) u |= uint64_t(b[k]) << (8 * k);
+    return u;
+}
+
 PlyLayout check_ply_file(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
     if (!in) throw MeshLoadError(fmt::format("cannot read mesh '{}'", path));
@@ -251,10 +258,8 @@ PlyLayout check_ply_file(const std::string& path) {
                     unsigned char b[8] = {};
                     if (!reader.bytes(b, p.count_size)) throw ends("");
                     if (big_endian) std::reverse(b, b + p.count_size);
-                    uint64_t u = 0;
-                    for (size_t k = 0; k < p.count_size; ++k) u |= uint64_t(b[k]) << (8 * k);
                     const bool negative = p.count_signed && (b[p.count_size - 1] & 0x80);
-                    n = negative ? -1 : int64_t(u);
+                    n = negative ? -1 : int64_t(ply_unsigned(b, p.count_size));
                 } else {
                     if (!reader.word(word)) throw ends("");
                     if (word.empty() || word.size() > 12 || word.find_first_not_of("0123456789") != std::string::npos)
@@ -380,9 +385,7 @@ MeshAttributes read_ply_attributes(const std::string& path, const PlyLayout& lay
         unsigned char b[8] = {};
         reader.bytes(b, p.count_size);
         if (layout.big_endian) std::reverse(b, b + p.count_size);
-        uint64_t u = 0;
-        for (size_t k = 0; k < p.count_size; ++k) u |= uint64_t(b[k]) << (8 * k);
-        return u;
+        return ply_unsigned(b, p.count_size);
     };
     // Every element's values, kept for the vertex and face elements (check_ply_file walked the
     // same body, so the counts and lists hold).

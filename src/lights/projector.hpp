@@ -102,7 +102,8 @@ inline ProjectorLight read_projector_light(Properties& p, const EmitterContext& 
     if (min_component(image->min_value()) < 0) p.fail("irradiance", "a projector's irradiance must not be negative");
     // The image's aspect: a bitmap's resolution, 1 for a constant or a pattern (Mitsuba's
     // resolution() of a texture without pixels).
-    if (const auto* b = std::get_if<BitmapTexture>(&image->model())) l.aspect = float(b->width()) / float(b->height());
+    const auto* bitmap = std::get_if<BitmapTexture>(&image->model());
+    if (bitmap) l.aspect = float(bitmap->width()) / float(bitmap->height());
     // The field of view along x (mitsuba3 src/core/util.cpp parse_fov): fov along fov_axis, or a
     // focal length on a 36 x 24 mm film, whose diagonal it spans.
     double tan_axis, axis_over_x;
@@ -142,8 +143,7 @@ inline ProjectorLight read_projector_light(Properties& p, const EmitterContext& 
     l.scale = float(s * uniform_scale * uniform_scale);
     l.irradiance = std::move(image);
     // The image's mean: its texels' for a bitmap (a midpoint rule at 4 x its resolution), the value for the rest.
-    const int nx = std::get_if<BitmapTexture>(&l.irradiance->model()) ? 4 * std::get_if<BitmapTexture>(&l.irradiance->model())->width() : 16;
-    const int ny = std::get_if<BitmapTexture>(&l.irradiance->model()) ? 4 * std::get_if<BitmapTexture>(&l.irradiance->model())->height() : 16;
+    const int nx = bitmap ? 4 * bitmap->width() : 16, ny = bitmap ? 4 * bitmap->height() : 16;
     Vec3d sum(0.0);
     for (int y = 0; y < ny; ++y)
         for (int x = 0; x < nx; ++x) sum += Vec3d(l.irradiance->eval(SurfaceUv((x + 0.5f) / float(nx), (y + 0.5f) / float(ny))));

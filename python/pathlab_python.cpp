@@ -110,7 +110,7 @@ std::shared_ptr<PyScene> py_load(const py::object& what, const std::map<std::str
         spec = py::str(what.attr("__fspath__")()).cast<std::string>();
     } else {
         throw py::type_error(fmt::format("scene must be a course index (int 0-7), a scene name or a scene file (str or path), not {}; "
-                                         "valid scenes: {}, or a scene file ending in .xml",
+                                         "valid scenes: {}, or a scene file ending in .xml (or a glTF scene: .gltf, .glb)",
                                          type_name(what), scene_names()));
     }
     if (spec.empty() || spec == "all" || spec.find(',') != std::string::npos)

@@ -10,7 +10,7 @@ packages=(
   build-essential cmake pkg-config
   libembree-dev libtbb-dev libopenexr-dev libstb-dev
   libcli11-dev libfmt-dev nlohmann-json3-dev libpugixml-dev libtinyobjloader-dev libnanoflann-dev
-  libopenvdb-dev libassimp-dev zlib1g-dev
+  libopenvdb-dev libassimp-dev libtinygltf-dev zlib1g-dev
   libgtest-dev libbenchmark-dev
   libopenmpi-dev openmpi-bin libxxhash-dev
   pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib

@@ -133,9 +133,10 @@ def test_load_takes_indices_names_and_files_with_defines():
     ("3", "ic", ["--ic-rays", "16", "--ic-error", "0.5", "--ic-no-gradients"]),
     ("3", "pbgi", ["--pbgi-surfels", "400", "--pbgi-bounces", "1", "--pbgi-cutoff", "0.1"]),
     ("scenes/fog-box.xml", "pm", ["--volume-estimate", "points", "--photons", "200"]),
+    ("scenes/gltf/room.glb", "pt-mis", []),  # a glTF scene
 ])
 def test_render_equals_the_command_line_bit_for_bit(tmp_path, scene, algorithm, extra):
-    path = os.path.join(SOURCE, scene) if scene.endswith(".xml") else scene
+    path = os.path.join(SOURCE, scene) if scene.endswith((".xml", ".glb")) else scene
     out = tmp_path / "cli.exr"
     cli(path, "-a", algorithm, "--spp", 3, "--seed", 77, "--resolution", "20x14", "-q", "-o", out, *extra)
     defines = dict([extra[1].split("=")]) if extra[:1] == ["-D"] else {}
@@ -394,7 +395,7 @@ def test_renders_of_disjoint_ranges_merge_into_the_one_shot_render(tmp_path):
     ("scenes/example.xml", "sppm", {"spp": "2"}, {"photons": 300, "radius": 0.05, "spectral": True}),
 ])
 def test_the_command_line_continues_a_python_checkpoint(tmp_path, scene, algorithm, defines, options):
-    path = os.path.join(SOURCE, scene) if scene.endswith(".xml") else scene
+    path = os.path.join(SOURCE, scene) if scene.endswith((".xml", ".glb")) else scene
     flags = [w for k, v in options.items() for w in (["--" + k] if v is True else ["--" + k, v])]
     cli(path, "-a", algorithm, *[w for k, v in defines.items() for w in ("-D", f"{k}={v}")], *flags, "--spp", 9, *SMALL_CLI,
         "-o", tmp_path / "whole.exr")

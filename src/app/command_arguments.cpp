@@ -76,10 +76,10 @@ const char* const kInterruptHelp =
 
 void add_scene_arguments(CLI::App& app, SceneArguments& a) {
     app.add_option("scene", a.positional,
-                   "Scene(s): course index 0-7, name or acronym (see `pathlab scenes`), a scene file (.xml), 'all', or several "
+                   "Scene(s): course index 0-7, name or acronym (see `pathlab scenes`), a scene file (.xml, or glTF: .gltf .glb), 'all', or several "
                    "(also comma-separated)");
     app.add_option("-s,--scene", a.option,
-                   "The same as an option: course index, name, scene file (.xml), a comma-separated list, or 'all'");
+                   "The same as an option: course index, name, scene file (.xml, .gltf, .glb), a comma-separated list, or 'all'");
     app.add_option("-D,--define", a.defines, "name=value for $name in scene files (repeatable; overrides <default>; a name no scene uses is an error)");
 }
 
@@ -104,7 +104,7 @@ std::vector<SceneChoice> resolve_scene_arguments(const SceneArguments& a, const 
     const std::string spec = given.empty() ? fallback : given;
     if (spec.empty())
         throw UsageError("no scene given: pathlab SCENE [options], where SCENE is a course index 0-7, a name (see `pathlab "
-                         "scenes`), a scene file (.xml), a comma-separated list, or 'all'");
+                         "scenes`), a scene file (.xml, or glTF: .gltf .glb), a comma-separated list, or 'all'");
     return resolve_scenes(spec, parse_defines(a.defines));
 }
 

@@ -17,11 +17,14 @@
 #include "job/output_paths.hpp"
 #include "job/render_identity.hpp"
 #include "job/usage_error.hpp"
+#include "scenefile/gltf_scene.hpp"
 
 namespace pathlab {
 namespace {
 
 bool is_png(const std::string& path) { return image_format_for(path) == ImageFormat::Png; }
+
+bool ends_with_xml(const std::string& path) { return std::filesystem::path(path).extension() == ".xml"; }
 
 // Any supported image as linear RGB (a PNG's sRGB values decoded); unreadable files are
 // UsageErrors naming them.
@@ -41,15 +44,33 @@ struct ChannelSummary {
 }  // namespace
 
 CLI::App* add_convert_command(CLI::App& app, ConvertOptions& o) {
-    CLI::App* cmd = app.add_subcommand("convert", "Convert an image between .exr .hdr .pfm .png, with an exposure and a crop");
-    cmd->add_option("IN", o.input, "Input image (.exr, .hdr, .pfm, or .png: its sRGB values are decoded to linear)")->required();
-    cmd->add_option("OUT", o.output, "Output image; format by extension (.png: sRGB, 8 bits)")->required();
+    CLI::App* cmd = app.add_subcommand(
+        "convert", "Convert an image between .exr .hdr .pfm .png, with an exposure and a crop; or a glTF scene (.gltf, .glb) to Mitsuba XML");
+    cmd->add_option("IN", o.input, "Input image (.exr, .hdr, .pfm, or .png: its sRGB values are decoded to linear), or a glTF scene")->required();
+    cmd->add_option("OUT", o.output,
+                    "Output image; format by extension (.png: sRGB, 8 bits). For a glTF scene, an .xml file (its meshes and images go in "
+                    "the folder OUT's-stem_files beside it)")
+        ->required();
     cmd->add_option("--exposure", o.exposure, "Scale the values by 2^E (stops), for every output format")->capture_default_str();
     cmd->add_option("--crop", o.crop, "Keep only X,Y,W,H (pixels from the top left)");
     return cmd;
 }
 
 int run_convert_command(const ConvertOptions& o) {
+    if (is_gltf_path(o.input)) {
+        if (!o.crop.empty() || o.exposure != 0) throw UsageError("--crop and --exposure are for images, not for a glTF scene");
+        if (!ends_with_xml(o.output)) throw UsageError(fmt::format("{}: a glTF scene converts to a Mitsuba scene file ending in .xml", o.output));
+        OutputPaths paths;
+        paths.input(o.input, "the input");
+        paths.output(o.output, "the output", /*image=*/false);
+        try {
+            const GltfConversion c = convert_gltf_scene(o.input, o.output);
+            for (const std::string& w : c.warnings) fmt::print(stderr, "pathlab: warning: {}: {}\n", o.input, w);
+        } catch (const SceneFileError& e) {
+            throw UsageError(e.what());
+        }
+        return 0;
+    }
     if (!std::isfinite(o.exposure)) throw UsageError("--exposure must be a finite number of stops");
     std::optional<PixelRect> rect;
     if (!o.crop.empty()) rect = parse_crop_option(o.crop);

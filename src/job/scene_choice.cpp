@@ -13,12 +13,13 @@
 
 #include "core/input_file.hpp"
 #include "job/usage_error.hpp"
+#include "scenefile/gltf_scene.hpp"
 #include "scene/builtin_scenes.hpp"
 
 namespace pathlab {
 
 bool looks_like_scene_file(const std::string& key) {
-    return key.size() > 4 && key.compare(key.size() - 4, 4, ".xml") == 0;
+    return (key.size() > 4 && key.compare(key.size() - 4, 4, ".xml") == 0) || is_gltf_path(key);
 }
 
 SceneChoice builtin_scene_choice(int index) {
@@ -176,7 +177,7 @@ int builtin_scene_or_usage_error(const std::string& key, bool scene_files_allowe
     std::string valid;
     for (const BuiltinSceneInfo& s : builtin_scenes()) valid += fmt::format("\n  {} {}", s.index, s.name);
     throw UsageError(fmt::format("unknown scene '{}'. Valid scenes (index or name, comma-separated, or 'all'){}:{}", key,
-                                 scene_files_allowed ? ", or a scene file ending in .xml" : "", valid));
+                                 scene_files_allowed ? ", or a scene file ending in .xml (or a glTF scene: .gltf, .glb)" : "", valid));
 }
 
 std::vector<int> parse_builtin_scene_list(const std::string& spec) {

@@ -30,7 +30,7 @@ struct SceneChoice {
 // the files' names and folders do not count (a copied scene is the same scene).
 std::string scene_hash(const SceneChoice& scene);
 
-// True for a key that names a scene file (ends in .xml).
+// True for a key that names a scene file (ends in .xml, or .gltf or .glb: a glTF scene).
 bool looks_like_scene_file(const std::string& key);
 
 // "3", "ceiling-glossy", "ws_c_sdsgwdwg", "scenes/x.xml", "all" or a comma-separated list of

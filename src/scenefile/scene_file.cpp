@@ -1,4 +1,5 @@
 #include "scenefile/scene_file.hpp"
+#include "scenefile/gltf_scene.hpp"
 
 #include <cctype>
 #include <cerrno>
@@ -203,6 +204,7 @@ SceneDescription load_scene_text(const std::string& text, const std::string& fil
 }
 
 SceneDescription load_scene_file(const std::string& path, const SceneDefines& defines, SceneFileInputs* inputs) {
+    if (is_gltf_path(path)) return load_gltf_scene(path, defines, inputs);
     std::string text;
     try {
         text = read_input_file(path, Loader::kMaxIncludedBytes);  // as much as its includes may bring

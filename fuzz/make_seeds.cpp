@@ -2,7 +2,7 @@
 // links) can make itself: small images in every format and variant the readers know, and OBJ
 // meshes (OBJ, PLY, .serialized), voxel grids, spectrum files and a checkpoint. Usage:
 // fuzz_make_seeds DIR  (creates DIR/exr, DIR/hdr, DIR/pfm, DIR/png,
-// DIR/jpeg, DIR/obj, DIR/vol, DIR/vdb, DIR/ply, DIR/serialized, DIR/spd, DIR/checkpoint).
+// DIR/jpeg, DIR/bmp, DIR/obj, DIR/vol, DIR/vdb, DIR/ply, DIR/serialized, DIR/spd, DIR/checkpoint).
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
@@ -81,7 +81,7 @@ int main(int argc, char** argv) {
         return 2;
     }
     const fs::path dir = argv[1];
-    for (const char* sub : {"exr", "hdr", "pfm", "png", "jpeg", "obj", "vol", "vdb", "ply", "serialized", "spd", "checkpoint"})
+    for (const char* sub : {"exr", "hdr", "pfm", "png", "jpeg", "bmp", "obj", "vol", "vdb", "ply", "serialized", "spd", "checkpoint"})
         fs::create_directories(dir / sub);
 
     // pathlab's own writers, at sizes around the readers' special cases (HDR run-length
@@ -106,6 +106,10 @@ int main(int argc, char** argv) {
             stbi_write_jpg((stem + "-q" + std::to_string(q) + ".jpg").c_str(), w, h, 3, rgb.data(), q);
             stbi_write_jpg((stem + "-grey-q" + std::to_string(q) + ".jpg").c_str(), w, h, 1, grey.data(), q);
         }
+        // BMP (stb_image_write: 24 bits, bottom-up rows padded to 4 bytes; grey written as 24 bits too)
+        const std::string bmp = (dir / "bmp" / (std::to_string(w) + "x" + std::to_string(h))).string();
+        stbi_write_bmp((bmp + ".bmp").c_str(), w, h, 3, rgb.data());
+        stbi_write_bmp((bmp + "-grey.bmp").c_str(), w, h, 1, grey.data());
     }
 
     // EXR: every compression; tiled with mipmaps; half and grey channels.

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Fuzzes pathlab's readers of untrusted files with libFuzzer (clang, AddressSanitizer, UBSan).
-#   scripts/fuzz.sh TARGET [SECONDS]   TARGET: scene_xml, exr, hdr, pfm, png, jpeg, obj, vol, vdb, ies, ply,
+#   scripts/fuzz.sh TARGET [SECONDS]   TARGET: scene_xml, exr, hdr, pfm, png, jpeg, bmp, obj, vol, vdb, ies, ply,
 #                                      serialized, spd, checkpoint, or all
 #                                      (all: each target in turn for SECONDS); default 660 s
 #   scripts/fuzz.sh [SECONDS]          the scene-file loader, as before (scene_xml)
@@ -15,14 +15,14 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-all_targets=(scene_xml exr hdr pfm png jpeg obj vol vdb ies ply serialized spd checkpoint)
+all_targets=(scene_xml exr hdr pfm png jpeg bmp obj vol vdb ies ply serialized spd checkpoint)
 if [[ $# -eq 0 || $1 =~ ^[0-9]+$ ]]; then
     targets=(scene_xml)
     seconds=${1:-660}
 else
     case $1 in
         all) targets=("${all_targets[@]}") ;;
-        scene_xml | exr | hdr | pfm | png | jpeg | obj | vol | vdb | ies | ply | serialized | spd | checkpoint) targets=("$1") ;;
+        scene_xml | exr | hdr | pfm | png | jpeg | bmp | obj | vol | vdb | ies | ply | serialized | spd | checkpoint) targets=("$1") ;;
         *) echo "fuzz.sh: unknown target '$1' (valid: ${all_targets[*]}, all)" >&2; exit 2 ;;
     esac
     seconds=${2:-660}

@@ -113,8 +113,9 @@ TEST(AreaLight, PerspectiveCameraHittingTheLightBoxReturnItsRadiance) { expect_e
 
 TEST(AreaLight, EmitsOnItsNormalSideOnly) {
     const TriangleLight tri({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, Rgb(2.0f));  // normal +z
-    EXPECT_EQ(tri.emitted({0, 0, 1}), Rgb(2.0f));
-    EXPECT_EQ(tri.emitted(normalize(Vec3f(1, 1, -1))), Rgb(0.0f));
+    EXPECT_EQ(tri.radiance_at({0.3f, 0.3f}), Rgb(2.0f));
+    EXPECT_GT(tri.pdf_emission({0.2f, 0.2f, 0}, tri.normal, {0, 0, 1}, {}).pdfW, 0.0f);
+    EXPECT_EQ(tri.pdf_emission({0.2f, 0.2f, 0}, tri.normal, normalize(Vec3f(1, 1, -1)), {}).pdfW, 0.0f);
     EXPECT_FALSE(tri.sample_li({0.2f, 0.2f, -1.0f}, {0.3f, 0.3f}));  // behind it: nothing to sample
     EXPECT_TRUE(tri.sample_li({0.2f, 0.2f, 1.0f}, {0.3f, 0.3f}));
 }

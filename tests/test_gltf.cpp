@@ -227,6 +227,35 @@ TEST(Gltf, ABaseColourFactorTimesItsTextureIsBakedAsLinearValues) {
     EXPECT_NO_THROW(load_scene_file(dir.path + "/out.xml"));
 }
 
+TEST(Gltf, AnEmissiveTextureTimesItsFactorAndStrengthIsTheRadiance) {
+    // A textured emissive quad filling the view: each half of the image shows one texel, times
+    // emissiveFactor (0.5, 1, 1) times strength 2, of the texel's decoded sRGB value.
+    TempDir dir;
+    Image8 texels;
+    texels.width = 2, texels.height = 1;
+    texels.rgb = {200, 100, 50, 30, 90, 250};
+    write_png8(texels, dir.path + "/t.png");
+    std::ifstream in(dir.path + "/t.png", std::ios::binary);
+    const std::string png((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    Gltf g;
+    g.camera();
+    g.doc["images"] = {{{"mimeType", "image/png"}, {"bufferView", g.view(png)}}};
+    g.doc["samplers"] = {{{"magFilter", 9728}}};
+    g.doc["textures"] = {{{"source", 0}, {"sampler", 0}}};
+    g.doc["extensionsUsed"] = {"KHR_materials_emissive_strength"};
+    const int m = g.material({{"pbrMetallicRoughness", {{"baseColorFactor", {0, 0, 0, 1}}}},
+                              {"emissiveFactor", {0.5, 1, 1}},
+                              {"emissiveTexture", {{"index", 0}}},
+                              {"extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", 2}}}}}});
+    g.node({{"mesh", g.quad(-1.2f, 1.2f, 1.2f, -2, m)}});
+    const Image img = render_scene(load_scene_file(g.write(dir.path)), "pt-naive", 8, 8, 4, 1).film.mean();
+    const float k[3] = {1, 2, 2};
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x)
+            for (int c = 0; c < 3; ++c)
+                EXPECT_NEAR(img.at(x, y)[c], k[c] * decode_srgb8(texels.at(x < 4 ? 0 : 1, 0, c)), 1e-5) << x << "," << y << " channel " << c;
+}
+
 TEST(Gltf, TheShippedSceneRendersBitForBitAsItsConversionAndItsTextTwin) {
     TempDir dir;
     const std::string glb = kSource + "/scenes/gltf/room.glb", text = kSource + "/scenes/gltf/room.gltf";
@@ -289,8 +318,9 @@ TEST(Gltf, RefusesWhatItCannotRenderNamingTheFile) {
             g.doc["textures"] = {{{"source", 0}}};
             g.doc["images"] = {{{"mimeType", "image/png"}, {"bufferView", 0}}};
             g.doc["meshes"][0]["primitives"][0]["material"] = 0;
+            g.doc["meshes"][0]["primitives"][0]["attributes"].erase("TEXCOORD_0");
         },
-        "emissive texture");
+        "material 'glow' has an emissive texture but the primitive has no TEXCOORD_0");
     TempDir dir;
     std::ofstream(dir.path + "/broken.gltf") << "{\"asset\": {\"version\": \"2.0\"}, \"nodes\": [";
     try {

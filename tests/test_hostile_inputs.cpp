@@ -69,6 +69,9 @@ protected:
         if (ext == "jpg") {
             const Image8 img = to_srgb8(pattern(w, h), 0.0f);
             if (!stbi_write_jpg(file.c_str(), w, h, 3, img.rgb.data(), 90)) throw std::runtime_error("cannot write a JPEG");
+        } else if (ext == "bmp") {
+            const Image8 img = to_srgb8(pattern(w, h), 0.0f);
+            if (!stbi_write_bmp(file.c_str(), w, h, 3, img.rgb.data())) throw std::runtime_error("cannot write a BMP");
         } else {
             write_image(pattern(w, h), file);
         }
@@ -90,6 +93,8 @@ void read_bytes_as(const std::string& ext, const std::string& bytes, const std::
         (void)read_png8_from_memory(bytes.data(), bytes.size(), name);
     } else if (ext == "jpg") {
         (void)read_jpeg8_from_memory(bytes.data(), bytes.size(), name);
+    } else if (ext == "bmp") {
+        (void)read_bmp8_from_memory(bytes.data(), bytes.size(), name);
     } else {
         (void)read_image_from_memory(image_format_for("x." + ext), bytes.data(), bytes.size(), name);
     }
@@ -199,7 +204,7 @@ TEST_F(Hostile, ObjNumbersReadAsOtherNumbersAreRefusedWithTheirLine) {
 }
 
 TEST_F(Hostile, EveryTruncationOfAValidFileFailsCleanly) {
-    for (const char* ext : {"hdr", "pfm", "exr", "png", "jpg"}) {
+    for (const char* ext : {"hdr", "pfm", "exr", "png", "jpg", "bmp"}) {
         const std::string bytes = valid_file(ext);
         const BoundedResult r = run_bounded(
             [&] {
@@ -221,7 +226,7 @@ TEST_F(Hostile, EveryTruncationOfAValidFileFailsCleanly) {
 
 // Random byte changes of valid files: each must load or fail with an ImageIoError.
 TEST_F(Hostile, RandomlyCorruptedFilesLoadOrFailCleanly) {
-    for (const char* ext : {"hdr", "pfm", "exr", "png", "jpg"}) {
+    for (const char* ext : {"hdr", "pfm", "exr", "png", "jpg", "bmp"}) {
         const std::string bytes = valid_file(ext, 19, 7);
         const BoundedResult r = run_bounded(
             [&] {
@@ -367,6 +372,9 @@ TEST_F(Hostile, HeadersClaimingLargeImagesAllocateNothing) {
         return run_bounded([&, ext, bytes] { read_bytes_as(ext, bytes, "claim." + ext); }, 10, little);
     };
     // Within the 2^28-pixel limit, but the data are missing.
+    std::string bmp = "BM" + std::string(8, '\0') + std::string("\x36\0\0\0\x28\0\0\0", 8) + std::string("\x10\x27\0\0\x10\x27\0\0", 8) +
+                      std::string("\x01\0\x18\0", 4) + std::string(24 + 64, '\0');  // 10000 x 10000, 24 bits
+    EXPECT_CLEAN(bounded_read("bmp", bmp), "claim.bmp: cannot read BMP: truncated: 118 bytes cannot hold 10000x10000 pixels of 24 bits from byte 54");
     EXPECT_CLEAN(bounded_read("pfm", "PF\n10000 10000\n-1\n" + std::string(64, '\0')),
                  "claim.pfm: cannot read PFM: truncated: the header says 10000x10000 (1200000000 bytes of pixels) but 64 bytes follow it");
     EXPECT_CLEAN(bounded_read("hdr", "#?RADIANCE\n\n-Y 16000 +X 16000\n\x02\x02\x3e\x80\x81\x01"),

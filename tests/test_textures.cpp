@@ -243,6 +243,18 @@ TEST_F(TextureFiles, JpegAndExrAreRead) {
     EXPECT_EQ(e.min_value(), Rgb(0.0f, -0.25f, 0.0f));
 }
 
+TEST_F(TextureFiles, BmpIsReadAsStored) {
+    // Mitsuba's test scenes use .bmp textures: 24 bits (stb_image_write's) read back exactly.
+    const Image8 p = pattern8(5, 3, 10, 20);
+    ASSERT_TRUE(stbi_write_bmp(path("p.bmp").c_str(), p.width, p.height, 3, p.rgb.data()));
+    const BitmapTexture b = load_bitmap_texture(path("p.bmp"), true);
+    ASSERT_EQ(b.width(), 5);
+    ASSERT_EQ(b.height(), 3);
+    for (int y = 0; y < 3; ++y)
+        for (int x = 0; x < 5; ++x)
+            for (int c = 0; c < 3; ++c) EXPECT_EQ(b.texels()[size_t(y * 5 + x)][c], p.at(x, y, c) / 255.0f) << x << "," << y;
+}
+
 TEST_F(TextureFiles, UnreadableTruncatedAndUnsupportedImagesNameTheFile) {
     write_png8(pattern8(8, 8), path("good.png"));
     std::ifstream in(path("good.png"), std::ios::binary);
@@ -254,12 +266,14 @@ TEST_F(TextureFiles, UnreadableTruncatedAndUnsupportedImagesNameTheFile) {
     write("cut.jpg", jpg.substr(0, jpg.size() - 40));
     write("fake.jpg", "not a jpeg at all");
     write("image.bmp", "BM....");
+    write("image.tga", "......");
     const std::pair<const char*, const char*> cases[] = {
         {"missing.png", "missing.png"},
         {"cut.png", "cut.png: cannot read PNG"},
         {"cut.jpg", "cut.jpg: cannot read JPEG: truncated"},
         {"fake.jpg", "fake.jpg: cannot read JPEG: not a JPEG file"},
-        {"image.bmp", "unsupported texture image '.bmp' (supported: .png, .jpg, .jpeg, .exr, .hdr, .pfm)"},
+        {"image.bmp", "image.bmp: cannot read BMP: not a BMP file (it is 6 bytes long)"},
+        {"image.tga", "unsupported texture image '.tga' (supported: .png, .jpg, .jpeg, .bmp, .exr, .hdr, .pfm)"},
     };
     for (const auto& [file, needle] : cases) {
         const std::string e = error_of(std::string("<bsdf type=\"diffuse\"><texture type=\"bitmap\" name=\"reflectance\"><string name=\"filename\" value=\"") +

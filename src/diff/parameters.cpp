@@ -124,8 +124,9 @@ std::vector<SceneParameter> scene_parameters(const SceneDescription& d) {
             add("diffuse_reflectance.value", ParamField::RoughPlasticDiffuse, 3);
         }
     }
-    for (size_t i = 0; i < d.meshes.size(); ++i)
-        if (!d.meshes[i].id.empty() && !is_black(d.meshes[i].emission))
+    for (size_t i = 0; i < d.meshes.size(); ++i)  // (a textured emitter's radiance is its texture: not a value)
+        if (!d.meshes[i].id.empty() && !is_black(d.meshes[i].emission) &&
+            !(i < d.mesh_emission_textures.size() && d.mesh_emission_textures[i]))
             out.push_back({d.meshes[i].id + ".emitter.radiance.value", ParamField::MeshRadiance, uint32_t(i), 3});
     for (size_t i = 0; i < d.spheres.size(); ++i)
         if (!d.spheres[i].id.empty() && !is_black(d.spheres[i].emission))

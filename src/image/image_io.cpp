@@ -27,6 +27,7 @@
 
 #include "image/file_io.hpp"
 #include "image/rgbe.hpp"
+#include "image/stb_bmp.hpp"
 #include "image/stb_jpeg.hpp"
 #include "image/stb_png.hpp"
 
@@ -635,6 +636,52 @@ Image8 read_jpeg(const io::ByteSource& src, const ImageReadLimits& limits) {
     return img;
 }
 
+// ---- BMP ---------------------------------------------------------------------------------
+// The headers are read here first (the file header, then the core or info header) and the
+// pixels' size checked against the limits and, uncompressed, against the file's length, before
+// stb_image decodes it within a budget.
+Image8 read_bmp(const io::ByteSource& src, const ImageReadLimits& limits) {
+    const std::string& name = src.name();
+    if (src.size() < 26) throw ImageIoError(fmt::format("{}: not a BMP file (it is {} bytes long)", name, src.size()));
+    if (src.size() > uint64_t(INT32_MAX)) throw ImageIoError(fmt::format("{}: files over 2 GiB are not read", name));
+    const io::Bytes bytes(src, src.size());
+    const uint8_t* b = bytes.data();
+    const size_t n = bytes.size();
+    if (b[0] != 'B' || b[1] != 'M') throw ImageIoError(fmt::format("{}: not a BMP file (no 'BM' signature)", name));
+    const uint32_t offset = le32(b + 10), header = le32(b + 14);
+    const auto le16 = [](const uint8_t* p) { return uint32_t(p[0]) | uint32_t(p[1]) << 8; };
+    int64_t w = 0, h = 0;
+    uint32_t bpp = 0, compression = 0;
+    if (header == 12) {  // OS/2 core header
+        w = le16(b + 18), h = le16(b + 20), bpp = le16(b + 24);
+    } else if (header >= 40 && header <= 124) {
+        if (n < 14 + size_t(header)) throw ImageIoError(fmt::format("{}: truncated: the file ends inside its header", name));
+        w = int32_t(le32(b + 18)), h = int32_t(le32(b + 22)), bpp = le16(b + 28), compression = le32(b + 30);
+    } else {
+        throw ImageIoError(fmt::format("{}: unsupported BMP header of {} bytes (12 and 40 to 124 are read)", name, header));
+    }
+    if (bpp != 1 && bpp != 4 && bpp != 8 && bpp != 16 && bpp != 24 && bpp != 32)
+        throw ImageIoError(fmt::format("{}: unsupported BMP: {} bits per pixel (1, 4, 8, 16, 24 or 32 are read)", name, bpp));
+    if (compression != 0 && compression != 3)
+        throw ImageIoError(fmt::format("{}: unsupported BMP compression {} (uncompressed and bit fields are read; not RLE)", name, compression));
+    if (w <= 0 || h == 0) throw ImageIoError(fmt::format("{}: corrupt: a {}x{} image", name, w, h));
+    const uint64_t height = uint64_t(h < 0 ? -h : h), width = uint64_t(w);
+    io::check_image_size(name, width, height, limits.max_pixels, 3);
+    const uint64_t row = (uint64_t(bpp) * width + 31) / 32 * 4;
+    if (offset > n || row * height > n - offset)
+        throw ImageIoError(fmt::format("{}: truncated: {} bytes cannot hold {}x{} pixels of {} bits from byte {}", name, n, width, height, bpp, offset));
+    const size_t budget = n + size_t(4 * width * height) + (size_t(4) << 20);
+    Image8 img;
+    const io::BmpDecodeResult r = io::decode_bmp_rgb8(b, n, budget, img);
+    if (!r.ok) {
+        if (r.over_budget) throw ImageIoError(fmt::format("{}: decoding it would take more memory than a {}x{} image needs (corrupt?)", name, width, height));
+        throw ImageIoError(fmt::format("{}: {}", name, r.error));
+    }
+    if (uint64_t(img.width) != width || uint64_t(img.height) != height)
+        throw ImageIoError(fmt::format("{}: corrupt: decoded {}x{} pixels for a {}x{} image", name, img.width, img.height, width, height));
+    return img;
+}
+
 // Runs a reader, giving each of its errors as "NAME: cannot read FORMAT: reason".
 template <typename Read>
 auto reading(const io::ByteSource& src, const char* format, Read&& read) -> decltype(read()) {
@@ -663,6 +710,10 @@ Image8 read_png8_from(const io::ByteSource& src, const ImageReadLimits& limits) 
 
 Image8 read_jpeg8_from(const io::ByteSource& src, const ImageReadLimits& limits) {
     return reading(src, "JPEG", [&] { return read_jpeg(src, limits); });
+}
+
+Image8 read_bmp8_from(const io::ByteSource& src, const ImageReadLimits& limits) {
+    return reading(src, "BMP", [&] { return read_bmp(src, limits); });
 }
 
 void write_encoded(const Image& img, ImageFormat format, io::FdWriter& out, const std::string& name, float png_exposure) {
@@ -759,6 +810,12 @@ Image8 read_jpeg8(const std::string& path, const ImageReadLimits& limits) { retu
 
 Image8 read_jpeg8_from_memory(const void* data, size_t size, const std::string& name, const ImageReadLimits& limits) {
     return read_jpeg8_from(io::MemorySource(data, size, name), limits);
+}
+
+Image8 read_bmp8(const std::string& path, const ImageReadLimits& limits) { return read_bmp8_from(io::FileSource(path), limits); }
+
+Image8 read_bmp8_from_memory(const void* data, size_t size, const std::string& name, const ImageReadLimits& limits) {
+    return read_bmp8_from(io::MemorySource(data, size, name), limits);
 }
 
 }  // namespace pathlab

@@ -4,6 +4,7 @@
 //   .pfm  portable float map, 32-bit float RGB (linear)
 //   .png  8-bit sRGB, tone-mapped by exposure (write); 8-bit values (read_png8)
 //   .jpg  8-bit values (read_jpeg8; baseline and progressive JPEG through stb_image; not written)
+//   .bmp  8-bit values (read_bmp8; Windows BMP, uncompressed or bit fields, through stb_image; not written)
 //
 // Writing: every byte goes to a temporary file `.NAME.pathlab-tmp-PID-N` next to the target;
 // each write, the flush, fsync and close are checked, and only then is the temporary renamed
@@ -83,6 +84,8 @@ Image8 read_png8(const std::string& path, const ImageReadLimits& limits = {});
 // Reads an 8-bit JPEG as stored (grey and CMYK converted to RGB by stb_image). A file that
 // ends before its end-of-image marker is refused as truncated.
 Image8 read_jpeg8(const std::string& path, const ImageReadLimits& limits = {});
+// Reads an 8-bit Windows BMP as stored (1 to 32 bits per pixel; palettes expanded; RLE refused).
+Image8 read_bmp8(const std::string& path, const ImageReadLimits& limits = {});
 
 // The same readers on bytes in memory, as if they were the file `name` (which only appears in
 // messages). For the fuzzers and the tests.
@@ -90,6 +93,7 @@ Image read_image_from_memory(ImageFormat format, const void* data, size_t size, 
                              const ImageReadLimits& limits = {});
 Image8 read_png8_from_memory(const void* data, size_t size, const std::string& name, const ImageReadLimits& limits = {});
 Image8 read_jpeg8_from_memory(const void* data, size_t size, const std::string& name, const ImageReadLimits& limits = {});
+Image8 read_bmp8_from_memory(const void* data, size_t size, const std::string& name, const ImageReadLimits& limits = {});
 
 // Writes `text` to `path` atomically, with the same checks as the images.
 void write_text_file(const std::string& path, const std::string& text);

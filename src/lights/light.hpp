@@ -8,7 +8,8 @@
 //   sample_li(p, u) -> LightSample        incident illumination at p (direction, radiance, pdfW)
 //   pdf_li(...)                           its density (surface lights: of a point q with normal n
 //                                         seen from p; the environment: of a direction)
-//   emitted(w) / Le(w)                    radiance for a ray that hits it (surface / environment)
+//   Le(w)                                 radiance for a ray that hits it (environment; surfaces:
+//                                         surface_radiance below)
 //   sample_emission(u_pos, u_dir, sphere) an origin and a direction for a light path
 //   pdf_emission(origin, normal, dir, sphere) -> {pdfA, pdfW}
 //   power(sphere)                         for choosing lights by power (light_distribution.hpp)
@@ -41,9 +42,10 @@ inline bool is_delta_light(const Light& light) {
     return (light_flags(light) & (kLightDeltaPosition | kLightDeltaDirection)) != 0;
 }
 
-// Radiance of a surface emitter (triangle or sphere), black for other lights.
-inline Rgb surface_radiance(const Light& light) {
-    if (const auto* t = std::get_if<TriangleLight>(&light)) return t->radiance;
+// Radiance of a surface emitter (triangle or sphere) at the point with texture coordinates uv
+// (a textured emitter's), black for other lights.
+inline Rgb surface_radiance(const Light& light, const Vec2f& uv) {
+    if (const auto* t = std::get_if<TriangleLight>(&light)) return t->radiance_at(uv);
     if (const auto* s = std::get_if<SphereLight>(&light)) return s->radiance;
     return Rgb(0.0f);
 }

@@ -126,8 +126,22 @@ std::unique_ptr<Scene> Scene::build(const SceneDescription& desc) {
         if (m.media.changes_medium() || m.media.index_matched) rec.media = &s->desc_.meshes[i].media;
         if (!is_black(m.emission)) {
             rec.first_light = int32_t(s->lights_.size());
+            const Texture* texture = i < desc.mesh_emission_textures.size() ? s->desc_.mesh_emission_textures[i].get() : nullptr;
+            if (texture && m.uvs.size() != m.positions.size())
+                throw SceneError(fmt::format("mesh {} ('{}') has a textured emitter but no texture coordinates", i, m.name));
             for (const auto& t : m.triangles) {
-                s->lights_.emplace_back(TriangleLight(m.positions[t[0]], m.positions[t[1]], m.positions[t[2]], m.emission));
+                TriangleLight light(m.positions[t[0]], m.positions[t[1]], m.positions[t[2]], m.emission);
+                if (texture) {
+                    light.texture = texture;
+                    light.uv0 = m.uvs[t[0]], light.uv1 = m.uvs[t[1]], light.uv2 = m.uvs[t[2]];
+                    // Its mean radiance (for its power among lights): 4 x 4 stratified points.
+                    Rgb sum(0.0f);
+                    for (int a = 0; a < 4; ++a)
+                        for (int c = 0; c < 4; ++c)
+                            sum += light.radiance_at_barycentric(square_to_uniform_triangle({(a + 0.5f) / 4, (c + 0.5f) / 4}));
+                    if (light.area > 0) light.radiance = sum / 16.0f;
+                }
+                s->lights_.emplace_back(light);
                 emitter_of.push_back(rec.first_light);  // the mesh is one emitter
                 add_spectrum(desc.mesh_emission_spectra, i);
             }

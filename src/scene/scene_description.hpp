@@ -44,6 +44,10 @@ struct SceneDescription {
     // it in spectral mode: free lights by index in `lights`, area emitters by index in `meshes`
     // and `spheres` (each vector may be shorter than the one it follows; null: RGB only).
     std::vector<std::shared_ptr<const EmissionSpectrum>> light_spectra, mesh_emission_spectra, sphere_emission_spectra;
+    // Area emitters whose radiance is a texture (<texture name="radiance">), by index in
+    // `meshes` (the vector may be shorter; null: the mesh's constant emission). Such a mesh's
+    // `emission` is the texture's largest value (it says that the mesh emits).
+    std::vector<std::shared_ptr<const Texture>> mesh_emission_textures;
     // Render settings a scene file may suggest; command-line options override them.
     std::optional<std::string> algorithm;
     // A scene file's integrator that pathlab does not have: its type, and where the file gives it

@@ -133,6 +133,7 @@ private:
     void add_camera(const tinygltf::Camera& cam, const Transform& to_world);
     void add_default_camera();
     void add_light(int light, const Transform& to_world);
+    void add_emission(pugi::xml_node shape, int material, bool has_uv, const std::string& what);
 
     std::string path_, xml_path_;
     tinygltf::Model model_;
@@ -143,6 +144,7 @@ private:
     std::map<std::pair<int, bool>, std::vector<std::string>> mesh_files_;  // (mesh, mirrored) -> one file per primitive
     std::map<int, std::string> material_ids_;
     std::map<int, std::string> image_files_;
+    std::map<int, std::string> emissive_files_;  // by material
     bool have_camera_ = false;
     Vec3d lo_{1e300}, hi_{-1e300};  // the scene's world bounds, for a default camera
 };
@@ -346,22 +348,41 @@ void Converter::add_mesh(int node, int mesh_index, const Transform& to_world) {
         const std::string mat = material_id(p.material, shape);
         pugi::xml_node ref = shape.append_child("ref");
         ref.append_attribute("id") = mat.c_str();
-        // Emission: emissiveFactor times KHR_materials_emissive_strength, from the winding's front.
-        if (p.material >= 0) {
-            const tinygltf::Material& m = model_.materials[size_t(p.material)];
-            double strength = 1;
-            if (const auto it = m.extensions.find("KHR_materials_emissive_strength"); it != m.extensions.end())
-                if (it->second.Has("emissiveStrength")) strength = it->second.Get("emissiveStrength").GetNumberAsDouble();
-            if (m.emissiveFactor.size() == 3 && (m.emissiveFactor[0] > 0 || m.emissiveFactor[1] > 0 || m.emissiveFactor[2] > 0) && strength > 0) {
-                pugi::xml_node e = shape.append_child("emitter");
-                e.append_attribute("type") = "area";
-                pugi::xml_node r = e.append_child("rgb");
-                r.append_attribute("name") = "radiance";
-                r.append_attribute("value") =
-                    triple(m.emissiveFactor[0] * strength, m.emissiveFactor[1] * strength, m.emissiveFactor[2] * strength).c_str();
-            }
-        }
+        if (p.material >= 0) add_emission(shape, p.material, attribute("TEXCOORD_0") >= 0, what);
     }
+}
+
+// Emission: emissiveFactor times KHR_materials_emissive_strength (times the emissive texture's
+// decoded sRGB values), an area emitter radiating from the winding's front side.
+void Converter::add_emission(pugi::xml_node shape, int material, bool has_uv, const std::string& what) {
+    const tinygltf::Material& m = model_.materials[size_t(material)];
+    double strength = 1;
+    if (const auto it = m.extensions.find("KHR_materials_emissive_strength"); it != m.extensions.end())
+        if (it->second.Has("emissiveStrength")) strength = it->second.Get("emissiveStrength").GetNumberAsDouble();
+    const std::vector<double>& f = m.emissiveFactor;
+    if (f.size() != 3 || !(f[0] > 0 || f[1] > 0 || f[2] > 0) || !(strength > 0)) return;
+    const double k[3] = {f[0] * strength, f[1] * strength, f[2] * strength};
+    pugi::xml_node e = shape.append_child("emitter");
+    e.append_attribute("type") = "area";
+    if (m.emissiveTexture.index < 0) {
+        pugi::xml_node r = e.append_child("rgb");
+        r.append_attribute("name") = "radiance";
+        r.append_attribute("value") = triple(k[0], k[1], k[2]).c_str();
+        return;
+    }
+    const std::string name = m.name.empty() ? fmt::format("{}", material) : m.name;
+    if (!has_uv) fail(fmt::format("{}: its material '{}' has an emissive texture but the primitive has no TEXCOORD_0", what, name));
+    const tinygltf::Image& image = texture_image(m.emissiveTexture, name, "emissiveTexture");
+    auto& file = emissive_files_[material];
+    if (file.empty()) {
+        if (k[0] == 1 && k[1] == 1 && k[2] == 1)
+            file = image_file(model_.textures[size_t(m.emissiveTexture.index)].source);
+        else  // the factor times the texture's decoded sRGB values, as a linear image
+            file = derived_image(fmt::format("emission-{}.exr", material), image, [&](const uint8_t* t) {
+                return Rgb(float(k[0] * decode_srgb8(t[0])), float(k[1] * decode_srgb8(t[1])), float(k[2] * decode_srgb8(t[2])));
+            });
+    }
+    add_bitmap(e, "radiance", file, m.emissiveTexture, /*raw=*/false);
 }
 
 // The material's bsdf id; the bsdf is written before its first user.
@@ -467,8 +488,6 @@ void Converter::write_material(int index, const std::string& id, pugi::xml_node 
     const tinygltf::Material& m = index < 0 ? kDefault : model_.materials[size_t(index)];
     const std::string name = m.name.empty() ? fmt::format("{}", index) : m.name;
     const tinygltf::PbrMetallicRoughness& pbr = m.pbrMetallicRoughness;
-    if (m.emissiveTexture.index >= 0)
-        fail(fmt::format("material '{}' has an emissive texture; pathlab's area emitter has one radiance per shape", name));
     if (m.alphaMode != "OPAQUE" && !m.alphaMode.empty())
         warn(fmt::format("material '{}': alphaMode {} is not read; the surface is rendered opaque", name, m.alphaMode));
     if (m.normalTexture.index >= 0 && m.normalTexture.scale != 1.0)

@@ -149,6 +149,8 @@ void read_shape_into(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b, s
     MediumInterface media;
     Rgb emission(0.0f);
     std::shared_ptr<const EmissionSpectrum> emission_spectrum;
+    std::shared_ptr<const Texture> emission_texture;  // <texture name="radiance"> in the emitter
+    pugi::xml_node emitter_node;
     bool emitter = false;
     // A medium on one side: name="interior" or "exterior".
     const auto medium_side = [&](const pugi::xml_node& c) -> int32_t& {
@@ -205,14 +207,26 @@ void read_shape_into(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b, s
             const std::string etype = xml.attr(c, "type");
             if (etype != area_plugin().type) xml.fail(c, fmt::format("a shape's emitter must be of type 'area', not '{}'", etype));
             if (emitter) xml.fail(c, "a shape can have only one emitter");
-            if (!xml.plugin_children(c).empty()) xml.fail(xml.plugin_children(c).front(), "an <emitter> has no nested plugins");
+            // Its radiance: a value, or a texture (Mitsuba 3's spatially varying area light).
+            for (const pugi::xml_node& t : xml.plugin_children(c)) {
+                const std::string t_tag = t.name();
+                if ((t_tag != "texture" && t_tag != "ref") || std::string(t.attribute("name").value()) != "radiance")
+                    xml.fail(t, "an area emitter's only nested plugin is its radiance: <texture name=\"radiance\" ...> (or a <ref "
+                                "name=\"radiance\"> to one)");
+                if (emission_texture) xml.fail(t, "an area emitter takes one radiance texture");
+                emission_texture = texture_child(xml, t, b);
+                if (std::holds_alternative<MeshAttributeTexture>(emission_texture->model()))
+                    xml.fail(t, "an area emitter's radiance cannot be a mesh_attribute texture in pathlab (use a bitmap)");
+            }
             Properties ep = xml.properties(c, area_plugin());
+            if (emission_texture && ep.has("radiance")) xml.fail(c, "the emitter's radiance is given twice (a value and a texture)");
             emission = reading([&] {
-                const Rgb L = read_area_radiance(ep);
+                const Rgb L = emission_texture ? emission_texture->max_value() : read_area_radiance(ep);
                 ep.check_all_used();
                 return L;
             });
             emission_spectrum = emitter_spectrum(ep);
+            emitter_node = c;
             emitter = true;
         } else {
             xml.fail(c, fmt::format("unsupported element <{}> in <shape>; supported: <bsdf>, <ref>, <emitter>, <medium>", tag));
@@ -242,6 +256,12 @@ void read_shape_into(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b, s
         if (emitter) xml.fail(n, "a shape in a shapegroup cannot emit light (pathlab samples emitters one by one)");
         if (media.changes_medium() || media.index_matched) xml.fail(n, "a shape in a shapegroup cannot bound media (place it on its own)");
     }
+    if (emission_texture && (std::holds_alternative<SphereDesc>(shape) || std::get<MeshDesc>(shape).uv_map != UvMap::Vertices ||
+                             std::get<MeshDesc>(shape).uvs.empty()))
+        xml.fail(emitter_node, fmt::format("a textured area emitter needs a mesh with texture coordinates in pathlab (obj or ply with uv, "
+                                           "serialized, rectangle, cube); this {} has {}",
+                                           type, std::holds_alternative<SphereDesc>(shape) ? "an exact sphere's parameterisation"
+                                                                                          : "none per vertex"));
     if (auto* sphere = std::get_if<SphereDesc>(&shape)) {
         sphere->material = *material;
         if (group) {  // in the group's space; each instance places a copy (read_instance)
@@ -268,6 +288,10 @@ void read_shape_into(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b, s
     if (emission_spectrum) {  // not in a group: a group's shapes cannot emit
         b.desc.mesh_emission_spectra.resize(b.desc.meshes.size());
         b.desc.mesh_emission_spectra.back() = emission_spectrum;
+    }
+    if (emission_texture) {
+        b.desc.mesh_emission_textures.resize(b.desc.meshes.size());
+        b.desc.mesh_emission_textures.back() = emission_texture;
     }
 }
 

@@ -140,8 +140,8 @@ BitmapTexture load_bitmap_texture(const std::string& path, bool raw, FilterType 
     std::vector<Rgb> texels;
     int w = 0, h = 0;
     bool colour = true;
-    if (ext == ".png" || ext == ".jpg" || ext == ".jpeg") {
-        const Image8 img = ext == ".png" ? read_png8(path) : read_jpeg8(path);
+    if (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".bmp") {
+        const Image8 img = ext == ".png" ? read_png8(path) : ext == ".bmp" ? read_bmp8(path) : read_jpeg8(path);
         const std::array<float, 256>& srgb = srgb8_to_linear_table();
         w = img.width, h = img.height;
         texels.resize(size_t(w) * size_t(h));
@@ -161,7 +161,7 @@ BitmapTexture load_bitmap_texture(const std::string& path, bool raw, FilterType 
                 throw ImageIoError(fmt::format("{}: texel ({}, {}) is not finite", path, i % size_t(w), i / size_t(w)));
         }
     } else {
-        throw ImageIoError(fmt::format("{}: unsupported texture image '{}' (supported: .png, .jpg, .jpeg, .exr, .hdr, .pfm)", path,
+        throw ImageIoError(fmt::format("{}: unsupported texture image '{}' (supported: .png, .jpg, .jpeg, .bmp, .exr, .hdr, .pfm)", path,
                                        ext.empty() ? "(no extension)" : ext));
     }
     return BitmapTexture(w, h, std::move(texels), filter, wrap, to_uv, colour, path);

@@ -1,7 +1,7 @@
 // bitmap: an image looked up at uv (Mitsuba 3's `bitmap` texture).
 //
 // XML (Mitsuba 3 names):
-//   filename     string     the image: .png, .jpg/.jpeg (8-bit, sRGB), .exr, .hdr, .pfm (linear)
+//   filename     string     the image: .png, .jpg/.jpeg, .bmp (8-bit, sRGB), .exr, .hdr, .pfm (linear)
 //   filter_type  string     bilinear (interpolate the four nearest texels) or nearest  default bilinear
 //   wrap_mode    string     outside [0,1]^2: repeat, mirror or clamp                     default repeat
 //   raw          boolean    keep 8-bit values as stored (v / 255) instead of decoding     default false

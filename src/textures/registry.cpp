@@ -21,7 +21,7 @@ UvTransform read_to_uv(Properties& p) {
 const PluginInfo& bitmap_plugin() {
     static const PluginInfo info{
         "texture", "bitmap", "an image looked up at uv: PNG and JPEG (sRGB) or EXR, HDR, PFM (linear)",
-        {{"filename", ParamType::String, "", "the image, relative to the scene file: .png, .jpg, .jpeg, .exr, .hdr or .pfm"},
+        {{"filename", ParamType::String, "", "the image, relative to the scene file: .png, .jpg, .jpeg, .bmp, .exr, .hdr or .pfm"},
          {"filter_type", ParamType::String, "bilinear", "bilinear (the four nearest texels) or nearest"},
          {"wrap_mode", ParamType::String, "repeat", "uv outside [0, 1]: repeat, mirror or clamp"},
          {"raw", ParamType::Boolean, "false", "keep 8-bit values as stored instead of decoding sRGB (normal and bump maps)"},

@@ -406,7 +406,7 @@ StrategyResult<T> Bdpt<T>::connect(const RenderContext& ctx, SubpathView light, 
             r.L = pt.beta * escaped_radiance(scene, pt.dir, wl);
         } else if (pt.light >= 0) {
             const Vec3f w = normalize(camera[size_t(t - 2)].p - pt.p);
-            if (dot(pt.emitter_n, w) > 0) r.L = pt.beta * light_colour(scene, pt.light, surface_radiance(scene.lights()[size_t(pt.light)]), wl);
+            if (dot(pt.emitter_n, w) > 0) r.L = pt.beta * light_colour(scene, pt.light, surface_radiance(scene.lights()[size_t(pt.light)], pt.sp.uv), wl);
         }
     } else if (t == 1) {
         const Vertex& qs = light[size_t(s - 1)];

@@ -58,7 +58,7 @@ inline ShadingPoint make_shading_point(const Scene& scene, const Intersection& h
 // surface emitters are one-sided, radiating on the side of the shape's geometric normal.
 inline Rgb emitted_radiance(const Scene& scene, const Intersection& hit, const Vec3f& w) {
     if (hit.light < 0 || dot(hit.ng, w) <= 0) return Rgb(0.0f);
-    return surface_radiance(scene.lights()[size_t(hit.light)]);
+    return surface_radiance(scene.lights()[size_t(hit.light)], hit.uv);
 }
 
 }  // namespace pathlab

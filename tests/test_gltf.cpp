@@ -107,6 +107,15 @@ struct Gltf {
         doc["cameras"] = {{{"type", "perspective"}, {"perspective", {{"yfov", 2 * std::atan(0.5)}, {"aspectRatio", 1.0}, {"znear", 0.01}}}}};
         node({{"camera", 0}});
     }
+    // Texture 0: `texels` as a PNG in the buffer (written through `dir`), bilinear or nearest.
+    void texture(const Image8& texels, const std::string& dir, bool nearest = false) {
+        write_png8(texels, dir + "/texture.png");
+        std::ifstream in(dir + "/texture.png", std::ios::binary);
+        const std::string png((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        doc["images"] = {{{"mimeType", "image/png"}, {"bufferView", view(png)}}};
+        doc["samplers"] = {{{"magFilter", nearest ? 9728 : 9729}}};
+        doc["textures"] = {{{"source", 0}, {"sampler", 0}}};
+    }
     std::string write(const std::string& dir, const std::string& name = "scene.gltf") const {
         json d = doc;
         d["buffers"] = {{{"byteLength", blob.size()}, {"uri", "data:application/octet-stream;base64," + base64(blob)}}};
@@ -115,6 +124,14 @@ struct Gltf {
         return path;
     }
 };
+
+// A 2 x 1 image of the sRGB codes `rgb` (6 bytes).
+Image8 two_texels(std::vector<uint8_t> rgb) {
+    Image8 img;
+    img.width = 2, img.height = 1;
+    img.rgb = std::move(rgb);
+    return img;
+}
 
 // A black quad emitting (0.5, 0.25, 1) x strength 4 = (2, 1, 4).
 int lamp_material(Gltf& g) {
@@ -204,16 +221,10 @@ TEST(Gltf, LightsAreReadInCandelaAndLuxAt683LumensPerWatt) {
 
 TEST(Gltf, ABaseColourFactorTimesItsTextureIsBakedAsLinearValues) {
     TempDir dir;
-    Image8 texels;
-    texels.width = 2, texels.height = 1;
-    texels.rgb = {10, 128, 250, 255, 0, 77};
-    write_png8(texels, dir.path + "/t.png");
-    std::ifstream in(dir.path + "/t.png", std::ios::binary);
-    const std::string png((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const Image8 texels = two_texels({10, 128, 250, 255, 0, 77});
     Gltf g;
     g.camera();
-    g.doc["images"] = {{{"mimeType", "image/png"}, {"bufferView", g.view(png)}}};
-    g.doc["textures"] = {{{"source", 0}}};
+    g.texture(texels, dir.path);
     const int m = g.material({{"pbrMetallicRoughness", {{"baseColorFactor", {0.5, 1, 0.25, 1}}, {"baseColorTexture", {{"index", 0}}}}}});
     g.node({{"mesh", g.quad(-1, 1, 1, -2, m)}});
     const GltfConversion c = convert_gltf_scene(g.write(dir.path), dir.path + "/out.xml");
@@ -231,17 +242,10 @@ TEST(Gltf, AnEmissiveTextureTimesItsFactorAndStrengthIsTheRadiance) {
     // A textured emissive quad filling the view: each half of the image shows one texel, times
     // emissiveFactor (0.5, 1, 1) times strength 2, of the texel's decoded sRGB value.
     TempDir dir;
-    Image8 texels;
-    texels.width = 2, texels.height = 1;
-    texels.rgb = {200, 100, 50, 30, 90, 250};
-    write_png8(texels, dir.path + "/t.png");
-    std::ifstream in(dir.path + "/t.png", std::ios::binary);
-    const std::string png((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const Image8 texels = two_texels({200, 100, 50, 30, 90, 250});
     Gltf g;
     g.camera();
-    g.doc["images"] = {{{"mimeType", "image/png"}, {"bufferView", g.view(png)}}};
-    g.doc["samplers"] = {{{"magFilter", 9728}}};
-    g.doc["textures"] = {{{"source", 0}, {"sampler", 0}}};
+    g.texture(texels, dir.path, /*nearest=*/true);
     g.doc["extensionsUsed"] = {"KHR_materials_emissive_strength"};
     const int m = g.material({{"pbrMetallicRoughness", {{"baseColorFactor", {0, 0, 0, 1}}}},
                               {"emissiveFactor", {0.5, 1, 1}},

@@ -514,9 +514,8 @@ void Converter::write_material(int index, const std::string& id, pugi::xml_node 
     if (m.normalTexture.index >= 0) {
         tinygltf::TextureInfo info;
         info.index = m.normalTexture.index, info.texCoord = m.normalTexture.texCoord, info.extensions = m.normalTexture.extensions;
-        const tinygltf::Image& image = texture_image(info, name, "normalTexture");
+        texture_image(info, name, "normalTexture");  // checks the texture (its image is copied as it is)
         add_bitmap(host, "normalmap", image_file(model_.textures[size_t(info.index)].source), info, /*raw=*/true);
-        (void)image;
         host = host.append_child("bsdf");
         host.append_attribute("type") = "principled";
     }

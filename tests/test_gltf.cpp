@@ -260,6 +260,35 @@ TEST(Gltf, AnEmissiveTextureTimesItsFactorAndStrengthIsTheRadiance) {
                 EXPECT_NEAR(img.at(x, y)[c], k[c] * decode_srgb8(texels.at(x < 4 ? 0 : 1, 0, c)), 1e-5) << x << "," << y << " channel " << c;
 }
 
+TEST(Gltf, KhrTextureTransformMovesTheLookup) {
+    // The textured emissive quad filling the view, its texture scaled by (2, 1) (four stripes),
+    // then offset by (1/4, 0) instead (the boundaries a quarter along): u' = T R S u, per column
+    // of 8 (an offset of -1/4 would give another image).
+    for (const bool offset : {false, true}) {
+        SCOPED_TRACE(offset ? "offset" : "scale");
+        TempDir dir;
+        const Image8 texels = two_texels({200, 100, 50, 30, 90, 250});
+        Gltf g;
+        g.camera();
+        g.texture(texels, dir.path, /*nearest=*/true);
+        g.doc["extensionsUsed"] = {"KHR_texture_transform"};
+        const json transform = offset ? json{{"offset", {0.25, 0}}} : json{{"scale", {2, 1}}};
+        const int m = g.material({{"pbrMetallicRoughness", {{"baseColorFactor", {0, 0, 0, 1}}}},
+                                  {"emissiveFactor", {1, 1, 1}},
+                                  {"emissiveTexture", {{"index", 0}, {"extensions", {{"KHR_texture_transform", transform}}}}}});
+        g.node({{"mesh", g.quad(-1, 1, 1.2f, -2, m)}});  // as wide as the view: u = (column + 1/2) / 8 at the centres
+        const Image img = render_scene(load_scene_file(g.write(dir.path)), "pt-naive", 8, 8, 4, 1).film.mean();
+        for (int x = 0; x < 8; ++x) {
+            // the quad's u at the column's centre, then the lookup's
+            const float u = (float(x) + 0.5f) / 8.0f;
+            const float looked = offset ? u + 0.25f : 2 * u;
+            const int texel = int(std::floor(looked * 2)) % 2;
+            for (int c = 0; c < 3; ++c)
+                EXPECT_NEAR(img.at(x, 4)[c], decode_srgb8(texels.at(texel, 0, c)), 1e-5) << "column " << x << " channel " << c;
+        }
+    }
+}
+
 TEST(Gltf, TheShippedSceneRendersBitForBitAsItsConversionAndItsTextTwin) {
     TempDir dir;
     const std::string glb = kSource + "/scenes/gltf/room.glb", text = kSource + "/scenes/gltf/room.gltf";

@@ -180,7 +180,7 @@ void Converter::load() {
 
 void Converter::check_extensions() {
     static const std::set<std::string> kSupported = {"KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_transmission",
-                                                      "KHR_materials_ior"};
+                                                      "KHR_materials_ior", "KHR_texture_transform"};
     std::vector<std::string> missing;
     for (const std::string& e : model_.extensionsRequired)
         if (!kSupported.count(e)) missing.push_back(e);
@@ -441,8 +441,10 @@ const tinygltf::Image& Converter::texture_image(const tinygltf::TextureInfo& inf
         fail(fmt::format("material '{}': {}'s texture {} has no image (or an image extension pathlab does not read)", material, slot, info.index));
     if (info.texCoord != 0)
         fail(fmt::format("material '{}': {} uses TEXCOORD_{}; pathlab reads the first texture coordinates only", material, slot, info.texCoord));
-    if (info.extensions.count("KHR_texture_transform"))
-        fail(fmt::format("material '{}': {} has a KHR_texture_transform, which pathlab does not read", material, slot));
+    if (const auto it = info.extensions.find("KHR_texture_transform"); it != info.extensions.end() && it->second.Has("texCoord") &&
+                                                                        it->second.Get("texCoord").GetNumberAsInt() != 0)
+        fail(fmt::format("material '{}': {}'s KHR_texture_transform uses TEXCOORD_{}; pathlab reads the first texture coordinates only",
+                         material, slot, it->second.Get("texCoord").GetNumberAsInt()));
     return model_.images[size_t(t.source)];
 }
 
@@ -471,6 +473,23 @@ void Converter::add_bitmap(pugi::xml_node parent, const char* name, const std::s
     pugi::xml_node filter = t.append_child("string");
     filter.append_attribute("name") = "filter_type";
     filter.append_attribute("value") = mag == TINYGLTF_TEXTURE_FILTER_NEAREST ? "nearest" : "bilinear";
+    // KHR_texture_transform: uv' = T(offset) R(rotation) S(scale) uv, as the bitmap's to_uv.
+    if (const auto it = info.extensions.find("KHR_texture_transform"); it != info.extensions.end()) {
+        const tinygltf::Value& x = it->second;
+        const auto pair = [&](const char* key, double fallback, int i) {
+            return x.Has(key) && x.Get(key).IsArray() && x.Get(key).ArrayLen() == 2 ? x.Get(key).Get(i).GetNumberAsDouble() : fallback;
+        };
+        const double ox = pair("offset", 0, 0), oy = pair("offset", 0, 1), sx = pair("scale", 1, 0), sy = pair("scale", 1, 1);
+        const double r = x.Has("rotation") && x.Get("rotation").IsNumber() ? x.Get("rotation").GetNumberAsDouble() : 0.0;
+        Transform m;
+        m.m[0] = {std::cos(r) * sx, std::sin(r) * sy, 0, ox};
+        m.m[1] = {-std::sin(r) * sx, std::cos(r) * sy, 0, oy};
+        if (!m.is_finite() || !(std::abs(sx * sy) > 0))
+            fail(fmt::format("texture {}: its KHR_texture_transform is not finite or scales by 0", info.index));
+        pugi::xml_node tw = t.append_child("transform");
+        tw.append_attribute("name") = "to_uv";
+        tw.append_child("matrix").append_attribute("value") = matrix_text(m).c_str();
+    }
     if (raw) {
         pugi::xml_node r = t.append_child("boolean");
         r.append_attribute("name") = "raw";

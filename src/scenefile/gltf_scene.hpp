@@ -8,7 +8,8 @@
 //   - nodes: their matrix or translation-rotation-scale, composed down the hierarchy, as each
 //     shape's to_world (a mirroring transform reverses the winding, as glTF's spec says);
 //   - the metallic-roughness material as `principled` (base colour, metallic, roughness, their
-//     textures and factors, the normal texture as `normalmap`, KHR_materials_transmission and
+//     textures and factors, KHR_texture_transform as the bitmaps' to_uv, the normal texture as
+//     `normalmap`, KHR_materials_transmission and
 //     KHR_materials_ior), emissive (its factor, KHR_materials_emissive_strength and texture) as
 //     an area emitter;
 //   - the first perspective camera of the scene (yfov on the y axis), else one framing the scene;

@@ -161,6 +161,24 @@ TEST(Gltf, AnEmissiveQuadCoversThePixelsTheCamerasYfovSays) {
     expect_columns_0_and_1_lit(load_scene_file(g.write(dir.path)));
 }
 
+TEST(Gltf, AnOrthographicCameraSeesXmagByYmag) {
+    // xmag 2, ymag 1: a 16 x 8 film spans x in [-2, 2], y in [-1, 1] (the film 640 x 320); the
+    // quad x in [-2.5, -1], y in [-1, -0.5], 5 m in front of the camera, covers exactly the
+    // columns 0-3 of the rows 6-7.
+    TempDir dir;
+    Gltf g;
+    g.doc["cameras"] = {{{"type", "orthographic"}, {"orthographic", {{"xmag", 2}, {"ymag", 1}, {"znear", 0.01}, {"zfar", 100}}}}};
+    g.node({{"camera", 0}, {"translation", {0, 0, 5}}});
+    g.node({{"mesh", g.quad(-2.5f, -1, 0.25f, 0, lamp_material(g))}, {"translation", {0, -0.75, 0}}});
+    const SceneDescription d = load_scene_file(g.write(dir.path));
+    EXPECT_EQ(d.width, 640);
+    EXPECT_EQ(d.height, 320);
+    const Image img = render_scene(d, "pt-naive", 16, 8, 4, 1).film.mean();
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 16; ++x)
+            for (int c = 0; c < 3; ++c) EXPECT_NEAR(img.at(x, y)[c], x < 4 && y >= 6 ? Rgb(2, 1, 4)[c] : 0.0f, 1e-5) << x << "," << y;
+}
+
 TEST(Gltf, AMirroringNodeKeepsTheFrontFaceTowardsTheCamera) {
     // The quad x in [0.5, 1.5] mirrored by scale x -1: glTF's spec makes its front face the
     // clockwise one, so it still emits towards the camera (without the reversed winding, the
@@ -330,8 +348,9 @@ void expect_refused(const std::function<void(Gltf&)>& edit, const std::string& w
 TEST(Gltf, RefusesWhatItCannotRenderNamingTheFile) {
     expect_refused([](Gltf& g) { g.doc["extensionsRequired"] = {"KHR_draco_mesh_compression"}; }, "KHR_draco_mesh_compression");
     expect_refused([](Gltf& g) { g.doc["meshes"][0]["primitives"][0]["mode"] = 1; }, "mode 1");
-    expect_refused([](Gltf& g) { g.doc["cameras"][0] = {{"type", "orthographic"}, {"orthographic", {{"xmag", 1}, {"ymag", 1}, {"znear", 0}, {"zfar", 1}}}}; },
-                   "orthographic");
+    expect_refused([](Gltf& g) { g.doc["cameras"][0] = {{"type", "orthographic"}, {"orthographic", {{"xmag", 0}, {"ymag", 1}, {"znear", 0}, {"zfar", 1}}}}; },
+                   "xmag 0 and ymag 1 must be positive");
+    expect_refused([](Gltf& g) { g.doc["cameras"][0] = {{"type", "fisheye"}}; }, "\"perspective\" or \"orthographic\"");  // tinygltf's words
     expect_refused([](Gltf& g) { g.doc["scenes"][0]["nodes"] = {0, 5}; }, "node 5");
     expect_refused([](Gltf& g) { g.doc["accessors"][0]["count"] = 4000000000u; }, "indices: accessor 0 reaches past the end of its buffer");
     expect_refused([](Gltf& g) { g.doc["accessors"][1]["count"] = 5; }, "POSITION: accessor 1 reaches past the end of its buffer");

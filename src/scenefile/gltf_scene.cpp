@@ -578,10 +578,14 @@ void Converter::write_material(int index, const std::string& id, pugi::xml_node 
 }
 
 void Converter::add_camera(const tinygltf::Camera& cam, const Transform& node) {
-    if (cam.type != "perspective")
-        fail(fmt::format("camera '{}' is {}; pathlab reads perspective glTF cameras", cam.name, cam.type.empty() ? "of no type" : cam.type));
+    const bool ortho = cam.type == "orthographic";
+    if (cam.type != "perspective" && !ortho)
+        fail(fmt::format("camera '{}' is {}; glTF cameras are perspective or orthographic", cam.name, cam.type.empty() ? "of no type" : cam.type));
     const tinygltf::PerspectiveCamera& p = cam.perspective;
-    if (!(p.yfov > 0 && p.yfov < kPi)) fail(fmt::format("camera '{}': yfov {} is not between 0 and pi", cam.name, p.yfov));
+    const tinygltf::OrthographicCamera& o = cam.orthographic;
+    if (!ortho && !(p.yfov > 0 && p.yfov < kPi)) fail(fmt::format("camera '{}': yfov {} is not between 0 and pi", cam.name, p.yfov));
+    if (ortho && !(o.xmag > 0 && o.ymag > 0 && std::isfinite(o.xmag) && std::isfinite(o.ymag)))
+        fail(fmt::format("camera '{}': xmag {} and ymag {} must be positive", cam.name, o.xmag, o.ymag));
     // glTF's camera looks down -z with +y up and +x right; Mitsuba's down +z with +x left: turn
     // it half a turn about y. Only the rotation and translation of the node count (no scale).
     Transform t = node;
@@ -594,15 +598,22 @@ void Converter::add_camera(const tinygltf::Camera& cam, const Transform& node) {
     }
     t = t * Transform::scale({-1, 1, -1});
     const int width = 640;
-    const int height = p.aspectRatio > 0 ? std::max(1, int(std::lround(width / p.aspectRatio))) : 480;
+    const double aspect = ortho ? o.xmag / o.ymag : p.aspectRatio;
+    const int height = aspect > 0 ? std::max(1, int(std::lround(width / aspect))) : 480;
     pugi::xml_node s = scene_.append_child("sensor");
-    s.append_attribute("type") = "perspective";
-    pugi::xml_node fov = s.append_child("float");
-    fov.append_attribute("name") = "fov";
-    fov.append_attribute("value") = number(p.yfov * 180.0 / kPi).c_str();
-    pugi::xml_node axis = s.append_child("string");
-    axis.append_attribute("name") = "fov_axis";
-    axis.append_attribute("value") = "y";
+    s.append_attribute("type") = ortho ? "orthographic" : "perspective";
+    if (ortho) {
+        // Mitsuba's orthographic sensor sees camera-space x in [-1, 1] and y in [-1/a, 1/a] (a the
+        // film's aspect, here xmag / ymag), scaled by to_world: xmag on both axes.
+        t = t * Transform::scale({o.xmag, o.xmag, 1});
+    } else {
+        pugi::xml_node fov = s.append_child("float");
+        fov.append_attribute("name") = "fov";
+        fov.append_attribute("value") = number(p.yfov * 180.0 / kPi).c_str();
+        pugi::xml_node axis = s.append_child("string");
+        axis.append_attribute("name") = "fov_axis";
+        axis.append_attribute("value") = "y";
+    }
     pugi::xml_node tw = s.append_child("transform");
     tw.append_attribute("name") = "to_world";
     tw.append_child("matrix").append_attribute("value") = matrix_text(t).c_str();

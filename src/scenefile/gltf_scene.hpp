@@ -12,11 +12,12 @@
 //     `normalmap`, KHR_materials_transmission and
 //     KHR_materials_ior), emissive (its factor, KHR_materials_emissive_strength and texture) as
 //     an area emitter;
-//   - the first perspective camera of the scene (yfov on the y axis), else one framing the scene;
+//   - the first camera of the scene (perspective: yfov on the y axis; orthographic: xmag by ymag),
+//     else one framing the scene;
 //   - KHR_lights_punctual point, spot and directional lights, candela and lux read with
 //     683 lm/W as Blender's importer does (intensity I cd -> I / 683 W/sr).
-// What it cannot render is refused with the file's name and the reason (an orthographic
-// camera, a required extension it lacks, lines and points); what it leaves out
+// What it cannot render is refused with the file's name and the reason (a required extension
+// it lacks, lines and points, a second uv set); what it leaves out
 // (alpha, other extensions) is a warning.
 #pragma once
 

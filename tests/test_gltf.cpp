@@ -9,32 +9,23 @@
 
 #include <filesystem>
 #include <fstream>
-#include <unistd.h>
 
 #include "image/image_io.hpp"
 #include "lights/registry.hpp"
+#include "core/input_file.hpp"
 #include "render_helpers.hpp"
+#include "scratch_dir.hpp"
 #include "scenefile/gltf_scene.hpp"
 
 namespace pathlab::test {
 namespace {
 
-namespace fs = std::filesystem;
 using nlohmann::json;
 
 const std::string kSource = PATHLAB_SOURCE_DIR;
 
-struct TempDir {
-    std::string path;
-    TempDir() {
-        std::string p = (fs::temp_directory_path() / "pathlab-gltf-test-XXXXXX").string();
-        if (!mkdtemp(p.data())) throw std::runtime_error("mkdtemp");
-        path = p;
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(path, ec);
-    }
+struct TempDir : ScratchDir {
+    TempDir() : ScratchDir("pathlab-gltf-test") {}
 };
 
 std::string base64(const std::string& bytes) {
@@ -110,8 +101,7 @@ struct Gltf {
     // Texture 0: `texels` as a PNG in the buffer (written through `dir`), bilinear or nearest.
     void texture(const Image8& texels, const std::string& dir, bool nearest = false) {
         write_png8(texels, dir + "/texture.png");
-        std::ifstream in(dir + "/texture.png", std::ios::binary);
-        const std::string png((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        const std::string png = read_input_file(dir + "/texture.png", 1 << 20);
         doc["images"] = {{{"mimeType", "image/png"}, {"bufferView", view(png)}}};
         doc["samplers"] = {{{"magFilter", nearest ? 9728 : 9729}}};
         doc["textures"] = {{{"source", 0}, {"sampler", 0}}};

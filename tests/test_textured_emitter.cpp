@@ -7,33 +7,24 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <unistd.h>
 
 #include "image/image_io.hpp"
 #include "render_helpers.hpp"
+#include "scratch_dir.hpp"
 #include "scenefile/scene_file.hpp"
 
 namespace pathlab::test {
 namespace {
 
-namespace fs = std::filesystem;
 
-struct TextureDir {
-    std::string path;
-    TextureDir() {
-        std::string p = (fs::temp_directory_path() / "pathlab-emitter-texture-XXXXXX").string();
-        if (!mkdtemp(p.data())) throw std::runtime_error("mkdtemp");
-        path = p;
+struct TextureDir : ScratchDir {
+    TextureDir() : ScratchDir("pathlab-emitter-texture") {
         // 2 x 2 texels, as sRGB codes: top (230, 140, 60), (60, 140, 230); bottom (140, 230, 60),
         // (60, 230, 140).
         Image8 img;
         img.width = 2, img.height = 2;
         img.rgb = {230, 140, 60, 60, 140, 230, 140, 230, 60, 60, 230, 140};
         write_png8(img, path + "/sign.png");
-    }
-    ~TextureDir() {
-        std::error_code ec;
-        fs::remove_all(path, ec);
     }
 };
 

@@ -44,6 +44,7 @@ std::string lower_extension(const std::string& path) {
     return ext;
 }
 
+uint32_t le16(const uint8_t* p) { return uint32_t(p[0]) | uint32_t(p[1]) << 8; }
 uint32_t le32(const uint8_t* p) { return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24; }
 uint32_t be32(const uint8_t* p) { return uint32_t(p[3]) | uint32_t(p[2]) << 8 | uint32_t(p[1]) << 16 | uint32_t(p[0]) << 24; }
 
@@ -561,6 +562,22 @@ Image8 read_png(const io::ByteSource& src, const ImageReadLimits& limits) {
     return img;
 }
 
+// stb's decode of a w x h image whose headers pathlab has checked (JPEG, BMP): its failure, or
+// memory beyond the budget, or another size than the headers' (`unit`: what they call the
+// image), as an ImageIoError naming the file.
+template <typename Decode>
+Image8 decoded_within_budget(const std::string& name, uint64_t w, uint64_t h, const char* unit, Decode&& decode) {
+    Image8 img;
+    const io::PngDecodeResult r = decode(img);
+    if (!r.ok) {
+        if (r.over_budget) throw ImageIoError(fmt::format("{}: decoding it would take more memory than a {}x{} image needs (corrupt?)", name, w, h));
+        throw ImageIoError(fmt::format("{}: {}", name, r.error));
+    }
+    if (uint64_t(img.width) != w || uint64_t(img.height) != h)
+        throw ImageIoError(fmt::format("{}: corrupt: decoded {}x{} pixels for a {}x{} {}", name, img.width, img.height, w, h, unit));
+    return img;
+}
+
 // ---- JPEG through stb ----------------------------------------------------------------------
 
 uint32_t be16(const uint8_t* p) { return uint32_t(p[0]) << 8 | uint32_t(p[1]); }
@@ -625,15 +642,7 @@ Image8 read_jpeg(const io::ByteSource& src, const ImageReadLimits& limits) {
     // Everything stb needs: the file, per component the decoded samples and (progressive) the
     // coefficients, at most four components padded to whole 32x32 blocks, and the RGB image.
     const size_t budget = n + size_t(40 * (w + 32) * (h + 32)) + (size_t(4) << 20);
-    Image8 img;
-    const io::JpegDecodeResult r = io::decode_jpeg_rgb8(b, n, budget, img);
-    if (!r.ok) {
-        if (r.over_budget) throw ImageIoError(fmt::format("{}: decoding it would take more memory than a {}x{} image needs (corrupt?)", name, w, h));
-        throw ImageIoError(fmt::format("{}: {}", name, r.error));
-    }
-    if (uint64_t(img.width) != w || uint64_t(img.height) != h)
-        throw ImageIoError(fmt::format("{}: corrupt: decoded {}x{} pixels for a {}x{} frame", name, img.width, img.height, w, h));
-    return img;
+    return decoded_within_budget(name, w, h, "frame", [&](Image8& img) { return io::decode_jpeg_rgb8(b, n, budget, img); });
 }
 
 // ---- BMP ---------------------------------------------------------------------------------
@@ -649,7 +658,6 @@ Image8 read_bmp(const io::ByteSource& src, const ImageReadLimits& limits) {
     const size_t n = bytes.size();
     if (b[0] != 'B' || b[1] != 'M') throw ImageIoError(fmt::format("{}: not a BMP file (no 'BM' signature)", name));
     const uint32_t offset = le32(b + 10), header = le32(b + 14);
-    const auto le16 = [](const uint8_t* p) { return uint32_t(p[0]) | uint32_t(p[1]) << 8; };
     int64_t w = 0, h = 0;
     uint32_t bpp = 0, compression = 0;
     if (header == 12) {  // OS/2 core header
@@ -671,15 +679,7 @@ Image8 read_bmp(const io::ByteSource& src, const ImageReadLimits& limits) {
     if (offset > n || row * height > n - offset)
         throw ImageIoError(fmt::format("{}: truncated: {} bytes cannot hold {}x{} pixels of {} bits from byte {}", name, n, width, height, bpp, offset));
     const size_t budget = n + size_t(4 * width * height) + (size_t(4) << 20);
-    Image8 img;
-    const io::BmpDecodeResult r = io::decode_bmp_rgb8(b, n, budget, img);
-    if (!r.ok) {
-        if (r.over_budget) throw ImageIoError(fmt::format("{}: decoding it would take more memory than a {}x{} image needs (corrupt?)", name, width, height));
-        throw ImageIoError(fmt::format("{}: {}", name, r.error));
-    }
-    if (uint64_t(img.width) != width || uint64_t(img.height) != height)
-        throw ImageIoError(fmt::format("{}: corrupt: decoded {}x{} pixels for a {}x{} image", name, img.width, img.height, width, height));
-    return img;
+    return decoded_within_budget(name, width, height, "image", [&](Image8& img) { return io::decode_bmp_rgb8(b, n, budget, img); });
 }
 
 // Runs a reader, giving each of its errors as "NAME: cannot read FORMAT: reason".

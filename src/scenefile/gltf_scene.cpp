@@ -122,8 +122,11 @@ private:
     void add_mesh(int node, int mesh, const Transform& to_world);
     std::string material_id(int material, pugi::xml_node first_user);
     void write_material(int material, const std::string& id, pugi::xml_node before);
-    std::vector<float> floats(int accessor, int components, const char* what, bool allow_normalized) const;
+    const tinygltf::Accessor& accessor(int index, const std::string& what) const;
+    const unsigned char* first_element(const tinygltf::Accessor& a, int index, size_t element, size_t& stride, const std::string& what) const;
+    std::vector<float> floats(int accessor, int components, const std::string& what, bool allow_normalized) const;
     std::vector<uint32_t> indices(const tinygltf::Primitive& p, size_t vertex_count) const;
+    std::string output_path(const std::string& name) const;
     std::string write_file(const std::string& name, const std::string& bytes);
     const tinygltf::Image& texture_image(const tinygltf::TextureInfo& info, const std::string& material, const char* slot);
     void add_bitmap(pugi::xml_node parent, const char* name, const std::string& file, const tinygltf::TextureInfo& info, bool raw);
@@ -191,9 +194,28 @@ void Converter::check_extensions() {
         if (!kSupported.count(e)) warn(fmt::format("the extension {} is not read: the scene is rendered without it", e));
 }
 
-std::vector<float> Converter::floats(int index, int components, const char* what, bool allow_normalized) const {
+const tinygltf::Accessor& Converter::accessor(int index, const std::string& what) const {
     if (index < 0 || size_t(index) >= model_.accessors.size()) fail(fmt::format("{}: accessor {} does not exist", what, index));
-    const tinygltf::Accessor& a = model_.accessors[size_t(index)];
+    return model_.accessors[size_t(index)];
+}
+
+// The first of accessor `a`'s (number `index`) elements of `element` bytes in its buffer, and in
+// `stride` the bytes from one to the next; fails naming `what` when any lies outside the buffer.
+const unsigned char* Converter::first_element(const tinygltf::Accessor& a, int index, size_t element, size_t& stride,
+                                              const std::string& what) const {
+    if (a.bufferView < 0 || size_t(a.bufferView) >= model_.bufferViews.size())
+        fail(fmt::format("{}: buffer view {} does not exist", what, a.bufferView));
+    const tinygltf::BufferView& v = model_.bufferViews[size_t(a.bufferView)];
+    if (v.buffer < 0 || size_t(v.buffer) >= model_.buffers.size()) fail(fmt::format("{}: buffer {} does not exist", what, v.buffer));
+    const std::vector<unsigned char>& data = model_.buffers[size_t(v.buffer)].data;
+    stride = v.byteStride ? v.byteStride : element;
+    if (!inside(v, data.size(), a.byteOffset, stride, a.count, element))
+        fail(fmt::format("{}: accessor {} reaches past the end of its buffer", what, index));
+    return data.data() + v.byteOffset + a.byteOffset;
+}
+
+std::vector<float> Converter::floats(int index, int components, const std::string& what, bool allow_normalized) const {
+    const tinygltf::Accessor& a = accessor(index, what);
     if (a.sparse.isSparse) fail(fmt::format("{}: accessor {} is sparse, which pathlab does not read", what, index));
     const int want_type = components == 2 ? TINYGLTF_TYPE_VEC2 : TINYGLTF_TYPE_VEC3;
     if (a.type != want_type) fail(fmt::format("{}: accessor {} is not a VEC{}", what, index, components));
@@ -209,19 +231,12 @@ std::vector<float> Converter::floats(int index, int components, const char* what
         if (a.count > (size_t(1) << 28)) fail(fmt::format("{}: accessor {} claims {} elements", what, index, a.count));
         return std::vector<float>(a.count * size_t(components), 0.0f);  // all zeros, as the spec says
     }
-    if (size_t(a.bufferView) >= model_.bufferViews.size()) fail(fmt::format("{}: buffer view {} does not exist", what, a.bufferView));
-    const tinygltf::BufferView& v = model_.bufferViews[size_t(a.bufferView)];
-    if (v.buffer < 0 || size_t(v.buffer) >= model_.buffers.size()) fail(fmt::format("{}: buffer {} does not exist", what, v.buffer));
-    const std::vector<unsigned char>& data = model_.buffers[size_t(v.buffer)].data;
-    const size_t element = component_size * size_t(components);
-    const size_t stride = v.byteStride ? v.byteStride : element;
-    if (!inside(v, data.size(), a.byteOffset, stride, a.count, element))
-        fail(fmt::format("{}: accessor {} reaches past the end of its buffer", what, index));
-    const size_t start = v.byteOffset + a.byteOffset;
+    size_t stride = 0;
+    const unsigned char* first = first_element(a, index, component_size * size_t(components), stride, what);
     std::vector<float> out(a.count * size_t(components), 0.0f);
     for (size_t i = 0; i < a.count; ++i)
         for (size_t c = 0; c < size_t(components); ++c) {
-            const unsigned char* p = data.data() + start + i * stride + c * component_size;
+            const unsigned char* p = first + i * stride + c * component_size;
             float f = 0;
             if (component_size == 4)
                 std::memcpy(&f, p, 4);
@@ -241,8 +256,7 @@ std::vector<uint32_t> Converter::indices(const tinygltf::Primitive& p, size_t ve
         for (size_t i = 0; i < vertex_count; ++i) out.push_back(uint32_t(i));
         return out;
     }
-    if (size_t(p.indices) >= model_.accessors.size()) fail(fmt::format("indices: accessor {} does not exist", p.indices));
-    const tinygltf::Accessor& a = model_.accessors[size_t(p.indices)];
+    const tinygltf::Accessor& a = accessor(p.indices, "indices");
     size_t size = 0;
     switch (a.componentType) {
         case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: size = 1; break;
@@ -252,14 +266,10 @@ std::vector<uint32_t> Converter::indices(const tinygltf::Primitive& p, size_t ve
     }
     if (a.type != TINYGLTF_TYPE_SCALAR || a.bufferView < 0 || size_t(a.bufferView) >= model_.bufferViews.size() || a.sparse.isSparse)
         fail(fmt::format("indices: accessor {} is not a plain list of scalars", p.indices));
-    const tinygltf::BufferView& v = model_.bufferViews[size_t(a.bufferView)];
-    if (v.buffer < 0 || size_t(v.buffer) >= model_.buffers.size()) fail(fmt::format("indices: buffer {} does not exist", v.buffer));
-    const std::vector<unsigned char>& data = model_.buffers[size_t(v.buffer)].data;
-    const size_t stride = v.byteStride ? v.byteStride : size;
-    if (!inside(v, data.size(), a.byteOffset, stride, a.count, size))
-        fail(fmt::format("indices: accessor {} reaches past the end of its buffer", p.indices));
+    size_t stride = 0;
+    const unsigned char* first = first_element(a, p.indices, size, stride, "indices");
     for (size_t i = 0; i < a.count; ++i) {
-        const unsigned char* q = data.data() + v.byteOffset + a.byteOffset + i * stride;
+        const unsigned char* q = first + i * stride;
         uint32_t k = size == 1 ? q[0] : size == 2 ? uint32_t(q[0] | (q[1] << 8)) : uint32_t(q[0] | (q[1] << 8) | (q[2] << 16) | (uint32_t(q[3]) << 24));
         if (k >= vertex_count) fail(fmt::format("indices: accessor {} names vertex {} of {}", p.indices, k, vertex_count));
         out.push_back(k);
@@ -267,9 +277,13 @@ std::vector<uint32_t> Converter::indices(const tinygltf::Primitive& p, size_t ve
     return out;
 }
 
+// Where the file `name` of the conversion goes (in the files folder beside the XML).
+std::string Converter::output_path(const std::string& name) const {
+    return (fs::path(xml_path_).parent_path() / files_dir_ / name).string();
+}
+
 std::string Converter::write_file(const std::string& name, const std::string& bytes) {
-    const fs::path xml_dir = fs::path(xml_path_).parent_path();
-    write_text_file((xml_dir / files_dir_ / name).string(), bytes);
+    write_text_file(output_path(name), bytes);
     return files_dir_ + "/" + name;
 }
 
@@ -292,7 +306,7 @@ void Converter::add_mesh(int node, int mesh_index, const Transform& to_world) {
             return it == p.attributes.end() ? -1 : it->second;
         };
         if (attribute("POSITION") < 0) fail(fmt::format("{}: no POSITION attribute", what));
-        const std::vector<float> pos = floats(attribute("POSITION"), 3, (what + " POSITION").c_str(), false);
+        const std::vector<float> pos = floats(attribute("POSITION"), 3, what + " POSITION", false);
         const size_t n = pos.size() / 3;
         for (size_t i = 0; i < n; ++i) {
             const Vec3d w = to_world.point({pos[3 * i], pos[3 * i + 1], pos[3 * i + 2]});
@@ -303,12 +317,12 @@ void Converter::add_mesh(int node, int mesh_index, const Transform& to_world) {
             m.name = mesh.name;
             for (size_t i = 0; i < n; ++i) m.positions.push_back({pos[3 * i], pos[3 * i + 1], pos[3 * i + 2]});
             if (attribute("NORMAL") >= 0) {
-                const std::vector<float> nrm = floats(attribute("NORMAL"), 3, (what + " NORMAL").c_str(), false);
+                const std::vector<float> nrm = floats(attribute("NORMAL"), 3, what + " NORMAL", false);
                 if (nrm.size() != pos.size()) fail(fmt::format("{}: NORMAL and POSITION have different counts", what));
                 for (size_t i = 0; i < n; ++i) m.normals.push_back({nrm[3 * i], nrm[3 * i + 1], nrm[3 * i + 2]});
             }
             if (attribute("TEXCOORD_0") >= 0) {
-                const std::vector<float> uv = floats(attribute("TEXCOORD_0"), 2, (what + " TEXCOORD_0").c_str(), true);
+                const std::vector<float> uv = floats(attribute("TEXCOORD_0"), 2, what + " TEXCOORD_0", true);
                 if (uv.size() / 2 != n) fail(fmt::format("{}: TEXCOORD_0 and POSITION have different counts", what));
                 // glTF's v runs down the image from its top row, as Mitsuba's uv does: no flip.
                 for (size_t i = 0; i < n; ++i) m.uvs.push_back({uv[2 * i], uv[2 * i + 1]});
@@ -428,8 +442,7 @@ std::string Converter::derived_image(const std::string& name, const tinygltf::Im
     Image out(in.width, in.height);
     for (int y = 0; y < in.height; ++y)
         for (int x = 0; x < in.width; ++x) out.at(x, y) = texel(&in.rgb[(size_t(y) * size_t(in.width) + size_t(x)) * 3]);
-    const fs::path target = fs::path(xml_path_).parent_path() / files_dir_ / name;
-    write_image(out, target.string());
+    write_image(out, output_path(name));
     return files_dir_ + "/" + name;
 }
 

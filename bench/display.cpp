@@ -1,7 +1,8 @@
-// `pathlab_bench display` (part of `make bench`): what streaming to tev costs. Each algorithm
-// renders the scene at size x size for `seconds`, without and with a display server (a viewer
-// on 127.0.0.1 in this process that reads and checks every packet, as tev would), in
-// interleaved pairs; the figures are medians over the pairs: samples per second of each, their
+// `pathlab_bench display` (part of `make bench`): what streaming to tev and `pathlab view` cost.
+// Each algorithm renders the scene at size x size for `seconds`, without and with a display
+// server (a viewer on 127.0.0.1 in this process that reads and checks every packet, as tev
+// would), and in `pathlab view` with a client polling as its page does, in interleaved triples;
+// the figures are medians over them: samples per second of each, their
 // ratio (the overhead), the frames the viewer received, and the time from the render's start
 // (the scene already built) to the viewer holding the first complete image.
 #include "display.hpp"
@@ -19,9 +20,14 @@
 #include <fmt/format.h>
 
 #include "bench_common.hpp"
+#include <httplib.h>
+#include <nlohmann/json.hpp>
+
 #include "display/display_server.hpp"
 #include "job/render_job.hpp"
 #include "job/scene_choice.hpp"
+#include "view/view_server.hpp"
+#include "view/view_session.hpp"
 
 namespace pathlab::bench {
 namespace {
@@ -129,30 +135,75 @@ Run render(const SceneChoice& choice, std::shared_ptr<const Scene> scene, const 
     return run;
 }
 
+// The same render in `pathlab view` with the page open: a client that does what the page does
+// (state every 200 ms, the image whenever there is a new one) over HTTP on loopback.
+Run render_in_view(const SceneChoice& choice, const std::string& algorithm, const DisplayOptions& o, uint64_t seed) {
+    ViewSession::Options v;
+    v.scene = choice;
+    v.request.algorithm = algorithm;
+    v.request.width = v.request.height = o.size;
+    v.request.time_limit = o.seconds;
+    v.request.seed = seed;
+    ViewSession session(std::move(v));  // the scene built, the render started
+    const Clock::time_point start = Clock::now();
+    ViewServer server(session, "127.0.0.1", 0);
+    std::atomic<bool> stop{false};
+    Run run;
+    std::thread page([&] {
+        httplib::Client c("127.0.0.1", server.port());
+        uint64_t have = 0;
+        while (!stop) {
+            if (auto st = c.Get("/api/state")) {
+                const uint64_t now = nlohmann::json::parse(st->body)["slots"][0]["frame"];
+                if (now != have) {
+                    auto img = c.Get("/api/frame/a");
+                    if (img && img->status == 200) {
+                        if (run.frames++ == 0) run.first_image_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+                        have = std::stoull(img->get_header_value("X-Frame"));
+                    }
+                }
+            }
+            std::this_thread::sleep_for(std::chrono::milliseconds(200));
+        }
+    });
+    session.wait(0, o.seconds + 600);
+    stop = true;
+    page.join();
+    const ViewSlotState a = session.slot(0);
+    run.samples_per_second = a.frame && a.frame->seconds > 0 ? double(a.frame->samples) / a.frame->seconds : 0;
+    return run;
+}
+
 }  // namespace
 
 void display_suite(const DisplayOptions& o) {
     fmt::print("## Streaming to a viewer (--display-server)\n\n");
-    fmt::print("Scene {}, {}x{} pixels, {} s per render, {} interleaved pairs without and with a viewer on loopback that reads "
-               "every packet (medians; the image is sent after the first pass, then every 0.5 s, and at the end). First image: "
-               "from the render's start (scene built) to the viewer holding the whole first image.\n\n",
+    fmt::print("Scene {}, {}x{} pixels, {} s per render, {} interleaved triples: without a viewer, with a viewer on loopback "
+               "that reads every packet (the image is sent after the first pass, then every 0.5 s, and at the end), and in "
+               "pathlab view with a client that polls as its page does (state every 200 ms, each new image; the view publishes "
+               "every 0.25 s); medians. First image: from the render's start (scene built) to the viewer holding the whole first image.\n\n",
                o.scene, o.size, o.size, o.seconds, o.repeats);
-    fmt::print("| algorithm | Msamples/s without | Msamples/s with | with / without | frames received | first image (s) |\n");
-    fmt::print("|---|---|---|---|---|---|\n");
+    fmt::print("| algorithm | Msamples/s without | Msamples/s with | with / without | frames received | first image (s) | "
+               "Msamples/s in pathlab view, page open | view / without | view frames fetched | view first image (s) |\n");
+    fmt::print("|---|---|---|---|---|---|---|---|---|---|\n");
     const SceneChoice choice = resolve_scenes(o.scene).at(0);
     std::shared_ptr<const Scene> scene = Scene::build(choice.description);
     Viewer viewer;
     for (const std::string& algorithm : o.algorithms) {
-        std::vector<double> without, with, ratio, first, frames;
+        std::vector<double> without, with, ratio, first, frames, in_view, view_ratio, view_frames, view_first;
         for (int k = 0; k < o.repeats; ++k) {
             const Run a = render(choice, scene, algorithm, o, nullptr, uint64_t(k));
             const Run b = render(choice, scene, algorithm, o, &viewer, uint64_t(k));
+            const Run c = render_in_view(choice, algorithm, o, uint64_t(k));
             without.push_back(a.samples_per_second * 1e-6), with.push_back(b.samples_per_second * 1e-6);
             ratio.push_back(b.samples_per_second / a.samples_per_second);
             first.push_back(b.first_image_seconds), frames.push_back(double(b.frames));
+            in_view.push_back(c.samples_per_second * 1e-6), view_ratio.push_back(c.samples_per_second / a.samples_per_second);
+            view_frames.push_back(double(c.frames)), view_first.push_back(c.first_image_seconds);
         }
-        fmt::print("| {} | {:.3f} | {:.3f} | {:.3f} | {:.0f} | {:.3f} |\n", algorithm, median(without), median(with), median(ratio),
-                   median(frames), median(first));
+        fmt::print("| {} | {:.3f} | {:.3f} | {:.3f} | {:.0f} | {:.3f} | {:.3f} | {:.3f} | {:.0f} | {:.3f} |\n", algorithm, median(without),
+                   median(with), median(ratio), median(frames), median(first), median(in_view), median(view_ratio), median(view_frames),
+                   median(view_first));
     }
     fmt::print("\n");
 }

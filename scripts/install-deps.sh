@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Installs every Debian package pathlab needs to build and test.
 # Usage: scripts/install-deps.sh
-# Chromium is installed for the test that opens `pathlab report`'s HTML in a headless browser
-# (the test is skipped where /usr/bin/chromium is absent). pybind11, NumPy, pytest and
+# Chromium is installed for the tests that open `pathlab report`'s HTML and `pathlab view`'s page
+# in a headless browser (the view's through ChromeDriver and Selenium; both are skipped where
+# /usr/bin/chromium is absent). pybind11, NumPy, pytest and
 # matplotlib are for the Python module (python/), its tests and the example in examples/.
 set -euo pipefail
 
@@ -12,9 +13,9 @@ packages=(
   libcli11-dev libfmt-dev nlohmann-json3-dev libpugixml-dev libtinyobjloader-dev libnanoflann-dev
   libopenvdb-dev libassimp-dev libtinygltf-dev zlib1g-dev
   libgtest-dev libbenchmark-dev
-  libopenmpi-dev openmpi-bin libxxhash-dev
+  libopenmpi-dev openmpi-bin libxxhash-dev libcpp-httplib-dev
   pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib
-  chromium
+  chromium chromium-driver python3-selenium python3-pil
 )
 
 missing=()

@@ -11,6 +11,7 @@
 #include "app/render_command.hpp"
 #include "app/resumed_command.hpp"
 #include "app/tool_commands.hpp"
+#include "app/view_command.hpp"
 #include "job/checkpoint.hpp"
 #include "job/rank_group.hpp"
 #include "job/usage_error.hpp"
@@ -87,6 +88,8 @@ int run_cli(int argc, const char* const* argv, RankGroup* ranks, bool resuming) 
     CLI::App* gradient_cmd = add_gradient_command(app, gradient_opt);
     OptimizeOptions optimize_opt;
     CLI::App* optimize_cmd = add_optimize_command(app, optimize_opt);
+    ViewOptions view_opt;
+    CLI::App* view_cmd = add_view_command(app, view_opt);
 
     // No arguments: the usage, not a render of everything.
     if (argc <= 1) {
@@ -163,6 +166,7 @@ int run_cli(int argc, const char* const* argv, RankGroup* ranks, bool resuming) 
         if (*params_cmd) return run_params_command(params_opt);
         if (*gradient_cmd) return run_gradient_command(gradient_opt);
         if (*optimize_cmd) return run_optimize_command(optimize_opt);
+        if (*view_cmd) return run_view_command(view_opt);
         return run_render_command(render_opt, ranks);
     } catch (const UsageError& e) {
         fmt::print(stderr, "pathlab: {}\n", e.what());

@@ -105,6 +105,11 @@ public:
 
     const SceneChoice& scene_choice() const { return choice_; }
     const Scene& scene();
+    // The same scene, built if needed, to share with other jobs (the constructor above).
+    std::shared_ptr<const Scene> shared_scene() {
+        scene();
+        return scene_;
+    }
     const IntegratorInfo& integrator_info() const { return *info_; }
     // The integrator is made when first needed, so its options may still be changed before.
     Integrator& integrator();

@@ -36,6 +36,7 @@
 #include "app/resumed_command.hpp"
 #include "image/image_io.hpp"
 #include "integrators/integrator.hpp"
+#include "job/extra_channels.hpp"
 #include "job/job_checkpoint.hpp"
 #include "job/render_identity.hpp"
 #include "job/render_job.hpp"
@@ -334,7 +335,7 @@ py::tuple py_render(const py::object& scene_obj, const py::object& algorithm, co
                  const py::object& threads_arg, double time, const py::object& resolution, const py::object& max_depth_arg,
                  const py::object& sampler, bool spectral, const py::object& rr_depth_arg, const py::object& light_sampler,
                  const py::object& ris_candidates_arg, const py::object& first_sample_arg, const py::object& checkpoint_arg,
-                 double checkpoint_every, const py::object& resume_arg, const py::kwargs& estimator_options) {
+                 double checkpoint_every, const py::object& resume_arg, const py::object& aovs_arg, const py::kwargs& estimator_options) {
     constexpr int kIntMax = std::numeric_limits<int>::max();
     // As the command line: sample indices from 2^62 on are refused (such a render never ends);
     // first_sample + spp past them are refused by RenderJob, with the command line's message.
@@ -383,6 +384,12 @@ py::tuple py_render(const py::object& scene_obj, const py::object& algorithm, co
     // --first-sample and --checkpoint-every: RenderJob checks them, as for the command line.
     request.first_sample = first_sample;
     request.checkpoint_every = checkpoint_every;
+    // aovs: a list of names or a comma-separated string, as --aovs.
+    if (!aovs_arg.is_none()) {
+        request.aovs = py::isinstance<py::str>(aovs_arg) ? split_comma_list(aovs_arg.cast<std::string>()) : aovs_arg.cast<std::vector<std::string>>();
+        if (!checkpoint_pattern.empty() || !resume_pattern.empty() || first_sample != 0)
+            throw py::value_error("aovs cannot be checkpointed, resumed or split by first_sample yet: render them in one go");
+    }
 
     // The scene's BVH is built once and shared by its renders with the default light sampler in
     // RGB; another light sampler, or spectral mode (which checks the scene's materials first),
@@ -448,7 +455,22 @@ py::tuple py_render(const py::object& scene_obj, const py::object& algorithm, co
         PyErr_SetString(PyExc_OSError, why.c_str());
         throw py::error_already_set();
     }
-    return py::make_tuple(to_array(film.mean()), to_array(film.standard_error()));
+    if (request.aovs.empty()) return py::make_tuple(to_array(film.mean()), to_array(film.standard_error()));
+    // The AOVs as the EXR's layers hold them, one array per name: (height, width, channels), or
+    // (height, width) for depth and sample-count.
+    py::dict aovs;
+    const size_t pixels = film.pixel_count();
+    for (const std::string& name : request.aovs) {
+        const std::vector<ExrChannel> channels = render_aov_channels({name}, film, job->aov_film());
+        const size_t k = channels.size();
+        py::array_t<float> a = k == 1 ? py::array_t<float>({film.height(), film.width()})
+                                      : py::array_t<float>({size_t(film.height()), size_t(film.width()), k});
+        float* out = a.mutable_data();
+        for (size_t i = 0; i < pixels; ++i)
+            for (size_t c = 0; c < k; ++c) out[i * k + c] = channels[c].values[i];
+        aovs[py::str(name)] = a;
+    }
+    return py::make_tuple(to_array(film.mean()), to_array(film.standard_error()), aovs);
 }
 
 // nlohmann::json -> Python objects.
@@ -675,6 +697,7 @@ PYBIND11_MODULE(pathlab, m) {
           py::arg("sampler") = "independent", py::arg("spectral") = false, py::arg("rr_depth") = py::none(),
           py::arg("light_sampler") = py::none(), py::arg("ris_candidates") = py::none(), py::arg("first_sample") = py::int_(0),
           py::arg("checkpoint") = py::none(), py::arg("checkpoint_every") = kDefaultCheckpointEvery, py::arg("resume") = py::none(),
+          py::arg("aovs") = py::none(),
           "Renders a scene (a pathlab.Scene, or what load() takes) and returns (image, standard_error), float32 arrays of shape\n"
           "(height, width, 3). As the command line: algorithm defaults to the scene file's integrator, else pt-mis; spp to the\n"
           "scene file's sample count, else 64 (unlimited with time=seconds); seed to 1234; threads=0 uses all cores. The same\n"
@@ -688,7 +711,9 @@ PYBIND11_MODULE(pathlab, m) {
           "the render's whole state every checkpoint_every seconds (default 300; 0: only at the end), at the end and on Ctrl-C;\n"
           "resume=FILE continues such a checkpoint (the same scene and settings; spp may be raised) and goes on checkpointing\n"
           "to it. The files are the command line's: `pathlab --resume FILE` continues a checkpoint written here, and resume=\n"
-          "one the command line wrote, to the bytes of the render never interrupted.");
+          "one the command line wrote, to the bytes of the render never interrupted. aovs=['albedo', 'normal', 'depth', 'position',\n"
+          "'variance', 'sample-count'] (or a comma-separated string) is --aovs: the result is then (image, standard_error, aovs),\n"
+          "aovs a dict of arrays, (height, width, 3) or (height, width) for depth and sample-count.");
     m.def("compare", [](const py::object& a, const py::object& b) {
         const Image ia = to_image(a, "a"), ib = to_image(b, "b");
         if (ia.width() != ib.width() || ia.height() != ib.height())

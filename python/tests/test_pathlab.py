@@ -159,6 +159,24 @@ def test_render_equals_the_command_line_bit_for_bit(tmp_path, scene, algorithm, 
     assert same_bits(img, again)
 
 
+def test_aovs_as_arrays_equal_the_command_lines_layers(tmp_path):
+    out = tmp_path / "aovs.exr"
+    cli("3", "--spp", 3, "--seed", 77, "--resolution", "20x14", "-q", "-o", out, "--aovs", "albedo,depth,variance,sample-count")
+    img, stderr, aovs = pathlab.render(3, "pt-mis", spp=3, seed=77, resolution=(20, 14), aovs=["albedo", "depth", "variance", "sample-count"])
+    layers = read_exr_channels(str(out))
+    assert sorted(aovs) == ["albedo", "depth", "sample-count", "variance"]
+    assert aovs["albedo"].shape == (14, 20, 3) and aovs["depth"].shape == (14, 20)
+    assert same_bits(aovs["albedo"], np.stack([layers["Albedo.R"], layers["Albedo.G"], layers["Albedo.B"]], axis=-1))
+    assert same_bits(aovs["depth"], layers["Z"])
+    assert same_bits(aovs["variance"], np.stack([layers["Variance.R"], layers["Variance.G"], layers["Variance.B"]], axis=-1))
+    assert (aovs["sample-count"] == 3).all()
+    assert same_bits(img, pathlab.render(3, "pt-mis", spp=3, seed=77, resolution=(20, 14))[0])  # the image is the same with them
+    with pytest.raises(ValueError, match="lt has no camera samples"):
+        pathlab.render(3, "lt", spp=1, resolution=(4, 4), aovs="albedo")
+    with pytest.raises(ValueError, match="unknown AOV 'shadow'"):
+        pathlab.render(3, "pt-mis", spp=1, resolution=(4, 4), aovs="shadow")
+
+
 def test_estimator_options_are_refused_as_on_the_command_line():
     with pytest.raises(ValueError, match="--photons sets the light paths of sppm, ppm and pm; pt-mis has no such count"):
         pathlab.render(3, "pt-mis", spp=1, resolution=(4, 4), photons=100)

@@ -171,6 +171,10 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
     app.add_option("--first-sample", o.first_sample,
                    "Index of the first sample (pass) to render: renders of disjoint ranges add up, with `pathlab merge`, to one render")
         ->capture_default_str();
+    app.add_option("--aovs", o.aovs,
+                   "Auxiliary images as layers of the EXR output, from the render's own samples: albedo, normal, depth, position "
+                   "(at each sample's first non-specular vertex, through mirrors and glass; pixel integrators), variance, "
+                   "sample-count (every integrator); comma-separated");
     app.add_option("--display-server", o.display_server,
                    fmt::format("Show the render as it converges in a running tev (its HOST:PORT; port {} when only HOST is "
                                "given): the image is sent after the first pass and then twice a second. An unreachable viewer "
@@ -246,6 +250,15 @@ std::vector<RenderJob> make_jobs(const RenderCommandOptions& o, bool check_paths
     request.mlt_large_step = o.mlt_large_step;
     request.mlt_sigma = o.mlt_sigma;
     request.checkpoint_every = o.checkpoint_every;
+    if (!o.aovs.empty()) {
+        request.aovs = split_comma_list(o.aovs);
+        // The AOV sums are neither in checkpoints nor reduced across processes.
+        if (!o.checkpoint.empty() || !o.resume.empty()) throw UsageError("--aovs cannot be checkpointed yet: render it without --checkpoint and --resume");
+        if (distributed) throw UsageError("--aovs are recorded in one process: render them without mpirun");
+        if (o.first_sample != 0) throw UsageError("--aovs with --first-sample: the AOVs of parts cannot be merged yet; render them in one go");
+        const bool exr = std::any_of(o.outputs.begin(), o.outputs.end(), [](const std::string& p) { return image_format_for(p) == ImageFormat::Exr; });
+        if (!o.outputs.empty() && !exr) throw UsageError("--aovs are written as layers of an EXR: give an -o ending in .exr");
+    }
     if (!o.display_server.empty() && !parse_display_address(o.display_server))
         throw UsageError(fmt::format("--display-server: '{}' is not HOST, HOST:PORT or [IPv6]:PORT (a port from 1 to 65535)",
                                      o.display_server));
@@ -307,7 +320,7 @@ std::vector<RenderJob> make_jobs(const RenderCommandOptions& o, bool check_paths
         // Without -o, the scene file's hdrfilm file_format chooses the HDR output's format.
         const std::string& format = jobs[j].scene_choice().description.file_format;
         for (std::string p : patterns) {
-            if (o.outputs.empty() && p.ends_with(".exr") && format != "openexr")
+            if (o.outputs.empty() && p.ends_with(".exr") && format != "openexr" && o.aovs.empty())  // (the AOVs need the EXR)
                 p = p.substr(0, p.size() - 4) + (format == "rgbe" ? ".hdr" : ".pfm");
             jobs[j].outputs.push_back(jobs[j].expand(p));
         }

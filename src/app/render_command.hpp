@@ -65,6 +65,7 @@ struct RenderCommandOptions {
     std::string resume;              // --resume FILE
     uint64_t first_sample = 0;       // --first-sample N
     std::string display_server;      // --display-server HOST[:PORT] (tev)
+    std::string aovs;                // --aovs albedo,normal,... (EXR layers)
     std::optional<int> mlt_chains;         // --chains (pssmlt)
     std::optional<int> mlt_bootstrap;      // --bootstrap
     std::optional<float> mlt_large_step;   // --large-step

@@ -38,10 +38,12 @@
 
 #include "cameras/camera.hpp"
 #include "core/properties.hpp"
+#include "render/aov_film.hpp"
 #include "render/film.hpp"
 #include "render/pixel_filter.hpp"
 #include "samplers/sampler.hpp"
 #include "scene/scene.hpp"
+#include "integrators/common/first_vertex.hpp"
 #include "integrators/common/transport.hpp"
 
 namespace pathlab {
@@ -115,6 +117,9 @@ struct RenderContext {
     int tile_size = 32;  // largest tile edge for pixel integrators (smaller when there are few tiles)
     // The reconstruction filter (render/pixel_filter.hpp); null or box: each sample in its own pixel.
     const PixelFilter* filter = nullptr;
+    // --aovs: the first non-specular vertex of every camera sample, summed per pixel (pixel
+    // integrators only: records_aovs()); null: none.
+    AovFilm* aovs = nullptr;
 
     size_t pixel_count() const { return size_t(width) * size_t(height); }
 };
@@ -158,6 +163,8 @@ public:
     virtual void finish(const RenderContext&) {}
     // Its own figures, for the summary line and --stats.
     virtual std::vector<IntegratorStatistic> statistics() const { return {}; }
+    // Whether it fills RenderContext::aovs from its camera samples (the pixel integrators).
+    virtual bool records_aovs() const { return false; }
 };
 
 // Today's per-pixel estimators: one Monte Carlo estimate of the radiance arriving along a
@@ -172,13 +179,22 @@ public:
     virtual ColourOf<T> radiance(const Scene& scene, const Ray& ray, Sampler& sampler, WavelengthsOf<T>& wl) const = 0;
     PassCounters render_passes(const RenderContext& ctx, Film& film, uint64_t first, int count,
                                const PassProgress& progress) final;
+    bool records_aovs() const final { return true; }
 
 private:
     PassCounters render_filtered_passes(const RenderContext& ctx, Film& film, uint64_t first, int count, const PassProgress& progress);
-    // One camera sample's colour for the film.
-    Vec3d sample_colour(const RenderContext& ctx, const Ray& ray, Sampler& sampler) const {
+    // One camera sample's colour for the film (and with --aovs, its first vertex for pixel `pixel`).
+    Vec3d sample_colour(const RenderContext& ctx, const Ray& ray, Sampler& sampler, size_t pixel) const {
         WavelengthsOf<T> wl = T::camera_wavelengths(sampler);
-        return film_colour(radiance(ctx.scene, ray, sampler, wl), wl);
+        if (!ctx.aovs) return film_colour(radiance(ctx.scene, ray, sampler, wl), wl);
+        FirstVertexRecorder recorder;
+        Vec3d L;
+        {
+            FirstVertexScope scope(recorder, ray.o);
+            L = film_colour(radiance(ctx.scene, ray, sampler, wl), wl);
+        }
+        ctx.aovs->add(pixel, recorder.vertex);
+        return L;
     }
     std::vector<Vec3d> lattice_, filtered_;  // a filtered pass (pixel_filter.hpp)
 };

@@ -38,7 +38,7 @@ PassCounters PixelIntegrator<T>::render_passes(const RenderContext& ctx, Film& f
                         Sampler sampler(ctx.seed, pixel, first + uint64_t(k), ctx.sampler);
                         const Vec2f jitter = sampler.next2d();
                         const Ray ray = camera_ray(ctx.camera, float(x) + jitter.x, float(y) + jitter.y, sampler);
-                        const Vec3d L = sample_colour(ctx, ray, sampler);
+                        const Vec3d L = sample_colour(ctx, ray, sampler, pixel);
                         if (is_finite(L)) film.add(pixel, L);
                         else ++tile_invalid;
                     }
@@ -78,7 +78,7 @@ PassCounters PixelIntegrator<T>::render_filtered_passes(const RenderContext& ctx
                         sampler.next2d();  // the unfiltered render's jitter
                         const float sx = float(x) + shift.x, sy = float(y) + shift.y;
                         const Ray ray = camera_ray(ctx.camera, sx, sy, sampler);
-                        const Vec3d L = sample_colour(ctx, ray, sampler);
+                        const Vec3d L = sample_colour(ctx, ray, sampler, pixel);
                         if (is_finite(L)) {
                             lattice_[pixel] = L;
                         } else {

@@ -76,4 +76,30 @@ std::vector<ExrChannel> aov_channels(const Scene& scene, const std::vector<std::
     return out;
 }
 
+std::vector<ExrChannel> render_aov_channels(const std::vector<std::string>& aovs, const Film& film, const AovFilm* first) {
+    const size_t pixels = film.pixel_count();
+    std::vector<ExrChannel> out;
+    for (const std::string& aov : aovs) {
+        const std::vector<std::string> names = aov_channel_names(aov);
+        for (size_t c = 0; c < names.size(); ++c) {
+            ExrChannel ch{names[c], std::vector<float>(pixels)};
+            for (size_t i = 0; i < pixels; ++i) {
+                if (aov == "variance") {
+                    const double n = double(film.count(i));
+                    if (n < 2) continue;
+                    const double sum = film.sum(i)[int(c)], sumsq = film.sum_of_squares(i)[int(c)];
+                    ch.values[i] = float(std::max(0.0, (sumsq - sum * sum / n) / (n - 1)));
+                } else if (aov == "sample-count") {
+                    ch.values[i] = float(film.count(i));
+                } else {
+                    const int base = aov == "albedo" ? 0 : aov == "normal" ? 3 : aov == "position" ? 6 : 9;
+                    ch.values[i] = first ? first->mean(i, base + int(c)) : 0.0f;
+                }
+            }
+            out.push_back(std::move(ch));
+        }
+    }
+    return out;
+}
+
 }  // namespace pathlab

@@ -251,6 +251,18 @@ RenderJob::RenderJob(SceneChoice scene, const JobRequest& r) : choice_(std::move
     options_.pbgi_spacing = r.pbgi_spacing ? *r.pbgi_spacing : d.pbgi_spacing.value_or(options_.pbgi_spacing);
     options_.hide_emitters = d.hide_emitters.value_or(false);
     if (const std::string why = integrator_refusal(*info_, d, r); !why.empty()) throw UsageError(why);
+    for (size_t i = 0; i < r.aovs.size(); ++i) {
+        const std::vector<std::string>& names = aov_names();
+        if (std::find(names.begin(), names.end(), r.aovs[i]) == names.end())
+            throw UsageError(fmt::format("unknown AOV '{}'. Valid AOVs: {}", r.aovs[i], fmt::join(names, ", ")));
+        if (std::find(r.aovs.begin(), r.aovs.begin() + long(i), r.aovs[i]) != r.aovs.begin() + long(i))
+            throw UsageError(fmt::format("--aovs names {} twice", r.aovs[i]));
+    }
+    aovs_ = r.aovs;
+    if (aovs_need_first_vertex(aovs_) && !info_->make(IntegratorOptions{})->records_aovs())
+        throw UsageError(fmt::format("--aovs {}: {} has no camera samples to take them from (it traces light paths); "
+                                     "these come with: {} (variance and sample-count come with every integrator)",
+                                     fmt::join(aovs_, ","), info_->name, aov_integrator_names()));
     if (const std::string why = option_refusal(*info_, r); !why.empty()) throw UsageError(why);
     options_.mlt_chains = r.mlt_chains.value_or(options_.mlt_chains);
     options_.guiding_spp = r.guiding_spp ? *r.guiding_spp : d.guiding_spp.value_or(options_.guiding_spp);
@@ -342,9 +354,33 @@ Integrator& RenderJob::integrator() {
     return *integrator_;
 }
 
-RenderResult RenderJob::run() { return render(scene(), integrator(), settings); }
+std::string aov_integrator_names() {
+    static const std::string names = [] {
+        std::vector<std::string> v;
+        for (const IntegratorInfo& info : integrators())
+            if (info.make(IntegratorOptions{})->records_aovs()) v.push_back(info.name);
+        return fmt::format("{}", fmt::join(v, ", "));
+    }();
+    return names;
+}
 
-RenderStats RenderJob::run_into(Film& film) { return render_into(scene(), integrator(), settings, film); }
+void RenderJob::prepare_aov_film(int width, int height) {
+    settings.aovs = nullptr;
+    if (!aovs_need_first_vertex(aovs_)) return;
+    aov_film_ = std::make_unique<AovFilm>(width, height);
+    settings.aovs = aov_film_.get();
+}
+
+RenderResult RenderJob::run() {
+    const Scene& s = scene();
+    prepare_aov_film(settings.width > 0 ? settings.width : s.default_width(), settings.height > 0 ? settings.height : s.default_height());
+    return render(s, integrator(), settings);
+}
+
+RenderStats RenderJob::run_into(Film& film) {
+    prepare_aov_film(film.width(), film.height());
+    return render_into(scene(), integrator(), settings, film);
+}
 
 std::string RenderJob::expand(const std::string& pattern) const {
     try {
@@ -383,6 +419,7 @@ void RenderJob::write_outputs(const RenderResult& result, float exposure,
     // integrators' channels.
     ExrExtras extras{{{"stderr", result.film.standard_error()}}, attributes, {}};
     if (d.moment) extras.channels = moment_channels(result.film);
+    for (ExrChannel& c : render_aov_channels(aovs_, result.film, aov_film_.get())) extras.channels.push_back(std::move(c));
     if (!d.aovs.empty()) {
         std::vector<ExrChannel> a = aov_channels(*scene_, d.aovs, result.film.width(), result.film.height(), result.stats.spp, settings.seed);
         for (ExrChannel& c : a) extras.channels.push_back(std::move(c));

@@ -71,6 +71,7 @@ struct JobRequest {
     std::optional<int> mlt_bootstrap;               // --bootstrap (pssmlt)
     std::optional<float> mlt_large_step;            // --large-step (pssmlt)
     std::optional<float> mlt_sigma;                 // --sigma (pssmlt)
+    std::vector<std::string> aovs;                  // --aovs (render/aov_film.hpp's names), as EXR layers
 };
 
 // The integrator `name` (or an alias); a UsageError listing them all otherwise.
@@ -125,6 +126,8 @@ public:
     // Output files (patterns already expanded), written by write_outputs().
     std::vector<std::string> outputs;
 
+    // With --aovs, also fills aov_film() (created for the render's size; a continued render's
+    // earlier passes are not in it).
     RenderResult run();
     // Continues a render into `film` (see render_into); settings.first_sample says where.
     RenderStats run_into(Film& film);
@@ -136,6 +139,10 @@ public:
     // (render_metadata in job/render_identity.hpp).
     void write_outputs(const RenderResult& result, float exposure = 0,
                        const std::vector<std::pair<std::string, std::string>>& attributes = {}) const;
+    // --aovs: the names asked for, and the first-vertex sums of the last run (null when none
+    // of them needs the first vertex, or before a run).
+    const std::vector<std::string>& aovs() const { return aovs_; }
+    const AovFilm* aov_film() const { return aov_film_.get(); }
 
 private:
     SceneChoice choice_;
@@ -143,6 +150,12 @@ private:
     const IntegratorInfo* info_ = nullptr;
     IntegratorOptions options_;
     std::unique_ptr<Integrator> integrator_;
+    std::vector<std::string> aovs_;
+    std::unique_ptr<AovFilm> aov_film_;
+    void prepare_aov_film(int width, int height);
 };
+
+// The integrators that record the first-vertex AOVs (albedo, normal, depth, position): the pixel integrators.
+std::string aov_integrator_names();
 
 }  // namespace pathlab

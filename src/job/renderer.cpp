@@ -54,6 +54,12 @@ RenderStats render_into(const Scene& scene, Integrator& integrator, const Render
         throw std::invalid_argument(fmt::format("the film is {}x{}, the render {}x{}", film.width(), film.height(), w, h));
     if (settings.spp <= 0 && settings.time_limit <= 0)
         throw std::invalid_argument("a render needs a positive sample count or time limit");
+    if (settings.aovs) {
+        if (settings.aovs->width() != w || settings.aovs->height() != h)
+            throw std::invalid_argument(fmt::format("the AOV film is {}x{}, the render {}x{}", settings.aovs->width(), settings.aovs->height(), w, h));
+        if (!integrator.records_aovs()) throw std::invalid_argument("this integrator records no AOVs");
+        if (settings.ranks && settings.ranks->size() > 1) throw std::invalid_argument("AOVs are recorded in one process only");
+    }
     const uint64_t first = settings.first_sample;
     if (settings.spp > UINT64_MAX - first) throw std::invalid_argument(fmt::format("sample indices {} + {} wrap round", first, settings.spp));
     const PassSet target = settings.spp > 0 ? PassSet::range(first, first + settings.spp) : PassSet::range(first, UINT64_MAX);
@@ -66,7 +72,7 @@ RenderStats render_into(const Scene& scene, Integrator& integrator, const Render
     const int rank_count = ranks.size(), me = ranks.rank();
     const PerspectiveCamera camera(scene.camera(), w, h);
     const PixelFilter filter(scene.description().filter, w, h);
-    const RenderContext ctx{scene, camera, w, h, settings.seed, settings.sampler, settings.tile_size, &filter};
+    const RenderContext ctx{scene, camera, w, h, settings.seed, settings.sampler, settings.tile_size, &filter, settings.aovs};
     const bool show_progress = settings.progress && ranks.root();
     Progress progress(show_progress);
     const auto start = std::chrono::steady_clock::now();

@@ -79,6 +79,11 @@ struct RenderSettings {
     std::function<void(const Film&, const RenderStats&)> display;
     double display_every = 0.5;
 
+    // --aovs: the integrator's camera samples' first vertices, summed into this film of the
+    // render's size (render/aov_film.hpp); null: none. Only a pixel integrator records them, and
+    // only in one process (the film is not reduced across ranks).
+    AovFilm* aovs = nullptr;
+
     // The processes rendering this image together; null: this one alone.
     RankGroup* ranks = nullptr;
     // Passes the film already holds (a resumed checkpoint; only the root's film holds them),

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "core/frame.hpp"
+#include "integrators/common/first_vertex.hpp"
 #include "scene/scene.hpp"
 
 namespace pathlab {
@@ -51,6 +52,8 @@ inline ShadingPoint make_shading_point(const Scene& scene, const Intersection& h
     else
         sp.frame = Frame(ns);
     sp.wi = sp.frame.to_local(-ray_dir);
+    if (FirstVertexRecorder* r = t_first_vertex) [[unlikely]]  // a camera sample with --aovs
+        offer_surface_vertex(*r, scene, sp);
     return sp;
 }
 

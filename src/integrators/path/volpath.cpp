@@ -64,6 +64,8 @@ public:
                 v.hit = &w;
                 v.p = sp.p;
             } else {
+                if (FirstVertexRecorder* r = t_first_vertex) [[unlikely]]  // a camera sample with --aovs
+                    offer_medium_vertex(*r, scene, w.medium, w.p);
                 v.p = w.p;
                 v.wi = -w.dir / length(w.dir);
                 v.phase = &medium_phase(scene.medium(w.medium));

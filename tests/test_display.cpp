@@ -5,6 +5,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -139,6 +140,32 @@ TEST_F(Display, StreamsThePathTracersAndTheSplattingImagesAsWritten) {
         const std::vector<std::string> got = wait_for(tev, 1);
         ASSERT_EQ(got.size(), 1u);
         check_stream(got[0], read_image(path("with.pfm")), std::string("box-diffuse / ") + algorithm);
+    }
+}
+
+TEST_F(Display, AovsGoAsExtraLayers) {
+    FakeTev tev;
+    const CliResult r = run({"--scene", "4", "--spp", "4", "--resolution", "12x10", "-q", "--aovs", "albedo,sample-count", "-o",
+                             path("aovs.exr"), "--display-server", tev.address()});
+    ASSERT_EQ(r.code, 0) << r.err;
+    const std::vector<std::string> got = wait_for(tev, 1);
+    ASSERT_EQ(got.size(), 1u);
+    const std::vector<TevPacket> ps = parse_packets(got[0]);
+    ASSERT_GE(ps.size(), 2u);
+    const std::vector<std::string> channels = {"R", "G", "B", "Albedo.R", "Albedo.G", "Albedo.B", "SampleCount"};
+    EXPECT_EQ(ps[0].channels, channels);
+    ExrExtras extras;
+    const Image image = read_exr(path("aovs.exr"), extras);
+    const auto albedo = std::find_if(extras.layers.begin(), extras.layers.end(), [](const auto& l) { return l.first == "Albedo"; });
+    ASSERT_NE(albedo, extras.layers.end());
+    const TevPacket& last = ps.back();
+    ASSERT_EQ(last.channels, channels);
+    for (size_t i = 0; i < image.pixel_count(); ++i) {
+        for (int c = 0; c < 3; ++c) {
+            ASSERT_EQ(last.data[size_t(c)][i], image[i][c]);
+            ASSERT_EQ(last.data[size_t(3 + c)][i], albedo->second[i][c]) << "pixel " << i;
+        }
+        ASSERT_EQ(last.data[6][i], 4.0f);
     }
 }
 

@@ -16,6 +16,7 @@
 #include "display/tev_protocol.hpp"
 #include "job/usage_error.hpp"
 #include "image/image_io.hpp"
+#include "job/extra_channels.hpp"
 #include "integrators/bidir/strategy_images.hpp"
 #include "integrators/common/path_rules.hpp"
 #include "job/output_paths.hpp"
@@ -465,8 +466,13 @@ int run_render_command(const RenderCommandOptions& o, RankGroup* ranks) {
         if (!o.display_server.empty()) {
             // Every rank takes part in summing the films for it; the root sends the sum.
             const std::string title = job.scene_choice().name + " / " + job.integrator_info().name;
-            job.settings.display = [&display, title](const Film& film, const RenderStats&) {
-                if (display) display->post(film_frame(title, film));
+            // With --aovs, their layers too (the display is called between rounds, when no
+            // pass is adding to the AOV film).
+            job.settings.display = [&display, &job, title](const Film& film, const RenderStats&) {
+                if (!display) return;
+                DisplayFrame frame = film_frame(title, film);
+                add_frame_channels(frame, render_aov_channels(job.aovs(), film, job.aov_film()));
+                display->post(std::move(frame));
             };
         }
         if (show_progress) fmt::print(stderr, "{} / {}\n", job.scene_choice().name, job.integrator_info().name);

@@ -25,6 +25,18 @@ DisplayFrame film_frame(const std::string& name, const Film& film) {
     return {name, film.width(), film.height(), {"R", "G", "B"}, std::vector<float>(mean.data(), mean.data() + 3 * mean.pixel_count())};
 }
 
+void add_frame_channels(DisplayFrame& frame, const std::vector<ExrChannel>& channels) {
+    if (channels.empty()) return;
+    const size_t pixels = size_t(frame.width) * size_t(frame.height), before = frame.channels.size(), after = before + channels.size();
+    std::vector<float> out(pixels * after);
+    for (size_t i = 0; i < pixels; ++i) {
+        std::copy_n(frame.pixels.data() + i * before, before, out.data() + i * after);
+        for (size_t c = 0; c < channels.size(); ++c) out[i * after + before + c] = channels[c].values.at(i);
+    }
+    for (const ExrChannel& c : channels) frame.channels.push_back(c.name);
+    frame.pixels = std::move(out);
+}
+
 std::optional<DisplayAddress> parse_display_address(const std::string& text) {
     DisplayAddress a;
     std::string port;

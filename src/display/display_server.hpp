@@ -18,6 +18,8 @@
 #include <thread>
 #include <vector>
 
+#include "image/image_io.hpp"
+
 namespace pathlab {
 
 // One picture for the viewer: width x height pixels of channels.size() interleaved floats.
@@ -32,6 +34,9 @@ class Film;
 // The film's current estimate (its mean: the splatting integrators' passes included, normalised
 // by the passes so far) as channels R, G, B.
 DisplayFrame film_frame(const std::string& name, const Film& film);
+// Appends channels (each width x height values, e.g. the --aovs layers) to the frame, interleaved
+// after its own, as extra layers in tev ("Albedo.R" goes in the layer Albedo).
+void add_frame_channels(DisplayFrame& frame, const std::vector<ExrChannel>& channels);
 
 struct DisplayAddress {
     std::string host;

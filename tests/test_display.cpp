@@ -169,6 +169,29 @@ TEST_F(Display, AovsGoAsExtraLayers) {
     }
 }
 
+TEST_F(Display, BdptsStrategyImagesGoAsExtraLayers) {
+    FakeTev tev;
+    const CliResult r = run({"--scene", "4", "-a", "bdpt", "--spp", "3", "--resolution", "10x8", "-q", "--strategies", path("st"),
+                             "--strategies-depth", "1", "-o", path("b.pfm"), "--display-server", tev.address()});
+    ASSERT_EQ(r.code, 0) << r.err;
+    const std::vector<std::string> got = wait_for(tev, 1);
+    ASSERT_EQ(got.size(), 1u);
+    const std::vector<TevPacket> ps = parse_packets(got[0]);
+    ASSERT_GE(ps.size(), 2u);
+    // Paths of 0 and 1 bounces: (s, t) = (0, 2); (0, 3), (1, 2), (2, 1) (s = t = 1 is not a strategy).
+    std::vector<std::string> channels = {"R", "G", "B"};
+    for (const char* st : {"n0-s0-t2", "n1-s0-t3", "n1-s1-t2", "n1-s2-t1"})
+        for (const char* c : {".R", ".G", ".B"}) channels.push_back(std::string(st) + c);
+    const TevPacket& last = ps.back();
+    EXPECT_EQ(ps[0].channels, channels);
+    EXPECT_EQ(last.channels, channels);
+    // The strategy images written at the end are the last frame's layers.
+    const Image s12 = read_image(path("st/n1-s1-t2-weighted.exr"));
+    const auto at = std::find(last.channels.begin(), last.channels.end(), "n1-s1-t2.G");
+    ASSERT_NE(at, last.channels.end());
+    for (size_t i = 0; i < s12.pixel_count(); ++i) ASSERT_EQ(last.data[size_t(at - last.channels.begin())][i], s12[i][1]);
+}
+
 TEST_F(Display, AViewerThatGoesAwayOrIsNotThereChangesNothing) {
     const std::vector<std::string> common = {"--scene", "4", "-a", "pt-mis", "--spp", "8", "--resolution", "24x16", "-q"};
     std::vector<std::string> reference = common;

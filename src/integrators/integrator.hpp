@@ -38,6 +38,7 @@
 
 #include "cameras/camera.hpp"
 #include "core/properties.hpp"
+#include "image/image_io.hpp"
 #include "render/aov_film.hpp"
 #include "render/film.hpp"
 #include "render/pixel_filter.hpp"
@@ -165,6 +166,10 @@ public:
     virtual std::vector<IntegratorStatistic> statistics() const { return {}; }
     // Whether it fills RenderContext::aovs from its camera samples (the pixel integrators).
     virtual bool records_aovs() const { return false; }
+    // Images of its own to show beside the image as it converges (--display-server; bdpt's
+    // per-strategy images with --strategies), as channels of the film's size. Called between
+    // passes.
+    virtual std::vector<ExrChannel> display_channels() const { return {}; }
 };
 
 // Today's per-pixel estimators: one Monte Carlo estimate of the radiance arriving along a

@@ -549,6 +549,11 @@ PassCounters Bdpt<T>::render_passes(const RenderContext& ctx, Film& film, uint64
 }
 
 template <class T>
+std::vector<ExrChannel> Bdpt<T>::display_channels() const {
+    return strategies_ ? strategies_->weighted_channels() : std::vector<ExrChannel>{};
+}
+
+template <class T>
 void Bdpt<T>::finish(const RenderContext&) {
     if (strategies_) strategies_->write();
 }

@@ -202,6 +202,8 @@ public:
 
     // The per-strategy films (null without --strategies).
     const StrategyImages* strategy_images() const { return strategies_.get(); }
+    // The weighted per-strategy images so far (with --strategies), for the viewer.
+    std::vector<ExrChannel> display_channels() const override;
 
     int max_camera_vertices() const { return max_bounces_ + 2; }
     int max_light_vertices() const { return max_bounces_ + 1; }

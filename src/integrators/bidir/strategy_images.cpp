@@ -54,6 +54,23 @@ void StrategyImages::finish_pass() {
     }
 }
 
+std::vector<ExrChannel> StrategyImages::weighted_channels() const {
+    std::vector<ExrChannel> out;
+    if (weighted_.empty()) return out;
+    for (int n = 0; n <= max_length_; ++n)
+        for (int s = 0; s <= n + 1; ++s) {
+            const int t = n + 2 - s;
+            if (s == 1 && t == 1) continue;
+            const Image mean = weighted_[size_t(index(s, t))].mean();
+            for (int c = 0; c < 3; ++c) {
+                ExrChannel ch{fmt::format("n{}-s{}-t{}.{}", n, s, t, "RGB"[c]), std::vector<float>(mean.pixel_count())};
+                for (size_t i = 0; i < mean.pixel_count(); ++i) ch.values[i] = mean[i][c];
+                out.push_back(std::move(ch));
+            }
+        }
+    return out;
+}
+
 void StrategyImages::write() const {
     if (weighted_.empty()) return;
     namespace fs = std::filesystem;

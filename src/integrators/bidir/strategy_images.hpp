@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "image/image_io.hpp"
 #include "render/film.hpp"
 
 namespace pathlab {
@@ -45,6 +46,9 @@ public:
     void finish_pass();
     // Writes every strategy's images and the montages (throws ImageIoError).
     void write() const;
+    // The weighted images so far as channels n{length}-s{s}-t{t}.R/G/B (--display-server's
+    // extra layers); none before the first pass.
+    std::vector<ExrChannel> weighted_channels() const;
 
     const Film& weighted(int s, int t) const { return weighted_[size_t(index(s, t))]; }
     const Film& unweighted(int s, int t) const { return unweighted_[size_t(index(s, t))]; }

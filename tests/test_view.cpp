@@ -158,6 +158,9 @@ TEST(ViewServer, ServesThePageTheImagesAndTheState) {
     EXPECT_EQ(c.Post("/api/render", "slot=a&algorithm=lt", "application/x-www-form-urlencoded")->status, 415);
     EXPECT_EQ(s.slot(0).algorithm, "pt-naive");
 
+    // A second server on the same port is refused (not sharing it, as SO_REUSEPORT would).
+    EXPECT_THROW(ViewServer(s, "127.0.0.1", server.port()), std::runtime_error);
+
     // Another Host: a page elsewhere whose name was rebound to 127.0.0.1.
     auto rebound = c.Get("/api/state", {{"Host", "attacker.example:80"}});
     ASSERT_TRUE(rebound);

@@ -1,6 +1,7 @@
 #include "view/view_server.hpp"
 
 #include <httplib.h>
+#include <sys/socket.h>
 
 #include <algorithm>
 #include <bit>
@@ -105,6 +106,12 @@ bool is_loopback_address(const std::string& address) {
 ViewServer::ViewServer(ViewSession& session, const std::string& bind, int port)
     : session_(session), bind_(bind), server_(std::make_unique<httplib::Server>()) {
     httplib::Server& srv = *server_;
+    // SO_REUSEADDR alone: cpp-httplib's default adds SO_REUSEPORT, which lets a second pathlab
+    // view listen on the same port and take half of the first one's requests.
+    srv.set_socket_options([](int s) {  // (a socket_t, on Linux)
+        int yes = 1;
+        setsockopt(s, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof(yes));
+    });
     const bool loopback = is_loopback_address(bind);
     srv.set_pre_routing_handler([this, loopback](const httplib::Request& req, httplib::Response& res) {
         if (view_path_refused(req.target.empty() ? req.path : req.target, req.path)) {

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 
 #include "cli_runner.hpp"
 #include "image/image_io.hpp"
@@ -178,7 +179,13 @@ TEST(Aovs, CommandLineWritesTheLayers) {
     ASSERT_NE(albedo, extras.layers.end());
     EXPECT_EQ(albedo->second.width(), 8);
     EXPECT_EQ(run({"3", "--aovs", "albedo", "-o", dir.path + "/a.png", "-q"}).code, 2);
-    const CliResult unknown = run({"3", "--aovs", "shadow", "-o", exr, "-q"});
+    // -a all renders the integrators that record them, and leaves out the others, saying why.
+    const CliResult all = run({"3", "-a", "all", "--aovs", "normal", "--spp", "1", "--resolution", "4x4", "-o", dir.path + "/{algorithm}.exr"});
+    EXPECT_EQ(all.code, 0) << all.err;
+    EXPECT_TRUE(std::filesystem::exists(dir.path + "/pt-mis.exr"));
+    EXPECT_FALSE(std::filesystem::exists(dir.path + "/lt.exr"));
+    EXPECT_TRUE(contains(all.err, "left out")) << all.err;
+    const CliResult unknown = run({"3", "-a", "lt", "--aovs", "shadow", "-o", exr, "-q"});
     EXPECT_EQ(unknown.code, 2);
     EXPECT_NE(unknown.err.find("sample-count"), std::string::npos) << unknown.err;
 }

@@ -108,6 +108,10 @@ std::string non_reciprocal_material(const SceneDescription& d) {
 }
 
 std::string integrator_refusal(const IntegratorInfo& info, const SceneDescription& d, const JobRequest& r) {
+    if (aovs_need_first_vertex(r.aovs) && !info.make(IntegratorOptions{})->records_aovs())
+        return fmt::format("--aovs {}: {} has no camera samples to take them from (it traces light paths); these come with: {} "
+                           "(variance and sample-count come with every integrator)",
+                           fmt::join(r.aovs, ","), info.name, aov_integrator_names());
     const bool mlt = info.name == "pssmlt" || info.name == "mmlt";
     if (r.sampler == SamplerKind::Sobol && mlt)
         return fmt::format("{} takes no --sampler sobol: its numbers are its Markov chains' states in primary sample space, not a pixel "
@@ -250,7 +254,6 @@ RenderJob::RenderJob(SceneChoice scene, const JobRequest& r) : choice_(std::move
     options_.pbgi_direct_samples = r.pbgi_direct_samples ? *r.pbgi_direct_samples : d.pbgi_direct_samples.value_or(options_.pbgi_direct_samples);
     options_.pbgi_spacing = r.pbgi_spacing ? *r.pbgi_spacing : d.pbgi_spacing.value_or(options_.pbgi_spacing);
     options_.hide_emitters = d.hide_emitters.value_or(false);
-    if (const std::string why = integrator_refusal(*info_, d, r); !why.empty()) throw UsageError(why);
     for (size_t i = 0; i < r.aovs.size(); ++i) {
         const std::vector<std::string>& names = aov_names();
         if (std::find(names.begin(), names.end(), r.aovs[i]) == names.end())
@@ -258,11 +261,8 @@ RenderJob::RenderJob(SceneChoice scene, const JobRequest& r) : choice_(std::move
         if (std::find(r.aovs.begin(), r.aovs.begin() + long(i), r.aovs[i]) != r.aovs.begin() + long(i))
             throw UsageError(fmt::format("--aovs names {} twice", r.aovs[i]));
     }
-    aovs_ = r.aovs;
-    if (aovs_need_first_vertex(aovs_) && !info_->make(IntegratorOptions{})->records_aovs())
-        throw UsageError(fmt::format("--aovs {}: {} has no camera samples to take them from (it traces light paths); "
-                                     "these come with: {} (variance and sample-count come with every integrator)",
-                                     fmt::join(aovs_, ","), info_->name, aov_integrator_names()));
+    if (const std::string why = integrator_refusal(*info_, d, r); !why.empty()) throw UsageError(why);
+    aovs_ = r.aovs;  // (an integrator without camera samples was refused by integrator_refusal)
     if (const std::string why = option_refusal(*info_, r); !why.empty()) throw UsageError(why);
     options_.mlt_chains = r.mlt_chains.value_or(options_.mlt_chains);
     options_.guiding_spp = r.guiding_spp ? *r.guiding_spp : d.guiding_spp.value_or(options_.guiding_spp);

@@ -39,7 +39,8 @@ std::vector<std::string> aov_channel_names(const std::string& aov) {
 }
 
 bool aovs_need_first_vertex(const std::vector<std::string>& aovs) {
-    return std::any_of(aovs.begin(), aovs.end(), [](const std::string& a) { return a != "variance" && a != "sample-count"; });
+    return std::any_of(aovs.begin(), aovs.end(),
+                       [](const std::string& a) { return a == "albedo" || a == "normal" || a == "depth" || a == "position"; });
 }
 
 }  // namespace pathlab

@@ -50,9 +50,7 @@ int run_view_command(const ViewOptions& o) {
     s.scene = std::move(scenes.front());
     JobRequest& r = s.request;
     if (!o.algorithm.empty()) r.algorithm = o.algorithm;
-    if (o.sampler != "independent" && o.sampler != "sobol")
-        throw UsageError(fmt::format("unknown sampler '{}'. Valid samplers: independent, sobol", o.sampler));
-    r.sampler = o.sampler == "sobol" ? SamplerKind::Sobol : SamplerKind::Independent;
+    r.sampler = sampler_or_usage_error(o.sampler);
     r.seed = parse_seed_option(o.seed);
     r.max_depth = o.max_depth;
     parse_resolution_option(o.resolution, r.width, r.height);

@@ -29,13 +29,13 @@ double rms_difference(const Image& a, const Image& b) {
     return n ? std::sqrt(sum / double(n)) : 0.0;
 }
 
+}  // namespace
+
 SamplerKind sampler_or_usage_error(const std::string& name) {
     if (name == "independent") return SamplerKind::Independent;
     if (name == "sobol") return SamplerKind::Sobol;
     throw UsageError(fmt::format("unknown sampler '{}'. Valid samplers: independent, sobol", name));
 }
-
-}  // namespace
 
 ViewSession::ViewSession(Options options) : options_(std::move(options)) {
     for (int i = 0; i < kSlots; ++i) slots_.push_back(std::make_unique<Slot>());

@@ -45,6 +45,9 @@ struct ViewSlotState {
     std::vector<std::pair<double, double>> rmse;  // (seconds, RMSE) per published image
 };
 
+// "independent" or "sobol" (a UsageError naming them otherwise).
+SamplerKind sampler_or_usage_error(const std::string& name);
+
 class ViewSession {
 public:
     struct Options {

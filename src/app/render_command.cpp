@@ -468,11 +468,12 @@ int run_render_command(const RenderCommandOptions& o, RankGroup* ranks) {
             const std::string title = job.scene_choice().name + " / " + job.integrator_info().name;
             // With --aovs, their layers too, and the integrator's own images (the display is
             // called between rounds, when no pass is adding to them).
-            job.settings.display = [&display, &job, title](const Film& film, const RenderStats&) {
+            job.settings.display = [&display, &job, title, distributed](const Film& film, const RenderStats&) {
                 if (!display) return;
                 DisplayFrame frame = film_frame(title, film);
                 add_frame_channels(frame, render_aov_channels(job.aovs(), film, job.aov_film()));
-                add_frame_channels(frame, job.integrator().display_channels());  // bdpt's per-strategy images
+                // bdpt's per-strategy images (the root's own part only across processes: left out there)
+                if (!distributed) add_frame_channels(frame, job.integrator().display_channels());
                 display->post(std::move(frame));
             };
         }

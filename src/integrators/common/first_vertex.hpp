@@ -14,7 +14,6 @@ namespace pathlab {
 
 class Scene;
 struct ShadingPoint;
-struct Intersection;
 
 struct FirstVertexRecorder {
     FirstVertex vertex;

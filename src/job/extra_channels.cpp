@@ -80,24 +80,25 @@ std::vector<ExrChannel> render_aov_channels(const std::vector<std::string>& aovs
     const size_t pixels = film.pixel_count();
     std::vector<ExrChannel> out;
     for (const std::string& aov : aovs) {
-        const std::vector<std::string> names = aov_channel_names(aov);
-        for (size_t c = 0; c < names.size(); ++c) {
-            ExrChannel ch{names[c], std::vector<float>(pixels)};
+        // The aov's channels, filled pixel by pixel (the kind decided once, not per value).
+        std::vector<ExrChannel> channels;
+        for (const std::string& name : aov_channel_names(aov)) channels.push_back({name, std::vector<float>(pixels)});
+        if (aov == "variance") {
             for (size_t i = 0; i < pixels; ++i) {
-                if (aov == "variance") {
-                    const double n = double(film.count(i));
-                    if (n < 2) continue;
-                    const double sum = film.sum(i)[int(c)], sumsq = film.sum_of_squares(i)[int(c)];
-                    ch.values[i] = float(std::max(0.0, (sumsq - sum * sum / n) / (n - 1)));
-                } else if (aov == "sample-count") {
-                    ch.values[i] = float(film.count(i));
-                } else {
-                    const int base = aov == "albedo" ? 0 : aov == "normal" ? 3 : aov == "position" ? 6 : 9;
-                    ch.values[i] = first ? first->mean(i, base + int(c)) : 0.0f;
-                }
+                const double n = double(film.count(i));
+                if (n < 2) continue;
+                const Vec3d sum = film.sum(i), sumsq = film.sum_of_squares(i);
+                for (int c = 0; c < 3; ++c) channels[size_t(c)].values[i] = float(std::max(0.0, (sumsq[c] - sum[c] * sum[c] / n) / (n - 1)));
             }
-            out.push_back(std::move(ch));
+        } else if (aov == "sample-count") {
+            for (size_t i = 0; i < pixels; ++i) channels[0].values[i] = float(film.count(i));
+        } else if (first) {
+            // The first-vertex components: albedo 0-2, normal 3-5, position 6-8, depth 9 (AovFilm::mean).
+            const int base = aov == "albedo" ? 0 : aov == "normal" ? 3 : aov == "position" ? 6 : 9;
+            for (size_t c = 0; c < channels.size(); ++c)
+                for (size_t i = 0; i < pixels; ++i) channels[c].values[i] = first->mean(i, base + int(c));
         }
+        for (ExrChannel& c : channels) out.push_back(std::move(c));
     }
     return out;
 }

@@ -236,7 +236,8 @@ void apply_estimator_options(JobRequest& r, const py::kwargs& options) {
     constexpr int kIntMax = std::numeric_limits<int>::max();
     static const char* const kNames =
         "mis, photons, radius, alpha, volume_estimate, no_merging, no_connections, ic_rays, ic_error, ic_no_gradients, pbgi_surfels, "
-        "pbgi_cutoff, pbgi_bounces, pbgi_resolution, pbgi_direct_samples, pbgi_spacing, guiding_spp, guiding_rr, estimators, photon_beams, beam_radius";
+        "pbgi_cutoff, pbgi_bounces, pbgi_resolution, pbgi_direct_samples, pbgi_spacing, guiding_spp, guiding_rr, estimators, photon_beams, beam_radius, "
+        "null_depth";
     const auto number = [](const py::handle& v, const std::string& name) {
         if (!py::isinstance<py::int_>(v) && !py::isinstance<py::float_>(v))
             throw py::type_error(fmt::format("{} must be a number, not {}", name, type_name(v)));
@@ -259,6 +260,10 @@ void apply_estimator_options(JobRequest& r, const py::kwargs& options) {
             const std::string m = string_argument(v, "mis", "balance, power");
             if (m != "balance" && m != "power") throw py::value_error(fmt::format("unknown mis '{}'; valid: balance, power", m));
             r.mis_power = m == "power";
+        } else if (name == "null_depth") {
+            const std::string m = string_argument(v, "null_depth", "count, skip");
+            if (m != "count" && m != "skip") throw py::value_error(fmt::format("unknown null_depth '{}'; valid: count, skip", m));
+            r.skip_null_events = m == "skip";
         } else if (name == "beam_radius") {
             r.beam_radius = float(number(v, name));
         } else if (name == "photon_beams") {
@@ -705,7 +710,8 @@ PYBIND11_MODULE(pathlab, m) {
           "light_sampler ('uniform', 'power', 'bvh', 'ris') and ris_candidates are --spectral, --rr-depth, --light-sampler and\n"
           "--ris-candidates. The estimators' own options go by their command-line names: mis='power', photons, radius, alpha,\n"
           "volume_estimate='points', no_merging=True, no_connections=True, ic_rays, ic_error, ic_no_gradients=True, pbgi_surfels,\n"
-          "pbgi_cutoff, pbgi_bounces, pbgi_resolution, pbgi_direct_samples, pbgi_spacing, guiding_spp, guiding_rr=True, estimators, photon_beams, beam_radius (refused for another estimator).\n"
+          "pbgi_cutoff, pbgi_bounces, pbgi_resolution, pbgi_direct_samples, pbgi_spacing, guiding_spp, guiding_rr=True, estimators, photon_beams, beam_radius (refused for another estimator),\n"
+          "null_depth='skip' (--null-depth).\n"
           "first_sample is --first-sample: the index of the first sample (pass), so that renders of disjoint ranges add up, with\n"
           "`pathlab merge`, to one render (give them checkpoint= files: merge takes checkpoints, exactly). checkpoint=FILE saves\n"
           "the render's whole state every checkpoint_every seconds (default 300; 0: only at the end), at the end and on Ctrl-C;\n"

@@ -12,8 +12,10 @@
 # The z-test divides by the variance of Mitsuba's estimator, so an unbiased estimator that is
 # noisier fails it. By default the scenes are rendered with Mitsuba 3's estimator choices where
 # pathlab's differ: lights chosen uniformly (--light-sampler uniform; pathlab's default picks
-# them by power) and the power heuristic (--mis power) in path, direct and volpath, as Mitsuba's
-# path tracers weigh their samples. --pathlab-defaults renders with pathlab's own defaults
+# them by power), the power heuristic (--mis power) in path, direct and volpath, as Mitsuba's
+# path tracers weigh their samples, and Russian roulette from Mitsuba's default depth (rr_depth
+# 5; pathlab's own starts after 3 bounces, which adds variance to the rare long paths of the
+# media scenes). --pathlab-defaults renders with pathlab's own defaults
 # instead (the same expected image, other variances).
 #
 # Usage: scripts/mitsuba-suite.sh DIR [OUT] [--pathlab-defaults] [-- extra pathlab options, e.g. --threads 2]
@@ -70,7 +72,11 @@ for scene in "$data"/tests/scenes/*/*.xml; do
     choices=()
     if [ $as_mitsuba -eq 1 ]; then
         case "$integrator" in
-            path | direct | volpath | volpathmis) choices=(--light-sampler uniform --mis power) ;;
+            # Russian roulette from Mitsuba's default rr_depth 5: its path plays it after bounce 5 on,
+            # its volpath after bounce 6 on (at the top of the next iteration, depth > rr_depth).
+            path) choices=(--light-sampler uniform --mis power --rr-depth 5) ;;
+            volpath | volpathmis) choices=(--light-sampler uniform --mis power --rr-depth 6) ;;
+            direct) choices=(--light-sampler uniform --mis power) ;;
         esac
     fi
     if ! err=$("$pathlab" "$scene" -D "integrator=$integrator" --spp "$spp" --seed 0 -q -o "$img" "${choices[@]}" "$@" 2>&1 >/dev/null); then

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 
 #include <fmt/format.h>
 #include <tbb/global_control.h>
@@ -832,6 +833,84 @@ TEST(SceneFileIntegrators, HideEmittersMomentAndAovs) {
     EXPECT_NEAR(aov[0].values[5], 3 / std::cos(0.0), 0.2);  // near the centre
     EXPECT_NEAR(aov[3].values[0], 1, 1e-6);                  // nn.Z
     EXPECT_NEAR(aov[6].values[0], 0.6, 1e-6);                // albedo.B
+}
+
+// --null-depth skip (Mitsuba's volpath): a straight pass through thin glass or a mask's hole is no
+// bounce. Twin scenes: a floor lit by a light above it, seen by the camera, with and without two
+// sheets that let everything through (a thindielectric of index 1 between the light and the
+// floor, a mask of opacity 0 between the camera and the floor), at a depth of one and of two
+// bounces. With skip the sheets change nothing (per-pixel z-tests); counted as bounces, they take
+// the direct light away. Also in fog (volpath's media loop) and through a scene file's volpath.
+TEST(SceneFileIntegrators, NullDepthSkipPassesStraightThroughWithoutABounce) {
+    const auto scene = [](bool sheets, bool fog, const std::string& integrator) {
+        return load_scene_text(fmt::format(R"(<scene version="3.0.0">
+  {0}
+  <medium type="homogeneous" id="fog"><rgb name="sigma_t" value="0.3"/><rgb name="albedo" value="0.8"/></medium>
+  <sensor type="perspective"><float name="fov" value="40"/>
+    <transform name="to_world"><lookat origin="0,-3,1.5" target="0,0,0" up="0,0,1"/></transform></sensor>
+  <shape type="rectangle"><transform name="to_world"><scale value="2"/></transform><bsdf type="diffuse"><rgb name="reflectance" value="0.7"/></bsdf></shape>
+  <shape type="rectangle"><transform name="to_world"><scale value="0.5"/><rotate x="1" angle="180"/><translate z="2"/></transform>
+    <emitter type="area"><rgb name="radiance" value="8"/></emitter></shape>
+  {1}
+  {2}
+</scene>)",
+                                           integrator,
+                                           sheets ? R"(<shape type="rectangle"><transform name="to_world"><scale value="3"/><translate z="1.75"/></transform>
+    <bsdf type="thindielectric"><float name="int_ior" value="1"/><float name="ext_ior" value="1"/></bsdf></shape>
+  <shape type="rectangle"><transform name="to_world"><scale value="3"/><rotate x="1" angle="80"/><translate y="-1.5" z="0.7"/></transform>
+    <bsdf type="mask"><float name="opacity" value="0"/><bsdf type="diffuse"/></bsdf></shape>)"
+                                                  : "",
+                                           fog ? R"(<shape type="cube"><transform name="to_world"><scale x="1" y="1" z="0.4"/><translate z="0.5"/></transform>
+    <bsdf type="null"/><ref name="interior" id="fog"/></shape>)"
+                                               : ""),
+                               "null.xml", ".");
+    };
+    const auto render = [](const SceneDescription& d, const std::string& algorithm, int depth, std::optional<bool> skip, uint64_t seed) {
+        JobRequest r;
+        r.algorithm = algorithm;
+        r.spp = 128;
+        r.max_depth = depth;
+        r.width = r.height = 12;
+        r.seed = seed;
+        r.skip_null_events = skip;
+        return RenderJob(scene_choice_of(d), r).run();
+    };
+    const auto agree = [](const RenderResult& a, const RenderResult& b) {
+        return test_agreement(a.film.mean(), a.film.standard_error(), b.film.mean(), b.film.standard_error(), AgreementOptions{1e-3, 1e-4});
+    };
+    for (const bool fog : {false, true})
+        for (const int depth : {1, 2}) {
+            const SceneDescription with = scene(true, fog, ""), without = scene(false, fog, "");
+            const std::string algorithm = fog ? "volpath" : "pt-mis";
+            const RenderResult twin = render(without, algorithm, depth, std::nullopt, 2);
+            const AgreementResult skipped = agree(render(with, algorithm, depth, true, 1), twin);
+            EXPECT_TRUE(skipped.agree) << algorithm << " depth " << depth << ": " << skipped.describe();
+            const AgreementResult counted = agree(render(with, algorithm, depth, std::nullopt, 1), twin);
+            EXPECT_FALSE(counted.agree) << algorithm << " depth " << depth << " (the test's power): " << counted.describe();
+        }
+    // A scene file's volpath counts depth as Mitsuba's volpath does (its max_depth 3: two bounces).
+    const SceneDescription file = scene(true, true, R"(<integrator type="volpath"><integer name="max_depth" value="3"/></integrator>)");
+    EXPECT_TRUE(file.skip_null_events.value_or(false));
+    const AgreementResult from_file = agree(render(file, "volpath", 2, std::nullopt, 1), render(scene(false, true, ""), "volpath", 2, std::nullopt, 2));
+    EXPECT_TRUE(from_file.agree) << from_file.describe();
+    // The integrators that count it as a bounce refuse skip where it would change their image.
+    const auto refusal = [&](const std::string& algorithm, int depth, bool sheets) {
+        JobRequest r;
+        r.algorithm = algorithm;
+        r.max_depth = depth;
+        r.skip_null_events = true;
+        try {
+            RenderJob job(scene_choice_of(scene(sheets, false, "")), r);
+        } catch (const UsageError& e) {
+            return std::string(e.what());
+        }
+        return std::string();
+    };
+    EXPECT_NE(refusal("bdpt", 2, true).find("--null-depth count"), std::string::npos) << refusal("bdpt", 2, true);
+    EXPECT_NE(refusal("lt", 2, true).find("pt-mis"), std::string::npos);
+    EXPECT_EQ(refusal("bdpt", -1, true), "");  // unlimited: the two conventions agree
+    EXPECT_EQ(refusal("bdpt", 2, false), "");  // nothing to pass through
+    EXPECT_EQ(refusal("pt-mis3", 2, true), "");
 }
 
 // ---- BSDFs -------------------------------------------------------------------------------------

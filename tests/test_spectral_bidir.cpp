@@ -119,7 +119,9 @@ TEST(SpectralBidir, ShadingNormalsAgreeInImportanceTransport) {
     const std::string dir = ::testing::TempDir() + "spectral-bidir-" + std::to_string(::getpid());
     std::filesystem::create_directories(dir);
     write_image(Image(3, 3, Rgb(0.5f, 0.2f, 0.9f)), dir + "/tilted.exr");  // n = 2 rgb - 1 = (0, -0.6, 0.8)
-    const std::string map = R"(<texture type="bitmap" name="normalmap"><string name="filename" value="tilted.exr"/></texture>)";
+    // (The reciprocal map: Mitsuba's flip_invalid_normals and shadowing term off; the light-path integrators refuse them.)
+    const std::string map = R"(<texture type="bitmap" name="normalmap"><string name="filename" value="tilted.exr"/></texture>
+      <boolean name="flip_invalid_normals" value="false"/><boolean name="use_shadowing_function" value="false"/>)";
     const std::string text = R"(<scene version="3.0.0">
   <sensor type="perspective"><float name="fov" value="50"/>
     <transform name="to_world"><lookat origin="0, -3, 2" target="0, 0, 0.3" up="0, 0, 1"/></transform></sensor>

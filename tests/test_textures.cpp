@@ -17,6 +17,8 @@
 #include "textures/registry.hpp"
 #include "textures/srgb.hpp"
 #include "integrators/common/shading.hpp"
+#include "job/render_job.hpp"
+#include "job/usage_error.hpp"
 #include "scene/scene.hpp"
 
 namespace pathlab {
@@ -353,6 +355,78 @@ TEST_F(TextureFiles, TexturesAreBoundToBsdfParameters) {
     EXPECT_EQ(bm.materials[0].textures->perturbation, FramePerturbation::BumpMap);
     EXPECT_EQ(bm.materials[0].textures->bump_scale, 0.25f);
     EXPECT_TRUE(bm.materials[0].two_sided);
+}
+
+// Mitsuba 3's normalmap options, on by default (material_textures.hpp): the shadowing term in
+// closed form, the flip of a tilted normal that the incoming direction sees from behind, and the
+// BSDF they give; off, the reciprocal map of before. A rectangle in the xy plane (n = z, dp/du
+// along x) whose map tilts the normal to n' = (0, -0.6, 0.8).
+TEST_F(TextureFiles, NormalMapFlipsInvalidNormalsAndShadowsAsMitsuba) {
+    // G = 2 / (1 + sqrt(1 + a^2 tan^2 theta_o)), a^2 = min(tan^2 theta_p / 8, 1).
+    EXPECT_FLOAT_EQ(bump_shadowing(1.0f, 0.3f), 1.0f);  // an untilted normal: no shadowing
+    EXPECT_FLOAT_EQ(bump_shadowing(0.6f, 1.0f), 1.0f);  // wo along the normal
+    EXPECT_NEAR(bump_shadowing(std::sqrt(0.5f), 0.5f), 2 / (1 + std::sqrt(1 + 0.125 * 3)), 1e-6);
+    EXPECT_NEAR(bump_shadowing(0.2f, 0.5f), 2 / (1 + std::sqrt(1 + 1.0 * 3)), 1e-6);  // a^2 capped at 1
+    const auto scene_of = [&](const std::string& options) {
+        return Scene::build(load_scene_text(R"(<scene version="3.0.0"><shape type="rectangle"><bsdf type="normalmap">
+            <texture type="rawconstant" name="normalmap"><vector name="value" value="0.5, 0.2, 0.9"/></texture>)" + options +
+                                                R"(<bsdf type="diffuse"><rgb name="reflectance" value="0.5"/></bsdf></bsdf></shape></scene>)",
+                                            path("scene.xml"), dir_.string()));
+    };
+    const auto mitsuba = scene_of(""), flip_only = scene_of(R"(<boolean name="use_shadowing_function" value="false"/>)"),
+               reciprocal = scene_of(R"(<boolean name="flip_invalid_normals" value="false"/><boolean name="use_shadowing_function" value="false"/>)");
+    const Vec3f tilted = normalize(Vec3f(0, -0.6f, 0.8f)), mirrored = normalize(Vec3f(0, 0.6f, 0.8f));
+    const auto at = [](const Scene& scene, const Vec3f& wi) {
+        Intersection hit;
+        EXPECT_TRUE(scene.intersect(Ray{wi * 2.0f, -wi}, hit));
+        return make_shading_point(scene, hit, -wi);
+    };
+    // Seen from (0, 0.9, 0.3): above the surface, behind n' (wi.n' < 0), so n' is mirrored about n.
+    const Vec3f wi = normalize(Vec3f(0, 0.9f, 0.3f)), wo = normalize(Vec3f(0.8f, 0.3f, 0.3f));
+    for (const auto* s : {mitsuba.get(), flip_only.get()}) {
+        const ShadingPoint sp = at(*s, wi);
+        EXPECT_NEAR(dot(sp.frame.n, mirrored), 1, 1e-5);
+    }
+    EXPECT_NEAR(dot(at(*reciprocal, wi).frame.n, tilted), 1, 1e-5);
+    // Seen from (0, -0.9, 0.3): in front of n' too, no flip.
+    EXPECT_NEAR(dot(at(*mitsuba, normalize(Vec3f(0, -0.9f, 0.3f))).frame.n, tilted), 1, 1e-5);
+    // The BSDF at the flipped frame: the diffuse's 0.5 / pi, times G(n'.n, wo.n) with the shadowing term.
+    const ShadingPoint m = at(*mitsuba, wi), f = at(*flip_only, wi);
+    const float G = bump_shadowing(0.8f, wo.z);
+    EXPECT_NEAR(m.material->eval(m, m.wi, m.frame.to_local(wo)).x, 0.5f / kPi * G, 1e-6);
+    EXPECT_NEAR(f.material->eval(f, f.wi, f.frame.to_local(wo)).x, 0.5f / kPi, 1e-6);
+    EXPECT_LT(G, 0.9f);  // (a grazing wo: a real attenuation)
+    // A direction above n' but below n (Mitsuba's rule: both must see it on one side) is black.
+    const Vec3f below = normalize(Vec3f(0, 0.9f, -0.1f));
+    ASSERT_GT(dot(below, m.frame.n), 0);
+    EXPECT_EQ(m.material->eval(m, m.wi, m.frame.to_local(below)).x, 0.0f);
+    // Sampling carries the same factor: f cos / pdf of the diffuse is its albedo, times G.
+    Sampler sampler(7, 0, 0);
+    for (int i = 0; i < 64; ++i) {
+        const auto s = m.material->sample(m, m.wi, sampler.next2d());
+        if (!s) continue;
+        const Vec3f w = m.frame.to_world(s->wo);
+        EXPECT_NEAR(s->f.x * s->wo.z / s->pdfW, 0.5f * bump_shadowing(0.8f, w.z), 1e-5);
+    }
+    // Not reciprocal: the integrators that scatter light paths with the adjoint BSDF refuse it.
+    const auto refusal = [&](const std::string& algorithm, const std::string& options) {
+        JobRequest r;
+        r.algorithm = algorithm;
+        try {
+            RenderJob job(scene_choice_of(load_scene_text(R"(<scene version="3.0.0"><sensor type="perspective"/><shape type="rectangle">
+              <bsdf type="normalmap" id="wall"><texture type="rawconstant" name="normalmap"><vector name="value" value="0.5, 0.2, 0.9"/></texture>)" +
+                                                              options + R"(<bsdf type="diffuse"/></bsdf></shape></scene>)",
+                                                          path("scene.xml"), dir_.string())),
+                          r);
+        } catch (const UsageError& e) {
+            return std::string(e.what());
+        }
+        return std::string();
+    };
+    EXPECT_NE(refusal("bdpt", "").find("'wall' has a normalmap with Mitsuba's flip_invalid_normals"), std::string::npos) << refusal("bdpt", "");
+    EXPECT_NE(refusal("lt", R"(<boolean name="flip_invalid_normals" value="false"/>)").find("not reciprocal"), std::string::npos);
+    EXPECT_EQ(refusal("bdpt", R"(<boolean name="flip_invalid_normals" value="false"/><boolean name="use_shadowing_function" value="false"/>)"), "");
+    EXPECT_EQ(refusal("pt-mis", ""), "");
 }
 
 // Mitsuba 3's rawconstant (the identity normal map of its render tests) and bitmap's storage

@@ -45,6 +45,9 @@ void print_algorithms() {
     fmt::print("\nParticipating media (scenes with a <medium>): {}; the others refuse such scenes.\n", media_integrator_names());
     fmt::print("Spectral mode (--spectral): {}.\n", spectral_integrator_names());
     fmt::print("Light sampling at shading points (--light-sampler uniform|power|bvh|ris): {}.\n", light_sampling_integrator_names());
+    fmt::print("A straight pass through thin glass or a mask's hole as no bounce (--null-depth skip, Mitsuba's volpath): {}; the others "
+               "count it, and refuse skip with a finite --max-depth in scenes that have such surfaces.\n",
+               null_skipping_integrator_names());
 }
 
 }  // namespace

@@ -104,6 +104,10 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
                                  "Longest path in bounces (-1: unlimited; default: the scene file's, else -1)");
     app.add_option_function<int>("--rr-depth", [&o](const int& v) { o.rr_depth = v, o.rr_depth_given = true; },
                                  "Bounces before Russian roulette starts (default: the scene file's, else 3)");
+    app.add_option("--null-depth", o.null_depth,
+                   "Whether a straight pass through a surface (thindielectric's transmission, a mask's hole) counts toward "
+                   "--max-depth: count (a bounce, as Mitsuba's path) or skip (no bounce, as Mitsuba's volpath; pt-mis, pt-mis3, "
+                   "volpath, pssmlt). Default: the scene file's (skip for <integrator type=\"volpath\">), else count");
     app.add_option("--light-sampler", o.light_sampler,
                    "How next-event estimation chooses a light: uniform (every emitter alike, a mesh's triangles by area), power (default: in proportion to power), bvh (a "
                    "light tree, by each light's bound at the shading point: for many lights) or ris (bvh's choices as "
@@ -219,6 +223,11 @@ std::vector<RenderJob> make_jobs(const RenderCommandOptions& o, bool check_paths
             throw UsageError(fmt::format("unknown light sampler '{}'. Valid light samplers: {}", *o.light_sampler, kLightSamplerNames));
     }
     request.ris_candidates = o.ris_candidates;
+    if (o.null_depth) {
+        if (*o.null_depth != "count" && *o.null_depth != "skip")
+            throw UsageError(fmt::format("unknown --null-depth '{}'. Valid: count, skip", *o.null_depth));
+        request.skip_null_events = *o.null_depth == "skip";
+    }
     request.strategies_depth = o.strategies_depth;
     request.photons = o.photons;
     request.photon_radius = o.photon_radius;

@@ -36,6 +36,7 @@ struct RenderCommandOptions {
     bool spectral = false;
     std::string mis = "balance";
     std::optional<std::string> light_sampler;
+    std::optional<std::string> null_depth;  // --null-depth count|skip
     std::optional<int> ris_candidates;
     std::string strategies_dir;
     int strategies_depth = 4;

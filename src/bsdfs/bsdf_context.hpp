@@ -27,6 +27,7 @@ struct BsdfContext {
     SurfaceUv uv;             // surface coordinates, (0, 0) where the shape has none; a mesh's attributes at the hit
     Frame frame;              // shading frame: n the shading normal, s the tangent, t the bitangent
     Vec3f ng;                 // unit geometric normal, on the side of frame.n
+    Vec3f ns{};               // unit shading normal before a normal or bump map (0: not known)
     TransportMode mode = TransportMode::Radiance;
     bool reverse_pdf = false;  // sample() also fills BsdfSample::pdf_rev
 };

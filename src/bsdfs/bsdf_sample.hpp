@@ -10,12 +10,16 @@
 namespace pathlab {
 
 // Lobe flags: the kind of scattering (diffuse, glossy, specular = a Dirac delta) and its side.
+// kLobeNull marks a straight pass through the surface, wo = -wi, as if it were not there
+// (thindielectric's transmission, a mask's hole; always with kLobeSpecular | kLobeTransmission):
+// Mitsuba's BSDFFlags::Null, which its volpath does not count as a bounce (--null-depth skip).
 enum BsdfLobe : uint32_t {
     kLobeDiffuse = 1,
     kLobeGlossy = 2,
     kLobeSpecular = 4,
     kLobeReflection = 8,
     kLobeTransmission = 16,
+    kLobeNull = 32,
 };
 
 // One sampled direction of a BSDF. `f` is the BSDF value (no cosine), `pdfW` the solid-angle

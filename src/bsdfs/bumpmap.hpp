@@ -9,9 +9,11 @@
 // (material_textures.hpp). Only h's variations matter; a constant height is no bump. Heights
 // are in the units of p per unit of h: on a shape whose dp/du is long (a large rectangle) the
 // same texture bumps less. The texture's gradient is that of its bilinear interpolant (zero
-// for nearest lookups and checkerboards).
+// for nearest lookups and checkerboards). flip_invalid_normals and use_shadowing_function as
+// for normalmap (normalmap.hpp).
 #pragma once
 
+#include "bsdfs/normalmap.hpp"
 #include "core/properties.hpp"
 
 namespace pathlab {
@@ -19,7 +21,11 @@ namespace pathlab {
 inline const PluginInfo& bumpmap_plugin() {
     static const PluginInfo info{"bsdf", "bumpmap",
                                  "tilts the shading frame of one nested BSDF as the surface displaced by a height texture would be",
-                                 {{"scale", ParamType::Float, "1", "multiplies the height texture's gradient"}}};
+                                 [] {
+                                     std::vector<ParamInfo> params{{"scale", ParamType::Float, "1", "multiplies the height texture's gradient"}};
+                                     for (ParamInfo& p : bump_rule_params()) params.push_back(std::move(p));
+                                     return params;
+                                 }()};
     return info;
 }
 

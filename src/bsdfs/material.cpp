@@ -97,8 +97,16 @@ Frame Material::shading_frame(const Vec3f& n, const Vec3f& ng, bool back, const 
 
 float Material::context_factor(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo) const {
     if (ctx.mode == TransportMode::Importance) return importance_factor(ctx, wi, wo);
-    if (perturbed() && !sides_agree(ctx, wi, wo)) return 0.0f;
-    return 1.0f;
+    return perturbed() ? perturbation_factor(ctx, wi, wo) : 1.0f;
+}
+
+float Material::perturbation_factor(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo) const {
+    if (!mitsuba_bump_rules() || ctx.ns == Vec3f(0.0f)) return sides_agree(ctx, wi, wo) ? 1.0f : 0.0f;
+    // Mitsuba's: wo on one side of the shading normal before and after the map, times the shadowing.
+    const Vec3f n = ctx.frame.to_local(ctx.ns);
+    const float cos_o = dot(wo, n);
+    if (!(cos_o * wo.z > 0)) return 0.0f;
+    return textures->shadowing_function ? bump_shadowing(n.z, cos_o) : 1.0f;
 }
 
 Rgb Material::eval_varying(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo) const {
@@ -152,13 +160,23 @@ std::optional<BsdfSample> BlendMaterial::sample(const Vec3f& wi, Vec2f u) const 
     return s;
 }
 
+float Material::null_transmission(const SurfaceUv& uv, float cos_i) const {
+    if (!(lobes() & kLobeNull)) return 0.0f;
+    const MaterialModel m = varies ? model_at(uv) : model;
+    if (const auto* t = std::get_if<ThinDielectricMaterial>(&m)) return 1 - t->reflectance(cos_i);
+    if (const auto* k = std::get_if<MaskMaterial>(&m)) return (1 - k->opacity) + k->opacity * k->inner->null_transmission(uv, cos_i);
+    if (const auto* b = std::get_if<BlendMaterial>(&m))
+        return (1 - b->weight) * b->first->null_transmission(uv, cos_i) + b->weight * b->second->null_transmission(uv, cos_i);
+    return 0.0f;
+}
+
 Rgb MaskMaterial::eval(const Vec3f& wi, const Vec3f& wo) const { return eval_at(*inner, uv, wi, wo) * opacity; }
 float MaskMaterial::pdf(const Vec3f& wi, const Vec3f& wo) const { return opacity * pdf_at(*inner, uv, wi, wo); }
 std::optional<BsdfSample> MaskMaterial::sample(const Vec3f& wi, Vec2f u) const {
     if (u.x >= opacity) {
         const float c = std::abs(wi.z);
         if (!(c > 0)) return std::nullopt;
-        return BsdfSample{-wi, Rgb((1 - opacity) / c), 1 - opacity, true, kLobeSpecular | kLobeTransmission};
+        return BsdfSample{-wi, Rgb((1 - opacity) / c), 1 - opacity, true, kLobeSpecular | kLobeTransmission | kLobeNull};
     }
     u.x = std::min(u.x / opacity, 0.99999994f);
     std::optional<BsdfSample> s = sample_at(*inner, uv, wi, u);
@@ -177,8 +195,10 @@ std::optional<BsdfSample> Material::sample_adjusted(const BsdfContext& ctx, cons
             const float k = importance_factor(ctx, wi, s->wo);
             if (!(k > 0)) return std::nullopt;
             s->f *= k;
-        } else if (perturbed() && !sides_agree(ctx, wi, s->wo)) {
-            return std::nullopt;
+        } else if (perturbed()) {
+            const float k = perturbation_factor(ctx, wi, s->wo);
+            if (!(k > 0)) return std::nullopt;
+            s->f *= k;
         }
         if (ctx.reverse_pdf) s->pdf_rev = s->delta ? s->pdfW : pdf_of(m, s->wo, wi);
         return s;

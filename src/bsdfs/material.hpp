@@ -144,6 +144,9 @@ struct Material {
     // the nested materials.
     void prepare();
     bool perturbed() const { return textures && textures->perturbation != FramePerturbation::None; }
+    // A normal or bump map with Mitsuba's non-reciprocal options (material_textures.hpp).
+    bool flips_invalid_normals() const { return perturbed() && textures->flip_invalid_normals; }
+    bool mitsuba_bump_rules() const { return perturbed() && (textures->flip_invalid_normals || textures->shadowing_function); }
     // The model at surface coordinates uv: the textured parameters set to their values there.
     MaterialModel model_at(const SurfaceUv& uv) const;
     // The shading frame at a hit whose front-side unit shading and geometric normals are n, ng
@@ -202,6 +205,11 @@ struct Material {
             return sample(wi, u);
         return sample_adjusted(ctx, wi, u);
     }
+    // The fraction of light that passes straight through at surface coordinates uv, arriving at
+    // |cos| = cos_i to the shading normal: the weight of its kLobeNull lobe (thindielectric's
+    // 1 - R', a mask's 1 - opacity, mixed through blends); what a shadow ray carries through it
+    // under --null-depth skip (Mitsuba's eval_null_transmission). 0 without such a lobe.
+    float null_transmission(const SurfaceUv& uv, float cos_i) const;
     // The flags of every lobe the material has (BsdfLobe).
     uint32_t lobes() const {
         return std::visit([](const auto& m) { return lobes_of(m); }, model);
@@ -255,6 +263,9 @@ struct Material {
     // refraction factor (eta_wo / eta_wi)^2 and the shading-normal correction; 0 for directions
     // on different sides of the geometric and the shading surface.
     float importance_factor(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo) const;
+    // What radiance mode multiplies a normal- or bump-mapped BSDF by: 0 for directions the map
+    // puts on the wrong side, and Mitsuba's shadowing term (material_textures.hpp).
+    float perturbation_factor(const BsdfContext& ctx, const Vec3f& wi, const Vec3f& wo) const;
 
 private:
     // What the context multiplies a varying material's radiance-mode BSDF by: importance mode's
@@ -271,9 +282,9 @@ private:
     static uint32_t lobes_of(const RoughDielectricMaterial&) { return kLobeGlossy | kLobeReflection | kLobeTransmission; }
     static uint32_t lobes_of(const PlasticMaterial&) { return kLobeDiffuse | kLobeSpecular | kLobeReflection; }
     static uint32_t lobes_of(const RoughPlasticMaterial&) { return kLobeDiffuse | kLobeGlossy | kLobeReflection; }
-    static uint32_t lobes_of(const ThinDielectricMaterial&) { return kLobeSpecular | kLobeReflection | kLobeTransmission; }
+    static uint32_t lobes_of(const ThinDielectricMaterial&) { return kLobeSpecular | kLobeReflection | kLobeTransmission | kLobeNull; }
     static uint32_t lobes_of(const BlendMaterial& m) { return m.first->lobes() | m.second->lobes(); }
-    static uint32_t lobes_of(const MaskMaterial& m) { return m.inner->lobes() | kLobeSpecular | kLobeTransmission; }
+    static uint32_t lobes_of(const MaskMaterial& m) { return m.inner->lobes() | kLobeSpecular | kLobeTransmission | kLobeNull; }
     static uint32_t lobes_of(const PrincipledMaterial& m) {
         return kLobeDiffuse | kLobeGlossy | kLobeReflection | (m.transmits ? kLobeTransmission : 0u);
     }

@@ -28,6 +28,11 @@ Frame frame_along(const Vec3f& n, const Vec3f& dpdu) {
 
 Frame tangent_frame(const Vec3f& n, const Vec3f& dpdu) { return frame_along(n, dpdu); }
 
+Frame flip_invalid_normal(const Frame& f, const Vec3f& n, const Vec3f& wi) {
+    if (dot(wi, n) * dot(wi, f.n) > 0) return f;
+    return frame_along(n * (2 * dot(f.n, n)) - f.n, f.s);
+}
+
 Frame perturbed_frame(const MaterialTextures& t, const Vec3f& n, const Vec3f& ng, const Vec3f& dpdu, const Vec3f& dpdv,
                       const SurfaceUv& uv) {
     const Frame base = frame_along(n, dpdu);

@@ -8,6 +8,9 @@
 // constant thus gives exactly the model of that constant.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
+
 #include <memory>
 #include <string>
 #include <vector>
@@ -32,7 +35,30 @@ struct MaterialTextures {
     FramePerturbation perturbation = FramePerturbation::None;
     std::shared_ptr<const Texture> perturbation_texture;  // the normal map, or the height field
     float bump_scale = 1;                                 // bumpmap's `scale`
+    // Mitsuba 3's normalmap and bumpmap options (true by default there and in scene files here;
+    // false for glTF's normal textures). flip_invalid_normals: a perturbed normal n' that the
+    // incoming direction wi sees from the other side than the shading normal n is mirrored about
+    // n (flip_invalid_normal()); use_shadowing_function: the BSDF is multiplied by
+    // bump_shadowing() of the outgoing direction. Both single out one direction, so the BSDF they
+    // make is not reciprocal (the light-path integrators refuse it); with either, a direction
+    // counts where n and n' see it on one side (Mitsuba's rule), else where ng and n' do.
+    bool flip_invalid_normals = false;
+    bool shadowing_function = false;
 };
+
+// Conty Estevez, Lecocq and Stein 2019, "A Microfacet-Based Shadowing Function to Solve the Bump
+// Terminator Problem" (Mitsuba 3's eval_shadow_terminator): cos_p the cosine between the
+// perturbed and the unperturbed shading normal, cos_o that of the outgoing direction to the
+// unperturbed one; G = 2 / (1 + sqrt(1 + a^2 tan^2 theta_o)) with a^2 = min(tan^2 theta_p / 8, 1).
+inline float bump_shadowing(float cos_p, float cos_o) {
+    const auto tan2 = [](float c) { return std::max(0.0f, 1 - c * c) / (c * c); };
+    const float a2 = std::min(0.125f * tan2(cos_p), 1.0f);
+    return 2 / (1 + std::sqrt(1 + a2 * tan2(cos_o)));
+}
+
+// flip_invalid_normals: `f` (the perturbed frame) with its normal mirrored about the shading
+// normal n when wi (towards where the path came from) sees n and f.n from different sides.
+Frame flip_invalid_normal(const Frame& f, const Vec3f& n, const Vec3f& wi);
 
 // The shading frame whose tangent s follows dp/du: s = dp/du made orthogonal to the unit
 // shading normal n, t = n x s; Frame(n) where dp/du is zero or along n.

@@ -39,7 +39,7 @@ struct ThinDielectricMaterial {
         if (!(cos_i > 0)) return std::nullopt;
         const float R = reflectance(cos_i);
         if (u.x < R) return BsdfSample{Vec3f(-wi.x, -wi.y, wi.z), Rgb(R / cos_i), R, true, kLobeSpecular | kLobeReflection};
-        return BsdfSample{-wi, Rgb((1 - R) / cos_i), 1 - R, true, kLobeSpecular | kLobeTransmission};
+        return BsdfSample{-wi, Rgb((1 - R) / cos_i), 1 - R, true, kLobeSpecular | kLobeTransmission | kLobeNull};
     }
 };
 

@@ -100,6 +100,10 @@ struct IntegratorOptions {
     bool guiding_rr = false;  // ppg: adjoint-driven Russian roulette and splitting (ADRRS)
     // Paths of no bounce (emitters and the environment seen directly) are left out (Mitsuba's hide_emitters).
     bool hide_emitters = false;
+    // --null-depth skip: a straight pass through a surface (a kLobeNull sample: thindielectric's
+    // transmission, a mask's hole) is no bounce under --max-depth, as in Mitsuba's volpath; by
+    // default (count) it is one, as in Mitsuba's path. Only a finite depth makes them differ.
+    bool skip_null_events = false;
     // Spectral mode (docs/spectral.md): paths carry 4 sampled wavelengths instead of RGB, the
     // integrator's SpectralTransport instantiation (common/transport.hpp; make_for_transport).
     bool spectral = false;
@@ -240,6 +244,9 @@ struct IntegratorInfo {
     // photon methods, vcm): a BSDF that is not reciprocal (principledthin's specular transmission,
     // as Mitsuba defines it) would make them converge to another image, so RenderJob refuses it.
     bool light_paths = false;
+    // Honours --null-depth skip (IntegratorOptions::skip_null_events); the others refuse it where it
+    // would change their image (a finite depth and a material with a null lobe).
+    bool skips_null_events = false;
 
     PluginInfo plugin() const;
 };
@@ -268,5 +275,7 @@ std::string spectral_integrator_names();
 std::string media_integrator_names();
 // ... and those that choose lights for next-event estimation (--light-sampler).
 std::string light_sampling_integrator_names();
+// ... and those that honour --null-depth skip.
+std::string null_skipping_integrator_names();
 
 }  // namespace pathlab

@@ -56,4 +56,6 @@ std::string media_integrator_names() { return names_of_integrators_with(&Integra
 
 std::string light_sampling_integrator_names() { return names_of_integrators_with(&IntegratorInfo::samples_lights); }
 
+std::string null_skipping_integrator_names() { return names_of_integrators_with(&IntegratorInfo::skips_null_events); }
+
 }  // namespace pathlab

@@ -66,7 +66,7 @@ std::string options_text(const IntegratorOptions& o) {
                        o.max_depth, o.rr_depth, o.only_length, o.mis_power ? "power" : "balance", o.photons, hex_float(o.photon_radius),
                        hex_float(o.photon_alpha), int(o.vcm_merging), int(o.vcm_connections), o.ic_rays, hex_float(o.ic_error),
                        int(o.ic_gradients)) +
-           (o.spectral ? " mode=spectral" : "") + (o.volume_beam ? "" : " volume=points") +
+           (o.spectral ? " mode=spectral" : "") + (o.volume_beam ? "" : " volume=points") + (o.skip_null_events ? " null_depth=skip" : "") +
            (o.light_sampler == LightSamplerKind::Power ? "" : fmt::format(" lights={}", light_sampler_name(o.light_sampler))) +
            (o.light_sampler == LightSamplerKind::Ris ? fmt::format(" ris={}", o.ris_candidates) : "") +
            (o.mlt_chains == defaults.mlt_chains && o.mlt_bootstrap == defaults.mlt_bootstrap && o.mlt_large_step == defaults.mlt_large_step &&

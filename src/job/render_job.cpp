@@ -91,19 +91,42 @@ void apply_environment_caps(RenderSettings& s, const SceneDescription& d) {
 
 }  // namespace
 
-// The first material of the scene whose BSDF is not reciprocal ("" for none): a principledthin
-// with specular transmission (principledthin.hpp), also inside a blend or mask.
+// The first material of the scene whose BSDF is not reciprocal ("" for none), as "<what> has
+// <why>": a principledthin with specular transmission (principledthin.hpp), a normal or bump map
+// with Mitsuba's flip_invalid_normals or use_shadowing_function (material_textures.hpp); also
+// inside a blend or mask.
 std::string non_reciprocal_material(const SceneDescription& d) {
-    const std::function<bool(const Material&)> non_reciprocal = [&](const Material& m) {
-        if (const auto* t = std::get_if<PrincipledThinMaterial>(&m.model)) return t->spec_trans > 0;
-        if (const auto* b = std::get_if<BlendMaterial>(&m.model)) return non_reciprocal(*b->first) || non_reciprocal(*b->second);
-        if (const auto* k = std::get_if<MaskMaterial>(&m.model)) return non_reciprocal(*k->inner);
-        return false;
+    const std::function<std::string(const Material&)> why = [&](const Material& m) -> std::string {
+        if (m.mitsuba_bump_rules())
+            return fmt::format("a {} with Mitsuba's flip_invalid_normals or use_shadowing_function (its defaults: set both false for "
+                               "the reciprocal map)",
+                               m.textures->perturbation == FramePerturbation::NormalMap ? "normalmap" : "bumpmap");
+        if (const auto* t = std::get_if<PrincipledThinMaterial>(&m.model); t && t->spec_trans > 0)
+            return "specular transmission, which Mitsuba's principledthin defines without reciprocity";
+        if (const auto* b = std::get_if<BlendMaterial>(&m.model)) {
+            const std::string first = why(*b->first);
+            return first.empty() ? why(*b->second) : first;
+        }
+        if (const auto* k = std::get_if<MaskMaterial>(&m.model)) return why(*k->inner);
+        return "";
     };
     for (size_t i = 0; i < d.materials.size(); ++i)
-        if (non_reciprocal(d.materials[i]))
-            return i < d.material_ids.size() && !d.material_ids[i].empty() ? fmt::format("principledthin '{}'", d.material_ids[i])
-                                                                             : std::string("principledthin");
+        if (const std::string w = why(d.materials[i]); !w.empty()) {
+            const char* kind = std::holds_alternative<PrincipledThinMaterial>(d.materials[i].model) ? "principledthin" : "material";
+            return i < d.material_ids.size() && !d.material_ids[i].empty() ? fmt::format("{} '{}' has {}", kind, d.material_ids[i], w)
+                                                                             : fmt::format("{} has {}", kind, w);
+        }
+    return "";
+}
+
+// The first material with a straight pass through it (kLobeNull: thindielectric, mask), named as
+// the scene file does ("" if none).
+std::string null_lobe_material(const SceneDescription& d) {
+    for (size_t i = 0; i < d.materials.size(); ++i)
+        if (d.materials[i].lobes() & kLobeNull) {
+            const char* kind = std::holds_alternative<ThinDielectricMaterial>(d.materials[i].model) ? "thindielectric" : "material with a mask";
+            return i < d.material_ids.size() && !d.material_ids[i].empty() ? fmt::format("{} '{}'", kind, d.material_ids[i]) : std::string(kind);
+        }
     return "";
 }
 
@@ -148,11 +171,18 @@ std::string integrator_refusal(const IntegratorInfo& info, const SceneDescriptio
     }
     if (info.light_paths)
         if (const std::string m = non_reciprocal_material(d); !m.empty())
-            return fmt::format("{} scatters light paths with the adjoint BSDF, and this scene's {} has specular transmission, "
-                               "which Mitsuba's principledthin defines without reciprocity (f(wi, wo) != f(wo, wi)): {} would "
-                               "converge to another image. Render it with a camera-side integrator (path, pt-mis3, pt-naive, "
-                               "volpath, direct, ic, pbgi)",
+            return fmt::format("{} scatters light paths with the adjoint BSDF, and this scene's {}, which is not reciprocal "
+                               "(f(wi, wo) != f(wo, wi)): {} would converge to another image. Render it with a camera-side "
+                               "integrator (path, pt-mis3, pt-naive, volpath, direct, ic, pbgi)",
                                info.name, m, info.name);
+    if (!info.skips_null_events && (r.skip_null_events ? *r.skip_null_events : d.skip_null_events.value_or(false)) &&
+        (r.max_depth ? *r.max_depth : d.max_depth.value_or(-1)) >= 0)
+        if (const std::string m = null_lobe_material(d); !m.empty())
+            return fmt::format("{0} counts a straight pass through a surface as a bounce, and this render asks for --null-depth "
+                               "skip{1} with a finite depth in a scene with a {2}: {0} would converge to another image. "
+                               "Give --null-depth count, or --max-depth -1 (then the two agree), or render it with {3}",
+                               info.name, r.skip_null_events ? "" : " (the scene file's volpath counts depth that way)", m,
+                               null_skipping_integrator_names());
     if (!info.any_camera && d.camera.kind != CameraKind::Perspective)
         return fmt::format("{} cannot render through a {} sensor: it connects light paths to a pinhole camera (or sizes "
                            "its radii by the pinhole's pixels); use a camera-side integrator (path, direct, pt-naive, "
@@ -254,6 +284,8 @@ RenderJob::RenderJob(SceneChoice scene, const JobRequest& r) : choice_(std::move
     options_.pbgi_direct_samples = r.pbgi_direct_samples ? *r.pbgi_direct_samples : d.pbgi_direct_samples.value_or(options_.pbgi_direct_samples);
     options_.pbgi_spacing = r.pbgi_spacing ? *r.pbgi_spacing : d.pbgi_spacing.value_or(options_.pbgi_spacing);
     options_.hide_emitters = d.hide_emitters.value_or(false);
+    // (Only where it matters: a scene without thin glass or masks renders as it did.)
+    options_.skip_null_events = (r.skip_null_events ? *r.skip_null_events : d.skip_null_events.value_or(false)) && !null_lobe_material(d).empty();
     for (size_t i = 0; i < r.aovs.size(); ++i) {
         const std::vector<std::string>& names = aov_names();
         if (std::find(names.begin(), names.end(), r.aovs[i]) == names.end())

@@ -6,6 +6,7 @@
 //              else the request's default_spp (64 for renders)
 //   max_depth  the request's, else the scene file's, else -1 (unlimited)
 //   rr_depth   the request's, else the scene file's, else 3
+//   null-depth the request's, else the scene file's (skip for Mitsuba's volpath), else count
 // For smoke tests of whole commands (the docs test runs every command of README this way), the
 // environment variables PATHLAB_SPP_CAP=N, PATHLAB_TIME_CAP=S and PATHLAB_RESOLUTION_CAP=P cap
 // every render at N samples per pixel, S seconds and P pixels on its longer side (the aspect
@@ -72,6 +73,7 @@ struct JobRequest {
     std::optional<float> mlt_large_step;            // --large-step (pssmlt)
     std::optional<float> mlt_sigma;                 // --sigma (pssmlt)
     std::vector<std::string> aovs;                  // --aovs (render/aov_film.hpp's names), as EXR layers
+    std::optional<bool> skip_null_events;           // --null-depth skip|count (default: the scene file's, else count)
 };
 
 // The integrator `name` (or an alias); a UsageError listing them all otherwise.

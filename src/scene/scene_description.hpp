@@ -73,6 +73,7 @@ struct SceneDescription {
     LightSamplerKind light_sampler = LightSamplerKind::Power;
     int ris_candidates = kDefaultRisCandidates;  // --ris-candidates (ris)
     std::optional<bool> hide_emitters;            // paths of no bounce (emitters seen directly) left out
+    std::optional<bool> skip_null_events;         // --null-depth skip (a Mitsuba <integrator type="volpath">)
     // The film: its reconstruction filter, the format of the default output (hdrfilm's
     // file_format: "openexr", "rgbe" or "pfm"), and extra outputs an integrator asks for
     // (moment: the second moment; aov: depth, position, normals, albedo).

@@ -548,6 +548,12 @@ void Converter::write_material(int index, const std::string& id, pugi::xml_node 
         info.index = m.normalTexture.index, info.texCoord = m.normalTexture.texCoord, info.extensions = m.normalTexture.extensions;
         texture_image(info, name, "normalTexture");  // checks the texture (its image is copied as it is)
         add_bitmap(host, "normalmap", image_file(model_.textures[size_t(info.index)].source), info, /*raw=*/true);
+        // The reciprocal normal map (Mitsuba's flip and shadowing term off), which every integrator renders.
+        for (const char* option : {"flip_invalid_normals", "use_shadowing_function"}) {
+            pugi::xml_node b = host.append_child("boolean");
+            b.append_attribute("name") = option;
+            b.append_attribute("value") = "false";
+        }
         host = host.append_child("bsdf");
         host.append_attribute("type") = "principled";
     }

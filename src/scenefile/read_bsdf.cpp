@@ -152,8 +152,11 @@ Material read_wrapper(XmlSource& xml, const pugi::xml_node& n, const BsdfPlugin&
         return m;
     }
     // normalmap, bumpmap
+    bool flip = true, shadowing = true;
     const float scale = reading([&] {
         const float s = type == "bumpmap" ? p.get_float("scale") : 1.0f;
+        if (p.has("flip_invalid_normals")) flip = p.get_bool("flip_invalid_normals");
+        if (p.has("use_shadowing_function")) shadowing = p.get_bool("use_shadowing_function");
         p.check_all_used();
         return s;
     });
@@ -166,6 +169,8 @@ Material read_wrapper(XmlSource& xml, const pugi::xml_node& n, const BsdfPlugin&
     t.perturbation = type == "normalmap" ? FramePerturbation::NormalMap : FramePerturbation::BumpMap;
     t.perturbation_texture = tex;
     t.bump_scale = scale;
+    t.flip_invalid_normals = flip;
+    t.shadowing_function = shadowing;
     m.set_textures(std::move(t));
     return m;
 }

@@ -39,6 +39,8 @@ void read_plain_integrator(XmlSource& xml, const pugi::xml_node& n, SceneBuilder
         return;
     }
     b.desc.algorithm = info->name;
+    // Mitsuba's volpath does not count a null BSDF sample (a straight pass) as a bounce; its path does.
+    if (info->name == "volpath") b.desc.skip_null_events = true;
     if (!xml.plugin_children(n).empty()) xml.fail(xml.plugin_children(n).front(), "an <integrator> has no nested plugins");
     const PluginInfo plugin = info->plugin();
     Properties p = xml.properties(n, plugin);

@@ -61,12 +61,12 @@ ColourOf<T> estimate_light(const Scene& scene, const ScatterVertex& v, Sampler& 
             shadow = Ray{v.p, to - v.p, 1.0f - 1e-4f};
         }
     }
-    if (scene.media_separated(medium, scene.light_medium(choice.index))) return Colour(0.0f);  // blocked: no ray needed
+    if (!st.pass_null && scene.media_separated(medium, scene.light_medium(choice.index))) return Colour(0.0f);  // blocked: no ray needed
     const Colour Tr = shadow_transmittance(scene, shadow, medium, st);
     if (is_black(Tr)) return Colour(0.0f);
     const float weight = !ls->delta ? (mis ? mis_heuristic(power, nee->pdf_source, pdf_scatter) : 1.0f) : 1.0f;
     const Colour contribution = f * light_colour(scene, choice.index, ls->Le, wl) * (cosine * weight / nee->pdf);
-    return scene.has_media() ? contribution * Tr : contribution;
+    return scene.has_media() || st.pass_null ? contribution * Tr : contribution;
 }
 
 // The radiance a walk that ended on a surface or in the sky finds (Le towards the path, in RGB),
@@ -93,6 +93,15 @@ inline EmitterHit emission_found(const Scene& scene, const MediumWalk& w, const 
     return e;
 }
 
+// Where the path last scattered, for the MIS weight of emission found past surfaces it passed
+// straight through (--null-depth skip): those are no vertices, so light sampling from here,
+// whose shadow rays pass them too, is the sample's partner. The camera: a delta, weight 1.
+struct MisOrigin {
+    Vec3f p{}, n{};  // n: the shading normal at a surface, 0 in a medium
+    float pdf = 0;   // the solid-angle density of the direction sampled there
+    bool delta = true;
+};
+
 // A BSDF or phase sample at a vertex and the walk along it.
 template <class T>
 struct ScatterSample {
@@ -103,14 +112,18 @@ struct ScatterSample {
     ColourOf<T> next_seg{1.0f};       // its free-flight weights
     ColourOf<T> weight{0.0f};         // f cos / pdf of the sampled direction
     ColourOf<T> found{0.0f};          // the emission the walk reached, times f cos / pdf and the MIS weight against light sampling
+    uint32_t lobe = 0;                // the BSDF lobe sampled (BsdfLobe; 0 for a phase sample)
+    float pdf = 0;                    // the solid-angle density of the sampled direction
+    bool delta = false;               // ... a Dirac delta's coefficient
 };
 
 // The second half of the MIS pair at v (the first is estimate_light): a BSDF sample at a surface
 // (whose vertex and walk are v.sp and v.hit) or a phase sample in a medium, and the emission its
-// walk finds; the caller adds beta * next_seg * found / density.
+// walk finds; the caller adds beta * next_seg * found / density. With `null_origin`, emission
+// found by a straight pass (kLobeNull) is weighed against light sampling at that origin.
 template <class T>
 ScatterSample<T> sample_scatter(const Scene& scene, const ScatterVertex& v, Sampler& sampler, MediumState<T>& st, bool mis,
-                                WavelengthsOf<T>& wl, bool power = false) {
+                                WavelengthsOf<T>& wl, bool power = false, const MisOrigin* null_origin = nullptr) {
     using Colour = ColourOf<T>;
     ScatterSample<T> n;
     int light;
@@ -120,18 +133,25 @@ ScatterSample<T> sample_scatter(const Scene& scene, const ScatterVertex& v, Samp
         const auto s = bsdf_sample(sp, sampler.next2d(), wl);
         if (!s) return n;
         n.sampled = true;
+        n.lobe = s->lobe;
+        n.pdf = s->pdfW;
+        n.delta = s->delta;
         n.ray = sp.spawn(s->wo);
         n.medium = medium_after(w.media, w.isect.ng, sp.frame.to_world(s->wo), w.medium);
         n.next = walk_media(scene, n.ray, n.medium, st, n.next_seg);
         const Colour f = bsdf_sample_colour(sp, *s, wl);
         n.weight = f * (std::abs(s->wo.z) / s->pdfW);
-        const EmitterHit e = emission_found(scene, n.next, sp.p, sp.frame.n, light);
-        const float weight = s->delta ? 1.0f : (mis ? mis_heuristic(power, s->pdfW, e.pdf_light) : 0.0f);
+        const bool passed = null_origin && (s->lobe & kLobeNull);
+        const MisOrigin here{sp.p, sp.frame.n, s->pdfW, s->delta};
+        const MisOrigin& o = passed ? *null_origin : here;
+        const EmitterHit e = emission_found(scene, n.next, o.p, o.n, light);
+        const float weight = o.delta ? 1.0f : (mis ? mis_heuristic(power, o.pdf, e.pdf_light) : 0.0f);
         if (!is_black(e.Le)) n.found = f * light_colour(scene, light, e.Le, wl) * (std::abs(s->wo.z) * weight / s->pdfW);
     } else {
         const PhaseSample ps = phase_sample(*v.phase, v.wi, sampler.next2d());
         if (!(ps.pdfW > 0)) return n;
         n.sampled = true;
+        n.pdf = ps.pdfW;
         n.ray = Ray{v.p, ps.wo, kInf};
         n.medium = v.medium;
         n.next = walk_media(scene, n.ray, n.medium, st, n.next_seg);

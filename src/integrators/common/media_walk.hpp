@@ -35,6 +35,9 @@ struct MediumState {
     std::optional<Sampler> stream{};  // forked on first use
     int hero = -1;  // drawn on first use unless set (the subpaths of one bdpt sample share it)
     ColourOf<T> r{1.0f};  // the channels' path densities over a common normaliser
+    // --null-depth skip (volpath): shadow rays pass thin glass and masks' holes times their
+    // null_transmission() instead of being blocked (the surfaces are no vertices of the path).
+    bool pass_null = false;
 
     Sampler& rng() {
         if (!stream) stream.emplace(parent.fork(stream_id));
@@ -119,20 +122,25 @@ MediumWalk walk_media(const Scene& scene, Ray ray, int32_t medium, MediumState<T
 
 // The transmittance along a shadow ray (a segment ending a little before its target, or a ray
 // to infinity) starting in `medium`: 0 if a surface blocks it, else the product of the media's
-// transmittance estimates between the index-matched boundaries it crosses. `mis_T`, if given,
+// transmittance estimates between the index-matched boundaries it crosses (and, with
+// st.pass_null, of the null_transmission of the thin glass and masks it passes). `mis_T`, if given,
 // is multiplied by the MIS transmittance of the pieces (left alone when a surface blocks it).
 template <class T>
 ColourOf<T> shadow_transmittance(const Scene& scene, Ray shadow, int32_t medium, MediumState<T>& st, float* mis_T = nullptr) {
     using Colour = ColourOf<T>;
-    if (!scene.has_media()) return scene.occluded(shadow) ? Colour(0.0f) : Colour(1.0f);
+    if (!scene.has_media() && !st.pass_null) return scene.occluded(shadow) ? Colour(0.0f) : Colour(1.0f);
     const bool segment = std::isfinite(shadow.tmax);
     const Vec3f target = shadow.o + shadow.d;  // (segments: d = target - origin)
     Colour Tr(1.0f);
     for (int crossings = 0; crossings < kMaxCrossings; ++crossings) {
         Intersection isect;
         const MediumInterface* media = nullptr;
-        const bool hit = scene.intersect(shadow, isect, kMaskAll, media);
-        if (hit && !(media && media->index_matched)) return Colour(0.0f);
+        const bool hit = intersect_with_boundaries(scene, shadow, isect, media);
+        if (hit && !(media && media->index_matched)) {
+            const float passed = st.pass_null ? null_transmission(scene, isect, shadow.d) : 0.0f;
+            if (!(passed > 0)) return Colour(0.0f);
+            Tr *= passed;
+        }
         if (medium >= 0) {
             const float len = length(shadow.d);
             const float t = hit ? isect.t : shadow.tmax;

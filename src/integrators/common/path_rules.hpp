@@ -1,7 +1,8 @@
 // When a path may go on: the depth limit and Russian roulette, shared by the path tracers.
 //
 // Depth counts bounces: a path camera -> x1 -> light has one bounce (direct illumination), so
-// max_depth = 1 gives direct lighting only. Russian roulette starts after rr_depth bounces
+// max_depth = 1 gives direct lighting only. With --null-depth skip a straight pass through a
+// surface (a kLobeNull sample) is no bounce (is_bounce). Russian roulette starts after rr_depth bounces
 // (never if rr_depth < 0): the path survives with probability q = clamp(max(beta), 0.05, 1)
 // and its throughput beta is divided by q, which keeps the estimator unbiased; the lower
 // bound keeps 1/q bounded. A hard cap of kMaxBounces guards against paths that never end
@@ -10,6 +11,7 @@
 
 #include <algorithm>
 
+#include "bsdfs/bsdf_sample.hpp"
 #include "samplers/sampler.hpp"
 #include "integrators/integrator.hpp"
 #include "spectral/spectrum4.hpp"
@@ -48,13 +50,21 @@ inline bool length_counts(const IntegratorOptions& o, int length) {
 class PathRules {
 public:
     explicit PathRules(const IntegratorOptions& o)
-        : max_depth_(bounce_limit(o.max_depth)), rr_depth_(o.rr_depth), power_mis_(o.mis_power) {}
+        : max_depth_(bounce_limit(o.max_depth)), rr_depth_(o.rr_depth), power_mis_(o.mis_power),
+          skip_null_(o.skip_null_events), hide_emitters_(o.hide_emitters) {}
 
     // The path tracers' MIS heuristic: the power heuristic (--mis power), else the balance one.
     bool power_mis() const { return power_mis_; }
 
     // May a path that has made `bounces` bounces make one more?
     bool may_bounce(int bounces) const { return bounces < max_depth_; }
+
+    // --null-depth skip: a path at its depth limit may still pass straight through surfaces.
+    bool skips_null() const { return skip_null_; }
+    // Whether a sampled direction makes a bounce (not a straight pass under --null-depth skip).
+    bool is_bounce(uint32_t sampled_lobe) const { return !(skip_null_ && (sampled_lobe & kLobeNull)); }
+    // Paths of no bounce (emitters seen directly, also through a null surface) are hidden.
+    bool hides_emitters() const { return hide_emitters_; }
 
     // Called after bounce number `bounces` (1-based) updated beta (RGB or spectral: q from its
     // largest channel or lane); false ends the path.
@@ -75,6 +85,8 @@ private:
     int max_depth_;
     int rr_depth_;
     bool power_mis_;
+    bool skip_null_;
+    bool hide_emitters_;
 };
 
 }  // namespace pathlab

@@ -19,11 +19,15 @@ struct ShadingPoint : BsdfContext {
 
 // The surface coordinates and the shading frame at a hit on a material that uses them (out of
 // the hot path): uv for its textures, and the frame along dp/du for tangent_frame materials.
-[[gnu::noinline]] inline void set_surface_coordinates(const Scene& scene, const Intersection& hit, bool back, ShadingPoint& sp) {
+// A normal map's flip_invalid_normals (material_textures.hpp) looks at where the path came from
+// (ray_dir), in radiance mode (importance mode refuses such maps: RenderJob).
+[[gnu::noinline]] inline void set_surface_coordinates(const Scene& scene, const Intersection& hit, bool back, const Vec3f& ray_dir,
+                                                      ShadingPoint& sp) {
     const Scene::SurfaceCoordinates c = scene.surface_coordinates(hit);
     sp.uv = c.uv;
-    sp.frame = sp.material->tangent_frame ? sp.material->shading_frame(hit.ns, hit.ng, back, c.dpdu, c.dpdv, c.uv)
-                                          : Frame(back ? -hit.ns : hit.ns);
+    sp.ns = back ? -hit.ns : hit.ns;
+    sp.frame = sp.material->tangent_frame ? sp.material->shading_frame(hit.ns, hit.ng, back, c.dpdu, c.dpdv, c.uv) : Frame(sp.ns);
+    if (sp.mode == TransportMode::Radiance && sp.material->flips_invalid_normals()) sp.frame = flip_invalid_normal(sp.frame, sp.ns, -ray_dir);
 }
 
 // Two-sided materials see the front of every surface: their normals are flipped to face the
@@ -48,13 +52,24 @@ inline ShadingPoint make_shading_point(const Scene& scene, const Intersection& h
         if (sp.material->back >= 0) sp.material = &scene.material(uint32_t(sp.material->back));
     }
     if (sp.material->surface_coordinates) [[unlikely]]
-        set_surface_coordinates(scene, hit, back, sp);
+        set_surface_coordinates(scene, hit, back, ray_dir, sp);
     else
         sp.frame = Frame(ns);
     sp.wi = sp.frame.to_local(-ray_dir);
     if (FirstVertexRecorder* r = t_first_vertex) [[unlikely]]  // a camera sample with --aovs
         offer_surface_vertex(*r, scene, sp);
     return sp;
+}
+
+// The fraction of light passing straight through the surface at `hit` along `dir` (its material's
+// kLobeNull lobe, Material::null_transmission; 0 for the rest): what a shadow ray carries through
+// thin glass or a mask's hole under --null-depth skip.
+inline float null_transmission(const Scene& scene, const Intersection& hit, const Vec3f& dir) {
+    const Material* m = &scene.material(hit.material);
+    if (!(m->lobes() & kLobeNull)) return 0.0f;
+    if (m->two_sided && m->back >= 0 && dot(dir, hit.ng) > 0) m = &scene.material(uint32_t(m->back));
+    const SurfaceUv uv = m->surface_coordinates ? scene.surface_coordinates(hit).uv : hit.uv;
+    return m->null_transmission(uv, std::abs(dot(dir, hit.ns)) / length(dir));
 }
 
 // Emitted radiance of the surface at `hit` towards direction `w` (unit, away from the surface):

@@ -66,6 +66,7 @@ const IntegratorInfo& pssmlt_integrator() {
                          path_params(),
                          [](const IntegratorOptions& o) { return make_for_transport<Pssmlt>(o); }};
         i.samples_lights = true;
+        i.skips_null_events = true;  // (pt-mis's and volpath's loops)
         i.media = true;
         return i;
     }();

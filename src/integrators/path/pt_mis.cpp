@@ -20,23 +20,33 @@ template <class Wl>
 ColourAt<Wl> pt_mis_from_hit(const Scene& scene, Intersection hit, Vec3f dir, int first_bounce, Sampler& sampler, const PathRules& rules,
                              Wl& wl, bool three_rays, int only_length, ColourAt<Wl> L) {
     using Colour = ColourAt<Wl>;
-    const auto counts = [only_length](int length) { return only_length < 0 || only_length == length; };
+    const auto counts = [&](int length) {
+        return (only_length < 0 || only_length == length) && !(length == 0 && rules.hides_emitters());
+    };
     Colour beta(1.0f);
-    for (int bounces = first_bounce; rules.may_bounce(bounces); ++bounces) {
+    // `bounces`: the bounces made before the vertex at `hit`. At the depth limit a path under
+    // --null-depth skip may still pass straight through surfaces (kLobeNull), and nothing else.
+    for (int bounces = first_bounce, step = 0; step < kMaxBounces; ++step) {
+        const bool may_scatter = rules.may_bounce(bounces);
+        if (!may_scatter && !rules.skips_null()) break;
         const ShadingPoint sp = make_shading_point(scene, hit, dir);
+        if (!may_scatter && !(sp.material->lobes() & kLobeNull)) break;
         if (sp.material->is_black()) break;
         // Paths of bounces + 1 bounces ending on a light: the MIS pair.
-        const Colour direct = estimate_light_sample(scene, sp, sampler, /*mis=*/true, wl, rules.power_mis());
-        if (counts(bounces + 1)) L += beta * direct;
+        if (may_scatter) {
+            const Colour direct = estimate_light_sample(scene, sp, sampler, /*mis=*/true, wl, rules.power_mis());
+            if (counts(bounces + 1)) L += beta * direct;
+        }
         const auto s = bsdf_sample(sp, sampler.next2d(), wl);
         EmitterHit found;
         Colour f(0.0f);  // the continuation's BSDF value
         if (s) {
             f = bsdf_sample_colour(sp, *s, wl);
             const Colour found_emission = estimate_bsdf_sample_mis(scene, sp, *s, f, found, wl, rules.power_mis());
-            if (counts(bounces + 1)) L += beta * found_emission;
+            const bool bounce = rules.is_bounce(s->lobe);
+            if ((may_scatter || !bounce) && counts(bounces + (bounce ? 1 : 0))) L += beta * found_emission;
         }
-        if (!rules.may_bounce(bounces + 1)) break;
+        if (!rules.skips_null() && !rules.may_bounce(bounces + 1)) break;
 
         // Continue the path: with the same BSDF sample (pt-mis) or a fresh one (pt-mis3).
         // The fresh one is independent of the first: a rejected MIS sample (a direction
@@ -50,9 +60,12 @@ ColourAt<Wl> pt_mis_from_hit(const Scene& scene, Intersection hit, Vec3f dir, in
             f = bsdf_sample_colour(sp, next, wl);
             found.hit = scene.intersect(sp.spawn(next.wo), found.isect);
         }
+        const bool bounce = rules.is_bounce(next.lobe);
+        if (!may_scatter && bounce) break;  // a scattering past the depth limit
         if (!found.hit) break;  // escaped: the environment was counted by the MIS pair
         beta *= f * (std::abs(next.wo.z) / next.pdfW);
-        if (!rules.survive_roulette(bounces + 1, beta, sampler)) break;
+        if (bounce && !rules.survive_roulette(bounces + 1, beta, sampler)) break;
+        bounces += bounce ? 1 : 0;
         hit = found.isect;
         dir = sp.frame.to_world(next.wo);
     }
@@ -79,6 +92,11 @@ template Spectrum4 pt_mis_camera_radiance(const Scene&, const Ray&, Sampler&, co
 
 namespace {
 
+IntegratorInfo skipping_null_events(IntegratorInfo info) {
+    info.skips_null_events = true;
+    return info;
+}
+
 template <class T>
 class PtMis final : public PixelIntegrator<T> {
 public:
@@ -99,13 +117,13 @@ private:
 }  // namespace
 
 const IntegratorInfo& pt_mis3_integrator() {
-    static const IntegratorInfo info = sampling_lights(IntegratorInfo{"pt-mis3", {"4b"}, "path tracing, MIS direct lighting at every bounce + a third continuation ray",
-                                     false, true, path_params(), [](const IntegratorOptions& o) { return make_for_transport<PtMis>(o, true); }});
+    static const IntegratorInfo info = skipping_null_events(sampling_lights(IntegratorInfo{"pt-mis3", {"4b"}, "path tracing, MIS direct lighting at every bounce + a third continuation ray",
+                                     false, true, path_params(), [](const IntegratorOptions& o) { return make_for_transport<PtMis>(o, true); }}));
     return info;
 }
 const IntegratorInfo& pt_mis_integrator() {
-    static const IntegratorInfo info = sampling_lights(IntegratorInfo{"pt-mis", {"4c", "path"}, "path tracing, MIS direct lighting whose BRDF ray continues the path",
-                                     false, true, path_params(), [](const IntegratorOptions& o) { return make_for_transport<PtMis>(o, false); }});
+    static const IntegratorInfo info = skipping_null_events(sampling_lights(IntegratorInfo{"pt-mis", {"4c", "path"}, "path tracing, MIS direct lighting whose BRDF ray continues the path",
+                                     false, true, path_params(), [](const IntegratorOptions& o) { return make_for_transport<PtMis>(o, false); }}));
     return info;
 }
 

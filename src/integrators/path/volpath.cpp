@@ -9,6 +9,10 @@
 //  - a light sample's shadow ray crosses boundaries and media too, and its contribution is
 //    multiplied by their transmittance (closed form, or ratio tracking in grids), estimated
 //    with the random numbers of a second stream;
+//  - under --null-depth skip (Mitsuba's volpath, and a scene file's <integrator type="volpath">) a
+//    straight pass through thin glass or a mask's hole is no bounce, light samples' shadow rays
+//    pass such surfaces times their null transmission, and emission found past them is weighed
+//    against light sampling at the vertex before them (MisOrigin);
 //  - a hero channel drives distance sampling, with spectral MIS over the channels (beta /
 //    path_density(r), media/medium.hpp): in RGB one of the three chosen per path, in spectral
 //    mode the hero wavelength (media/spectral_medium.hpp); Russian roulette on that ratio.
@@ -37,7 +41,8 @@ public:
     Volpath(const IntegratorOptions& o, VolpathSettings s) : rules_(o), settings_(s), hide_(o.hide_emitters) {}
 
     Colour radiance(const Scene& scene, const Ray& camera_ray, Sampler& sampler, WavelengthsOf<T>& wl) const override {
-        if (!scene.has_media() && settings_.pt_mis_without_media) {  // pt-mis's own loop: the same image, pt-mis's speed
+        // pt-mis's own loop: the same image, pt-mis's speed (not under --null-depth skip, whose shadow rays pass thin glass)
+        if (!scene.has_media() && settings_.pt_mis_without_media && !rules_.skips_null()) {
             Intersection hit;
             if (!scene.intersect(camera_ray, hit)) return hide_ ? Colour(0.0f) : escaped_radiance(scene, camera_ray.d, wl);
             const Colour emitted = hide_ ? Colour(0.0f) : emitted_radiance(scene, hit, -camera_ray.d, wl);
@@ -45,6 +50,8 @@ public:
         }
         const bool mis = settings_.mis;
         MediumState<T> st{sampler, wl, settings_.majorant_factor};
+        st.pass_null = rules_.skips_null();
+        MisOrigin origin;  // where the path last scattered (the camera: a delta)
         Colour seg(1.0f);
         MediumWalk w = walk_media(scene, camera_ray, scene.camera_medium(), st, seg);
         Colour beta = seg;
@@ -53,12 +60,17 @@ public:
         // (hide_emitters: not the emitters and the sky seen directly, also through media.)
         if (w.kind == MediumWalk::kEscaped) return hide_ ? Colour(0.0f) : beta * escaped_radiance(scene, w.dir, wl) / st.density();
         if (w.kind == MediumWalk::kSurface && !hide_) L = beta * emitted_radiance(scene, w.isect, -w.dir, wl) / st.density();
-        for (int bounces = 0; w.kind != MediumWalk::kLost && rules_.may_bounce(bounces); ++bounces) {
+        // `bounces`: those made before the vertex w reached. At the depth limit a path under
+        // --null-depth skip may still pass straight through surfaces (kLobeNull), and nothing else.
+        for (int bounces = 0, step = 0; w.kind != MediumWalk::kLost && step < kMaxBounces; ++step) {
+            const bool may_scatter = rules_.may_bounce(bounces);
+            if (!may_scatter && !(rules_.skips_null() && w.kind == MediumWalk::kSurface)) break;
             ScatterVertex v;
             v.medium = w.medium;
             ShadingPoint sp;
             if (w.kind == MediumWalk::kSurface) {
                 sp = make_shading_point(scene, w.isect, w.dir);
+                if (!may_scatter && !(sp.material->lobes() & kLobeNull)) break;
                 if (sp.material->is_black()) break;
                 v.sp = &sp;
                 v.hit = &w;
@@ -71,19 +83,25 @@ public:
                 v.phase = &medium_phase(scene.medium(w.medium));
             }
             // The MIS pair: a light sample, and a BSDF or phase sample whose walk may find emission.
-            const Colour direct = estimate_light(scene, v, sampler, st, mis, wl, rules_.power_mis());
-            L += beta * direct / st.density();
+            if (may_scatter) {
+                const Colour direct = estimate_light(scene, v, sampler, st, mis, wl, rules_.power_mis());
+                L += beta * direct / st.density();
+            }
 
-            const ScatterSample<T> n = sample_scatter(scene, v, sampler, st, mis, wl, rules_.power_mis());
+            const ScatterSample<T> n = sample_scatter(scene, v, sampler, st, mis, wl, rules_.power_mis(), st.pass_null ? &origin : nullptr);
             if (!n.sampled) break;  // pt-mis: no BSDF sample, nothing found, and the path ends
-            L += beta * n.next_seg * n.found / st.density();
+            const bool bounce = rules_.is_bounce(n.lobe);
+            if (bounce) origin = MisOrigin{v.p, v.sp ? v.sp->frame.n : Vec3f(0.0f), n.pdf, n.delta};
+            if (!may_scatter && bounce) break;  // a scattering past the depth limit
+            if (!(hide_ && bounces == 0 && !bounce)) L += beta * n.next_seg * n.found / st.density();
             const MediumWalk& next = n.next;
             const Colour& next_seg = n.next_seg;
             const Colour& weight_next = n.weight;
-            if (!rules_.may_bounce(bounces + 1)) break;
+            if (!rules_.skips_null() && !rules_.may_bounce(bounces + 1)) break;
             if (next.kind == MediumWalk::kEscaped || next.kind == MediumWalk::kLost) break;
             beta = beta * next_seg * weight_next;
-            if (!survive_roulette(bounces + 1, beta, st.density(), sampler)) break;
+            if (bounce && !survive_roulette(bounces + 1, beta, st.density(), sampler)) break;
+            bounces += bounce ? 1 : 0;
             w = next;
         }
         return L;
@@ -116,6 +134,7 @@ const IntegratorInfo& volpath_integrator() {
                          false, true, path_params(), [](const IntegratorOptions& o) { return make_volpath(o); }};
         i.media = true;
         i.samples_lights = true;
+        i.skips_null_events = true;
         return i;
     }();
     return info;

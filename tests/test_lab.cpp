@@ -339,6 +339,27 @@ TEST_F(Lab, ReportHasStandardErrorsEfficiencyBothCurvesCsvAndInsets) {
     EXPECT_TRUE(contains(bad.err, "not inside the 8x8 image")) << bad.err;
 }
 
+// --guide-pixel: ppg's learned distribution at a pixel's first hit, as a picture in the report.
+TEST_F(Lab, ReportShowsWhatTheGuideLearnedAtAPixel) {
+    const CliResult r = run({"report", "3", "-a", "ppg,pt-mis", "--spp", "2", "--resolution", "24x16", "--reference-spp", "4",
+                             "--guide-pixel", "12,10", "-q", "-o", path("g.html")});
+    ASSERT_EQ(r.code, 0) << r.err;
+    const std::string html = read_text(path("g.html"));
+    EXPECT_TRUE(contains(html, "What the guide learned"));
+    EXPECT_TRUE(contains(html, "pixel (12, 10): first hit at"));
+    EXPECT_TRUE(fs::exists(path("g_files/ppg_guide.png")));
+    EXPECT_FALSE(fs::exists(path("g_files/pt-mis_guide.png")));
+    EXPECT_EQ(read_png8(path("g_files/ppg_guide.png")).width, 256);
+    // Refused before anything renders: without ppg, and outside the image.
+    const CliResult without = run({"report", "3", "-a", "pt-mis", "--spp", "2", "--resolution", "8x8", "--guide-pixel", "1,1", "-q", "-o", path("b.html")});
+    EXPECT_EQ(without.code, 2);
+    EXPECT_TRUE(contains(without.err, "add ppg to -a")) << without.err;
+    const CliResult outside = run({"report", "3", "-a", "ppg", "--spp", "2", "--resolution", "8x8", "--reference-spp", "2", "--guide-pixel", "8,1",
+                                   "-q", "-o", path("c.html")});
+    EXPECT_EQ(outside.code, 2);
+    EXPECT_TRUE(contains(outside.err, "not inside the 8x8 image")) << outside.err;
+}
+
 TEST_F(Lab, ReportOfSeveralScenesWritesAPageEach) {
     CliResult r = run({"report", "2", ball(), "-a", "3", "--spp", "2", "--resolution", "8x6", "--reference-spp", "4", "-q", "-o", path("one.html")});
     EXPECT_EQ(r.code, 2);

@@ -7,6 +7,7 @@
 
 #include "chi2.hpp"
 #include "core/rng.hpp"
+#include "integrators/guiding/guide_map.hpp"
 #include "integrators/guiding/ppg.hpp"
 #include "job/render_job.hpp"
 #include "judge/image_statistics.hpp"
@@ -189,6 +190,33 @@ TEST(PpgAgreement, FailsWhenLightSamplingIgnoresTheGuidingDensity) {
 
 // Without training ppg is pt-mis's estimator with pt-mis's random numbers: the same image up to
 // the rounding of one product's order.
+// The report's picture of a leaf (guide_map.hpp): its pixels, each a density per steradian over
+// an equal area of the sphere, sum to 1 / (4 pi / pixels); the peak lies where the light came
+// from; a leaf that learned nothing is black; only a trained ppg has a tree to show.
+TEST(PathGuiding, GuideMapIsTheLeafsDensityOverTheSphere) {
+    const Vec3f peak = normalize(Vec3f(0.3f, -0.5f, 0.8f));
+    const SdTree tree = peaked_tree(peak);
+    const int w = 512, h = 256;
+    const Image map = guide_map(tree, Vec3f(0.1f), w, h);
+    double sum = 0;
+    size_t brightest = 0;
+    for (size_t i = 0; i < map.pixel_count(); ++i) {
+        sum += map[i].x;
+        if (map[i].x > map[brightest].x) brightest = i;
+    }
+    EXPECT_NEAR(sum * 4 * kPi / (w * h), 1.0, 2e-3);
+    // The brightest pixel's direction: column = azimuth, row = cos theta from +z down.
+    const float phi = 2 * kPi * (float(brightest % w) + 0.5f) / w, cos_theta = 1 - 2 * (float(brightest / w) + 0.5f) / h;
+    const float sin_theta = std::sqrt(1 - cos_theta * cos_theta);
+    EXPECT_GT(dot(Vec3f(sin_theta * std::cos(phi), sin_theta * std::sin(phi), cos_theta), peak), 0.95f);
+    const Image empty = guide_map(SdTree(Vec3f(0.0f), 1.0f), Vec3f(0.1f), 16, 8);
+    for (size_t i = 0; i < empty.pixel_count(); ++i) EXPECT_EQ(empty[i].x, 0.0f);
+    IntegratorOptions o;
+    o.guiding_spp = 0;
+    EXPECT_EQ(trained_guide(PathGuiding<RgbTransport>(o)), nullptr);  // never trained
+    EXPECT_EQ(trained_guide(*find_integrator("pt-mis")->make(IntegratorOptions{})), nullptr);
+}
+
 TEST(PathGuiding, WithoutTrainingIsPtMis) {
     IntegratorOptions o;
     o.guiding_spp = 0;

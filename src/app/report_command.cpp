@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <optional>
 
@@ -17,6 +18,8 @@
 #include "job/output_paths.hpp"
 #include "job/render_job.hpp"
 #include "scene/builtin_scenes.hpp"
+#include "cameras/camera.hpp"
+#include "integrators/guiding/guide_map.hpp"
 #include "judge/html_report.hpp"
 #include "judge/image_compare.hpp"
 #include "judge/reference_manifest.hpp"
@@ -40,6 +43,7 @@ std::string command_line(const ReportOptions& o, const std::string& scene, const
               (o.reference_algorithm != "pt-mis" ? " --reference-algorithm " + o.reference_algorithm : "");
     if (o.max_depth) s += fmt::format(" --max-depth {}", *o.max_depth);
     for (const std::string& c : o.crops) s += " --crop " + c;
+    if (!o.guide_pixel.empty()) s += " --guide-pixel " + o.guide_pixel;
     return s + fmt::format(" --seed {} -o {}", o.seed, output);
 }
 
@@ -83,6 +87,9 @@ CLI::App* add_report_command(CLI::App& app, ReportOptions& o) {
     cmd->add_option("--seed", o.seed, "Random seed of the compared renders")->capture_default_str();
     cmd->add_option("--max-depth", o.max_depth, "Longest path in bounces (-1: unlimited; default: the scene file's, else -1)");
     cmd->add_option("--crop", o.crops, "An inset X,Y,W,H (pixels from the top left) shown magnified for every image (repeatable)");
+    cmd->add_option("--guide-pixel", o.guide_pixel,
+                    "ppg: also show the guiding distribution its SD-tree learned where the ray through the centre of pixel X,Y (from the "
+                    "top left) first hits the scene, as an image of the sphere of directions");
     add_threads_option(*cmd, o.threads);
     cmd->add_flag("-q,--quiet", o.quiet, "No progress line and no summary");
     cmd->footer(kInterruptHelp);
@@ -103,6 +110,17 @@ int run_report_command(const ReportOptions& o) {
     parse_resolution_option(o.resolution, width, height);
     std::vector<PixelRect> crops;
     for (const std::string& c : o.crops) crops.push_back(parse_crop_option(c));
+    std::optional<std::pair<int, int>> guide_pixel;
+    if (!o.guide_pixel.empty()) {
+        int x = -1, y = -1;
+        char comma = 0, extra = 0;
+        if (std::sscanf(o.guide_pixel.c_str(), "%d%c%d%c", &x, &comma, &y, &extra) != 3 || comma != ',' || x < 0 || y < 0)
+            throw UsageError(fmt::format("--guide-pixel {}: give X,Y, a pixel's column and row from the top left", o.guide_pixel));
+        guide_pixel = std::pair{x, y};
+        bool guided = false;
+        for (const IntegratorInfo* e : infos) guided = guided || e->name == "ppg";
+        if (!guided) throw UsageError("--guide-pixel shows what ppg learned: add ppg to -a");
+    }
     const size_t direct = size_t(std::count_if(infos.begin(), infos.end(), [](const IntegratorInfo* e) { return is_direct_illumination(*e); }));
     const bool all_direct = direct == infos.size();
     if (o.reference.empty() && direct > 0 && !all_direct)
@@ -159,6 +177,8 @@ int run_report_command(const ReportOptions& o) {
         const RenderJob sized_job(page.choice, sized);
         if (page.reference.empty()) {
             const int w = sized_job.width(), h = sized_job.height();
+            if (guide_pixel && (guide_pixel->first >= w || guide_pixel->second >= h))
+                throw UsageError(fmt::format("--guide-pixel {},{} is not inside the {}x{} image", guide_pixel->first, guide_pixel->second, w, h));
             for (const PixelRect& c : crops)
                 if (c.x + c.width > w || c.y + c.height > h)
                     throw UsageError(fmt::format("--crop {},{},{},{} is not inside the {}x{} image", c.x, c.y, c.width, c.height, w, h));
@@ -187,6 +207,8 @@ int run_report_command(const ReportOptions& o) {
         if (data.reference_se.pixel_count() && data.reference_se.pixel_count() != data.reference.pixel_count()) data.reference_se = Image();
         data.reference_label = fs::path(page.reference).filename().string();
         data.reference_note = fmt::format("{} (given){}", page.reference, data.reference_se.pixel_count() ? ", with its standard errors" : "");
+        if (guide_pixel && (guide_pixel->first >= w || guide_pixel->second >= h))
+            throw UsageError(fmt::format("--guide-pixel {},{} is not inside the {}x{} image", guide_pixel->first, guide_pixel->second, w, h));
         for (const PixelRect& c : crops)
             if (c.x + c.width > w || c.y + c.height > h)
                 throw UsageError(fmt::format("--crop {},{},{},{} is not inside the {}x{} image", c.x, c.y, c.width, c.height, w, h));
@@ -303,6 +325,19 @@ int run_report_command(const ReportOptions& o) {
             entry.mean = r.film.mean();
             entry.std_error = r.film.standard_error();
             entry.stats = r.stats;
+            if (guide_pixel)
+                if (const SdTree* tree = trained_guide(job.integrator())) {
+                    const PerspectiveCamera camera(job.scene().camera(), entry.mean.width(), entry.mean.height());
+                    Intersection hit;
+                    const float x = float(guide_pixel->first) + 0.5f, y = float(guide_pixel->second) + 0.5f;
+                    if (job.scene().intersect(camera.generate(x, y), hit)) {
+                        entry.guide_map = guide_map(*tree, hit.p);
+                        entry.guide_note = fmt::format("pixel ({}, {}): first hit at ({:.3g}, {:.3g}, {:.3g})", guide_pixel->first,
+                                                       guide_pixel->second, hit.p.x, hit.p.y, hit.p.z);
+                    } else {
+                        entry.guide_note = fmt::format("pixel ({}, {}): its ray leaves the scene", guide_pixel->first, guide_pixel->second);
+                    }
+                }
             // The final point, if the last pass did not make a checkpoint (the time budget ended it).
             if (entry.convergence.empty() || entry.convergence.back().spp < r.stats.spp)
                 entry.convergence.push_back({r.stats.seconds, r.stats.spp, rmse_against_reference(entry.mean, data.reference, data.reference_se)});

@@ -81,6 +81,7 @@ struct ReportOptions {
     int threads = 0;
     bool quiet = false;
     std::vector<std::string> crops;  // --crop X,Y,W,H: inset crops, magnified
+    std::string guide_pixel;         // --guide-pixel X,Y: what ppg learned at that pixel's first hit
 };
 CLI::App* add_report_command(CLI::App& app, ReportOptions& o);
 int run_report_command(const ReportOptions& o);

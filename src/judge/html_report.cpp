@@ -361,6 +361,31 @@ std::vector<std::string> write_html_report(const ReportData& data, const std::st
     for (const std::string& n : data.notes) notes += "<p class=\"note\">" + xml_escape(n) + "</p>\n";
     const std::string inset_section =
         insets.empty() ? "" : "<h2>Insets</h2>\n<p>The crops outlined in yellow on the images above, side by side.</p>\n" + insets;
+    // ppg with --guide-pixel: the learned guiding density, each on its own scale (its largest value).
+    std::string guides;
+    for (const ReportRender& r : data.renders) {
+        if (r.guide_note.empty()) continue;
+        if (r.guide_map.pixel_count() == 0) {
+            guides += fmt::format("<p><b>{}</b>: {}; no distribution there.</p>\n", xml_escape(r.algorithm), xml_escape(r.guide_note));
+            continue;
+        }
+        float top = 0;
+        for (size_t p = 0; p < r.guide_map.pixel_count(); ++p) top = std::max(top, r.guide_map[p][0]);
+        const std::string caption =
+            top > 0 ? fmt::format("<b>{}</b><br>{}<br>largest density {:.3g} sr<sup>−1</sup>", xml_escape(r.algorithm), xml_escape(r.guide_note), top)
+                    : fmt::format("<b>{}</b><br>{}<br>nothing learned there: BSDF sampling only", xml_escape(r.algorithm), xml_escape(r.guide_note));
+        guides += figure_html({"", write_png(false_colour_magnitude(r.guide_map, top > 0 ? top : 1.0f), slug(r.algorithm) + "_guide.png"),
+                               r.algorithm + " guiding distribution", caption},
+                              r.guide_map.width(), r.guide_map.height());
+    }
+    const std::string guide_section =
+        guides.empty() ? ""
+                       : "<h2>What the guide learned</h2>\n<p>The directional distribution ppg's SD-tree learned in the spatial cell of the "
+                         "point, over the sphere of directions as its quadtree sees it: columns are the azimuth from +x (left) towards "
+                         "+y, rows the cosine of the angle from +z (top: up the z axis, bottom: down it), an equal-area map, so a "
+                         "region's share of the picture is its share of directions; bright where the training paths found light coming "
+                         "from.</p>\n<div class=\"grid\">\n" +
+                             guides + "</div>\n";
     const std::string se_section =
         std_errors.empty()
             ? ""
@@ -379,7 +404,8 @@ std::vector<std::string> write_html_report(const ReportData& data, const std::st
                                      "reference's mean.</p>\n"
                                      "<div class=\"bar\"><span>0</span><img src=\"{}\" alt=\"colour scale\"><span>{:.3g}</span></div>\n"
                                      "<div class=\"grid\">\n{}</div>\n",
-                                     xml_escape(se_bar), relative_scale, relative_errors));
+                                     xml_escape(se_bar), relative_scale, relative_errors)) +
+        guide_section;
 
     const std::string html = fmt::format(
         R"(<!DOCTYPE html>

@@ -34,6 +34,11 @@ struct ReportRender {
     Image std_error;  // per-pixel standard errors of the mean (may be empty)
     RenderStats stats;
     std::vector<ConvergencePoint> convergence;
+    // ppg with --guide-pixel: the density its SD-tree learned at that pixel's first hit
+    // (integrators/guiding/guide_map.hpp: per steradian over the equal-area square of directions;
+    // empty when none), and what it shows.
+    Image guide_map;
+    std::string guide_note;
 };
 
 struct ReportData {

@@ -32,6 +32,7 @@ public:
     std::vector<IntegratorStatistic> statistics() const override;
 
     const SdTree& tree() const { return tree_; }
+    bool trained() const { return guided_; }  // prepare() has trained the tree
     // The training iterations' sizes in samples per pixel, for a training budget.
     static std::vector<uint64_t> iteration_sizes(uint64_t training_spp);
 

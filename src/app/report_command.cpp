@@ -168,6 +168,14 @@ int run_report_command(const ReportOptions& o) {
 
     // The given references: read, and refused when of another size, or (by their manifest) of
     // another scene or estimator family.
+    // The insets and the guide's pixel inside a w x h image.
+    const auto check_inside = [&](int w, int h) {
+        if (guide_pixel && (guide_pixel->first >= w || guide_pixel->second >= h))
+            throw UsageError(fmt::format("--guide-pixel {},{} is not inside the {}x{} image", guide_pixel->first, guide_pixel->second, w, h));
+        for (const PixelRect& c : crops)
+            if (c.x + c.width > w || c.y + c.height > h)
+                throw UsageError(fmt::format("--crop {},{},{},{} is not inside the {}x{} image", c.x, c.y, c.width, c.height, w, h));
+    };
     std::vector<ReportData> datas(pages.size());
     for (size_t i = 0; i < pages.size(); ++i) {
         const PageJob& page = pages[i];
@@ -176,12 +184,7 @@ int run_report_command(const ReportOptions& o) {
         sized.width = width, sized.height = height;
         const RenderJob sized_job(page.choice, sized);
         if (page.reference.empty()) {
-            const int w = sized_job.width(), h = sized_job.height();
-            if (guide_pixel && (guide_pixel->first >= w || guide_pixel->second >= h))
-                throw UsageError(fmt::format("--guide-pixel {},{} is not inside the {}x{} image", guide_pixel->first, guide_pixel->second, w, h));
-            for (const PixelRect& c : crops)
-                if (c.x + c.width > w || c.y + c.height > h)
-                    throw UsageError(fmt::format("--crop {},{},{},{} is not inside the {}x{} image", c.x, c.y, c.width, c.height, w, h));
+            check_inside(sized_job.width(), sized_job.height());
             continue;
         }
         try {
@@ -207,11 +210,7 @@ int run_report_command(const ReportOptions& o) {
         if (data.reference_se.pixel_count() && data.reference_se.pixel_count() != data.reference.pixel_count()) data.reference_se = Image();
         data.reference_label = fs::path(page.reference).filename().string();
         data.reference_note = fmt::format("{} (given){}", page.reference, data.reference_se.pixel_count() ? ", with its standard errors" : "");
-        if (guide_pixel && (guide_pixel->first >= w || guide_pixel->second >= h))
-            throw UsageError(fmt::format("--guide-pixel {},{} is not inside the {}x{} image", guide_pixel->first, guide_pixel->second, w, h));
-        for (const PixelRect& c : crops)
-            if (c.x + c.width > w || c.y + c.height > h)
-                throw UsageError(fmt::format("--crop {},{},{},{} is not inside the {}x{} image", c.x, c.y, c.width, c.height, w, h));
+        check_inside(w, h);
     }
 
     std::optional<tbb::global_control> thread_limit;

@@ -30,12 +30,12 @@ inline std::optional<PhongMaterial> cached_diffuse(const ShadingPoint& sp) {
 // indirect_irradiance(sp, sampler, wl) returns E_indirect at the first hit sp in the path's
 // colour (wl: its wavelengths).
 template <class Wl, typename IndirectIrradiance>
-ColourAt<Wl> first_hit_radiance(const Scene& scene, const Ray& ray, Sampler& sampler, const PathRules& rules, bool hide_emitters, Wl& wl,
+ColourAt<Wl> first_hit_radiance(const Scene& scene, const Ray& ray, Sampler& sampler, const PathRules& rules, Wl& wl,
                                 IndirectIrradiance&& indirect_irradiance) {
     using Colour = ColourAt<Wl>;
     Intersection hit;
-    if (!scene.intersect(ray, hit)) return hide_emitters ? Colour(0.0f) : escaped_radiance(scene, ray.d, wl);
-    Colour L = hide_emitters ? Colour(0.0f) : emitted_radiance(scene, hit, -ray.d, wl);
+    if (!scene.intersect(ray, hit)) return rules.hides_emitters() ? Colour(0.0f) : escaped_radiance(scene, ray.d, wl);
+    Colour L = rules.hides_emitters() ? Colour(0.0f) : emitted_radiance(scene, hit, -ray.d, wl);
     const ShadingPoint sp = make_shading_point(scene, hit, ray.d);
     const std::optional<PhongMaterial> phong = sp.material->is_black() ? std::nullopt : cached_diffuse(sp);
     if (!phong) return pt_mis_from_hit(scene, hit, ray.d, 0, sampler, rules, wl, false, -1, L);

@@ -125,7 +125,7 @@ void IrradianceCaching<T>::prepare(const RenderContext& ctx, const PassProgress&
 
 template <class T>
 ColourOf<T> IrradianceCaching<T>::radiance(const Scene& scene, const Ray& ray, Sampler& sampler, WavelengthsOf<T>& wl) const {
-    return first_hit_radiance(scene, ray, sampler, rules_, options_.hide_emitters, wl,
+    return first_hit_radiance(scene, ray, sampler, rules_, wl,
                               [&](const ShadingPoint& sp, Sampler& s, WavelengthsOf<T>& w) { return indirect_irradiance(scene, sp, s, w); });
 }
 

@@ -132,10 +132,10 @@ template <class T>
 ColourOf<T> PointBasedGi<T>::radiance(const Scene& scene, const Ray& ray, Sampler& sampler, WavelengthsOf<T>& wl) const {
     if (tree_.surfels().empty()) {
         // Not prepared (or direct light only): no indirect diffuse light from the cloud.
-        return first_hit_radiance(scene, ray, sampler, rules_, options_.hide_emitters, wl,
+        return first_hit_radiance(scene, ray, sampler, rules_, wl,
                                   [](const ShadingPoint&, Sampler&, WavelengthsOf<T>&) { return ColourOf<T>(0.0f); });
     }
-    return first_hit_radiance(scene, ray, sampler, rules_, options_.hide_emitters, wl, [&](const ShadingPoint& sp, Sampler&, WavelengthsOf<T>& w) {
+    return first_hit_radiance(scene, ray, sampler, rules_, wl, [&](const ShadingPoint& sp, Sampler&, WavelengthsOf<T>& w) {
         return illuminant_colour(indirect_irradiance(sp, ray.d), w);
     });
 }

@@ -3,8 +3,6 @@
 // --guide-pixel`, issue 39).
 #pragma once
 
-#include <optional>
-
 #include "image/image.hpp"
 #include "integrators/guiding/sd_tree.hpp"
 #include "integrators/integrator.hpp"

@@ -37,7 +37,7 @@ ChainSample Pssmlt<T>::evaluate(const RenderContext& ctx, PrimarySamples& state)
     WavelengthsOf<T> wl = T::camera_wavelengths(sampler);
     const auto L = ctx.scene.has_media()
                        ? static_cast<const PixelIntegrator<T>&>(*volpath_).radiance(ctx.scene, ray, sampler, wl)
-                       : pt_mis_camera_radiance(ctx.scene, ray, sampler, rules_, wl, false, options_.only_length, options_.hide_emitters);
+                       : pt_mis_camera_radiance(ctx.scene, ray, sampler, rules_, wl, false, options_.only_length);
     return chain_sample(raster, film_colour(L, wl));
 }
 

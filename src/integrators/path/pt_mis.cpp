@@ -78,17 +78,17 @@ template Spectrum4 pt_mis_from_hit(const Scene&, Intersection, Vec3f, int, Sampl
 
 template <class Wl>
 ColourAt<Wl> pt_mis_camera_radiance(const Scene& scene, const Ray& camera_ray, Sampler& sampler, const PathRules& rules, Wl& wl,
-                                    bool three_rays, int only_length, bool hide_emitters) {
+                                    bool three_rays, int only_length) {
     using Colour = ColourAt<Wl>;
-    const bool seen_directly = (only_length < 0 || only_length == 0) && !hide_emitters;
+    const bool seen_directly = (only_length < 0 || only_length == 0) && !rules.hides_emitters();
     Intersection hit;
     if (!scene.intersect(camera_ray, hit)) return seen_directly ? escaped_radiance(scene, camera_ray.d, wl) : Colour(0.0f);
     const Colour emitted = seen_directly ? emitted_radiance(scene, hit, -camera_ray.d, wl) : Colour(0.0f);
     return pt_mis_from_hit(scene, hit, camera_ray.d, 0, sampler, rules, wl, three_rays, only_length, emitted);
 }
 
-template Rgb pt_mis_camera_radiance(const Scene&, const Ray&, Sampler&, const PathRules&, RgbWavelengths&, bool, int, bool);
-template Spectrum4 pt_mis_camera_radiance(const Scene&, const Ray&, Sampler&, const PathRules&, SampledWavelengths&, bool, int, bool);
+template Rgb pt_mis_camera_radiance(const Scene&, const Ray&, Sampler&, const PathRules&, RgbWavelengths&, bool, int);
+template Spectrum4 pt_mis_camera_radiance(const Scene&, const Ray&, Sampler&, const PathRules&, SampledWavelengths&, bool, int);
 
 namespace {
 
@@ -101,17 +101,16 @@ template <class T>
 class PtMis final : public PixelIntegrator<T> {
 public:
     PtMis(const IntegratorOptions& o, bool separate_continuation)
-        : rules_(limited_to_length(o)), three_rays_(separate_continuation), only_length_(o.only_length), hide_(o.hide_emitters) {}
+        : rules_(limited_to_length(o)), three_rays_(separate_continuation), only_length_(o.only_length) {}
 
     ColourOf<T> radiance(const Scene& scene, const Ray& camera_ray, Sampler& sampler, WavelengthsOf<T>& wl) const override {
-        return pt_mis_camera_radiance(scene, camera_ray, sampler, rules_, wl, three_rays_, only_length_, hide_);
+        return pt_mis_camera_radiance(scene, camera_ray, sampler, rules_, wl, three_rays_, only_length_);
     }
 
 private:
     PathRules rules_;
     bool three_rays_;
     int only_length_;
-    bool hide_;
 };
 
 }  // namespace

@@ -20,10 +20,10 @@ ColourAt<Wl> pt_mis_from_hit(const Scene& scene, Intersection hit, Vec3f dir, in
                              bool three_rays = false, int only_length = -1, ColourAt<Wl> L = ColourAt<Wl>(0.0f));
 
 // The estimate of a pt-mis pixel sample (pt-mis3's with `three_rays`): the radiance arriving
-// along a camera ray, the emission seen directly included (unless hide_emitters; with
+// along a camera ray, the emission seen directly included (unless rules.hides_emitters(); with
 // only_length >= 0, only if that length is 0). pssmlt drives it with a Markov chain's numbers.
 template <class Wl>
 ColourAt<Wl> pt_mis_camera_radiance(const Scene& scene, const Ray& camera_ray, Sampler& sampler, const PathRules& rules, Wl& wl,
-                                    bool three_rays, int only_length, bool hide_emitters);
+                                    bool three_rays, int only_length);
 
 }  // namespace pathlab

@@ -38,14 +38,14 @@ class Volpath final : public PixelIntegrator<T> {
 public:
     using Colour = ColourOf<T>;
 
-    Volpath(const IntegratorOptions& o, VolpathSettings s) : rules_(o), settings_(s), hide_(o.hide_emitters) {}
+    Volpath(const IntegratorOptions& o, VolpathSettings s) : rules_(o), settings_(s) {}
 
     Colour radiance(const Scene& scene, const Ray& camera_ray, Sampler& sampler, WavelengthsOf<T>& wl) const override {
         // pt-mis's own loop: the same image, pt-mis's speed (not under --null-depth skip, whose shadow rays pass thin glass)
         if (!scene.has_media() && settings_.pt_mis_without_media && !rules_.skips_null()) {
             Intersection hit;
-            if (!scene.intersect(camera_ray, hit)) return hide_ ? Colour(0.0f) : escaped_radiance(scene, camera_ray.d, wl);
-            const Colour emitted = hide_ ? Colour(0.0f) : emitted_radiance(scene, hit, -camera_ray.d, wl);
+            if (!scene.intersect(camera_ray, hit)) return rules_.hides_emitters() ? Colour(0.0f) : escaped_radiance(scene, camera_ray.d, wl);
+            const Colour emitted = rules_.hides_emitters() ? Colour(0.0f) : emitted_radiance(scene, hit, -camera_ray.d, wl);
             return pt_mis_from_hit(scene, hit, camera_ray.d, 0, sampler, rules_, wl, false, -1, emitted);
         }
         const bool mis = settings_.mis;
@@ -58,8 +58,8 @@ public:
         // What the camera sees directly (pt-mis: L starts as the emission at the first hit).
         Colour L(0.0f);
         // (hide_emitters: not the emitters and the sky seen directly, also through media.)
-        if (w.kind == MediumWalk::kEscaped) return hide_ ? Colour(0.0f) : beta * escaped_radiance(scene, w.dir, wl) / st.density();
-        if (w.kind == MediumWalk::kSurface && !hide_) L = beta * emitted_radiance(scene, w.isect, -w.dir, wl) / st.density();
+        if (w.kind == MediumWalk::kEscaped) return rules_.hides_emitters() ? Colour(0.0f) : beta * escaped_radiance(scene, w.dir, wl) / st.density();
+        if (w.kind == MediumWalk::kSurface && !rules_.hides_emitters()) L = beta * emitted_radiance(scene, w.isect, -w.dir, wl) / st.density();
         // `bounces`: those made before the vertex w reached. At the depth limit a path under
         // --null-depth skip may still pass straight through surfaces (kLobeNull), and nothing else.
         for (int bounces = 0, step = 0; w.kind != MediumWalk::kLost && step < kMaxBounces; ++step) {
@@ -93,7 +93,7 @@ public:
             const bool bounce = rules_.is_bounce(n.lobe);
             if (bounce) origin = MisOrigin{v.p, v.sp ? v.sp->frame.n : Vec3f(0.0f), n.pdf, n.delta};
             if (!may_scatter && bounce) break;  // a scattering past the depth limit
-            if (!(hide_ && bounces == 0 && !bounce)) L += beta * n.next_seg * n.found / st.density();
+            if (!(rules_.hides_emitters() && bounces == 0 && !bounce)) L += beta * n.next_seg * n.found / st.density();
             const MediumWalk& next = n.next;
             const Colour& next_seg = n.next_seg;
             const Colour& weight_next = n.weight;
@@ -119,7 +119,6 @@ private:
 
     PathRules rules_;
     VolpathSettings settings_;
-    bool hide_;
 };
 
 }  // namespace

@@ -308,7 +308,8 @@ int run_report_command(const ReportOptions& o) {
             request.time_limit = o.time_limit;
             request.seed = seed;
             RenderJob job(choice, request);
-            ReportRender entry{e->name, {}, {}, {}, {}};
+            ReportRender entry;
+            entry.algorithm = e->name;
             double next_checkpoint = 0;
             RenderSettings& rs = job.settings;
             rs.progress = show_progress;

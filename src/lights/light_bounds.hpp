@@ -4,8 +4,8 @@
 // half-angle theta_o), how far emission spreads around a normal (theta_e: pi/2 for a surface's
 // cosine lobe, 0 for a spot's beam, whose cone is theta_o) and the total power phi.
 //
-// importance(p, n) (of CompactLightBounds) estimates, up to a common factor, the power that can
-// arrive at p on a surface with normal n (n = 0: a point in a medium, no cosine there):
+// importance(p, n) (of LightBounds4, four groups at once) estimates, up to a common factor, the
+// power that can arrive at p on a surface with normal n (n = 0: a point in a medium, no cosine there):
 // phi cos(theta') / d^2, where d is the distance to the box's centre (no less than its bounding
 // sphere's radius, twice that for a single emitter) and theta' the smallest angle between an
 // emitter's normal and the direction to p that the box and the cones allow; times the receiver's
@@ -16,50 +16,11 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/float4.hpp"
 #include "core/vec.hpp"
 #include "lights/light.hpp"
 
 namespace pathlab {
-
-// The part of a group's bounds that importance(p, n) reads (LightBounds::compact()): what the
-// light tree keeps per node after it is built, 52 bytes.
-struct CompactLightBounds {
-    Vec3f centre{0.0f};
-    float radius = 0;
-    Vec3f w{0, 0, 1};
-    float phi = 0;
-    float cos_o = 1, sin_o = 0, cos_e = 1;
-    float near = 1;
-    bool two_sided = false;
-
-    float importance(const Vec3f& p, const Vec3f& n) const {
-        if (!(phi > 0)) return 0.0f;
-        const Vec3f d = p - centre;
-        const float dd = dot(d, d), r2 = radius * radius;
-        // Inside the bounding sphere every direction is possible: the distance is clamped to its radius.
-        if (dd <= r2) return std::min(phi / std::max(near * r2, 1e-20f), 1e30f);
-        const float inv_d = 1 / std::sqrt(dd);
-        const Vec3f wi = d * inv_d;  // from the lights towards p
-        // The half-angle theta_b the bounding sphere subtends at p.
-        const float sin_b = radius * inv_d, cos_b = std::sqrt(std::max(0.0f, 1 - sin_b * sin_b));
-        // theta_x = max(0, theta_w - theta_o), then theta' = max(0, theta_x - theta_b), as cosines.
-        float cos_w = dot(w, wi);
-        if (two_sided) cos_w = std::abs(cos_w);
-        float cos_p = 1;
-        if (cos_w < cos_o) {
-            const float sin_w = std::sqrt(std::max(0.0f, 1 - cos_w * cos_w));
-            const float cos_x = cos_w * cos_o + sin_w * sin_o, sin_x = sin_w * cos_o - cos_w * sin_o;
-            if (cos_x < cos_b) cos_p = cos_x * cos_b + sin_x * sin_b;
-        }
-        if (cos_p < cos_e) return 0.0f;  // theta' > theta_e: outside every emitter's lobe
-        float importance = std::min(phi * std::max(cos_p, 0.0f) / std::max(dd, near * r2), 1e30f);
-        if (n.x != 0 || n.y != 0 || n.z != 0) {
-            const float cos_i = std::abs(dot(wi, n));
-            if (cos_i < cos_b) importance *= cos_i * cos_b + std::sqrt(std::max(0.0f, 1 - cos_i * cos_i)) * sin_b;
-        }
-        return importance;
-    }
-};
 
 struct LightBounds {
     Vec3f lo{kInf}, hi{-kInf};
@@ -85,9 +46,58 @@ struct LightBounds {
         centre = (lo + hi) * 0.5f;
         radius = 0.5f * length(hi - lo);
     }
+};
 
-    // What importance() reads, in one cache line (the sampler's tree nodes hold this).
-    CompactLightBounds compact() const { return {centre, radius, w, phi, cos_o, sin_o, cos_e, near, two_sided}; }
+// The bounds of up to four groups side by side, lane k for group k (a node of the light tree holds
+// its children's): what importance(p, n) reads, so that one pass of 4-wide arithmetic
+// (core/float4.hpp) bounds all four. An empty lane has phi 0 and importance 0.
+struct LightBounds4 {
+    float cx[4]{}, cy[4]{}, cz[4]{}, radius[4]{};
+    float wx[4]{}, wy[4]{}, wz[4]{}, phi[4]{};
+    float cos_o[4]{}, sin_o[4]{}, cos_e[4]{};
+    float inv_near2[4]{};  // 1 / (the squared distance below which importance stops growing)
+    float two_sided[4]{};  // 1 or 0
+
+    void set(int k, const LightBounds& b) {
+        cx[k] = b.centre.x, cy[k] = b.centre.y, cz[k] = b.centre.z, radius[k] = b.radius;
+        wx[k] = b.w.x, wy[k] = b.w.y, wz[k] = b.w.z, phi[k] = b.phi;
+        cos_o[k] = b.cos_o, sin_o[k] = b.sin_o, cos_e[k] = b.cos_e;
+        inv_near2[k] = 1 / std::max(b.near * b.radius * b.radius, 1e-20f);
+        two_sided[k] = b.two_sided ? 1.0f : 0.0f;
+    }
+
+    // The four importances at p, on a surface with normal n (n = 0: in a medium). Every sine and
+    // cosine is kept multiplied by the distance d to the centre (d cos theta_w = d.w,
+    // d sin theta_w = sqrt(d^2 - (d.w)^2), d cos theta_b = sqrt(d^2 - r^2), d sin theta_b = r), so
+    // that the four square roots and the one division (1 / d^2) do not wait for each other.
+    Float4 importance(const Vec3f& p, const Vec3f& n) const {
+        const Float4 phi4 = Float4::load(phi), radius4 = Float4::load(radius);
+        const Float4 dx = Float4(p.x) - Float4::load(cx), dy = Float4(p.y) - Float4::load(cy), dz = Float4(p.z) - Float4::load(cz);
+        const Float4 dd = dx * dx + dy * dy + dz * dz, r2 = radius4 * radius4;
+        // Inside the bounding sphere every direction is possible: the distance is clamped to its radius.
+        const Float4 inv_near2_4 = Float4::load(inv_near2);
+        const Float4 inside = min(phi4 * inv_near2_4, Float4(1e30f));
+        // Outside it (dd > r^2; what follows is discarded in the lanes inside).
+        const Float4 zero(0.0f), one(1.0f);
+        const Float4 inv_dd = one / dd;
+        Float4 dw = Float4::load(wx) * dx + Float4::load(wy) * dy + Float4::load(wz) * dz;  // d cos theta_w
+        dw = select(Float4::load(two_sided) > zero, abs(dw), dw);
+        const Float4 d = sqrt(dd), dsin_w = sqrt(max(zero, dd - dw * dw)), dcos_b = sqrt(max(zero, dd - r2));
+        // theta_x = max(0, theta_w - theta_o), then theta' = max(0, theta_x - theta_b), as cosines
+        // (d cos theta_x, d sin theta_x; cos theta' = (d cos theta_x d cos theta_b + d sin theta_x r) / d^2).
+        const Float4 cos_o4 = Float4::load(cos_o), sin_o4 = Float4::load(sin_o);
+        const Float4 dcos_x = dw * cos_o4 + dsin_w * sin_o4, dsin_x = dsin_w * cos_o4 - dw * sin_o4;
+        const Float4 cos_p = select((dw < d * cos_o4) & (dcos_x < dcos_b), (dcos_x * dcos_b + dsin_x * radius4) * inv_dd, one);
+        Float4 outside = min(phi4 * max(cos_p, zero) * min(inv_dd, inv_near2_4), Float4(1e30f));
+        if (n.x != 0 || n.y != 0 || n.z != 0) {  // the receiver's cosine, bounded the same way
+            const Float4 dn = dx * Float4(n.x) + dy * Float4(n.y) + dz * Float4(n.z);
+            const Float4 dcos_i = abs(dn), dsin_i = sqrt(max(zero, dd - dn * dn));
+            outside = outside * select(dcos_i < dcos_b, (dcos_i * dcos_b + dsin_i * radius4) * inv_dd, one);
+        }
+        // theta' > theta_e: outside every emitter's lobe.
+        outside = select(cos_p < Float4::load(cos_e), zero, outside);
+        return select(phi4 > zero, select(dd <= r2, inside, outside), zero);
+    }
 };
 
 // The bounds of a light at a finite position (not kLightInfinite).

@@ -72,15 +72,23 @@ LightSampler::LightSampler(const std::vector<Light>& lights, const SceneSphere& 
         if (light_flags(lights[i]) & kLightInfinite) infinite_.push_back(int(i));
         else items.push_back({light_bounds(lights[i], sphere), int(i)});
     }
-    if (!items.empty()) {
-        nodes_.reserve(2 * items.size() - 1);
-        build(items, 0, items.size(), 0, 0);
+    if (items.empty()) return;
+    std::vector<BinaryNode> binary;
+    binary.reserve(2 * items.size() - 1);
+    build_binary(binary, items, 0, items.size(), 0);
+    if (binary[0].light >= 0) {  // a single light: a root with one lane
+        nodes_.emplace_back();
+        nodes_[0].bounds.set(0, binary[0].bounds);
+        nodes_[0].child[0] = ~binary[0].light;
+        trails_[size_t(binary[0].light)] = {0, 1};
+    } else {
+        collapse(binary, 0, 0, 0);
     }
 }
 
-int LightSampler::build(std::vector<Item>& items, size_t begin, size_t end, int depth, uint64_t bits) {
-    const int index = int(nodes_.size());
-    nodes_.push_back({});
+int LightSampler::build_binary(std::vector<BinaryNode>& out, std::vector<Item>& items, size_t begin, size_t end, int depth) {
+    const int index = int(out.size());
+    out.emplace_back();
     LightBounds all;
     Vec3f clo(kInf), chi(-kInf);
     for (size_t i = begin; i < end; ++i) {
@@ -88,15 +96,15 @@ int LightSampler::build(std::vector<Item>& items, size_t begin, size_t end, int 
         const Vec3f c = items[i].bounds.centre;
         clo = min(clo, c), chi = max(chi, c);
     }
-    nodes_[size_t(index)].bounds = all.compact();
+    out[size_t(index)].bounds = all;
     if (end - begin == 1) {
-        nodes_[size_t(index)].light = items[begin].light;
-        trails_[size_t(items[begin].light)] = {bits, depth};
+        out[size_t(index)].light = items[begin].light;
         return index;
     }
     // The split: binned surface area orientation heuristic over the centroids (12 buckets per
     // axis, each axis's cost scaled by how thin the node is along it); by count at the
-    // median when the centroids coincide or the tree grows too deep for a 64-bit trail.
+    // median when the centroids coincide, and below depth 32, so that the binary tree is at most
+    // 64 deep (32 levels of the 4-wide one: a trail of 64 bits).
     constexpr int kBuckets = 12;
     size_t mid = begin + (end - begin) / 2;
     const Vec3f extent = chi - clo;
@@ -106,7 +114,7 @@ int LightSampler::build(std::vector<Item>& items, size_t begin, size_t end, int 
     const float longest = max_component(extent);
     int best_axis = -1;
     float best_plane = 0, best_cost = kInf;
-    if (depth < 56)
+    if (depth < 32)
         for (int axis = 0; axis < 3; ++axis) {
             if (!(extent[axis] > 0)) continue;
             std::array<LightBounds, kBuckets> bucket{};
@@ -144,8 +152,44 @@ int LightSampler::build(std::vector<Item>& items, size_t begin, size_t end, int 
                              return ca < cb || (ca == cb && a.light < b.light);
                          });
     }
-    build(items, begin, mid, depth + 1, bits);
-    nodes_[size_t(index)].right = build(items, mid, end, depth + 1, bits | (uint64_t(1) << depth));
+    build_binary(out, items, begin, mid, depth + 1);
+    const int right = build_binary(out, items, mid, end, depth + 1);
+    out[size_t(index)].right = right;
+    return index;
+}
+
+// The 4-wide node of the binary interior node b: its lanes are b's descendants, expanded
+// breadth-first (the shallowest interior one first) until there are four or only leaves, so
+// that every wide level takes at least two binary levels.
+int LightSampler::collapse(const std::vector<BinaryNode>& binary, int b, int depth, uint64_t trail) {
+    struct Lane {
+        int node, level;
+    };
+    std::vector<Lane> lanes{{b + 1, 1}, {binary[size_t(b)].right, 1}};
+    while (lanes.size() < 4) {
+        int expand = -1;
+        for (int k = 0; k < int(lanes.size()); ++k)
+            if (binary[size_t(lanes[size_t(k)].node)].light < 0 && (expand < 0 || lanes[size_t(k)].level < lanes[size_t(expand)].level))
+                expand = k;
+        if (expand < 0) break;
+        const Lane e = lanes[size_t(expand)];
+        lanes[size_t(expand)] = {e.node + 1, e.level + 1};
+        lanes.insert(lanes.begin() + expand + 1, Lane{binary[size_t(e.node)].right, e.level + 1});
+    }
+    const int index = int(nodes_.size());
+    nodes_.emplace_back();
+    for (int k = 0; k < int(lanes.size()); ++k) {
+        const BinaryNode& lane = binary[size_t(lanes[size_t(k)].node)];
+        const uint64_t lane_trail = trail | (uint64_t(k) << (2 * depth));
+        nodes_[size_t(index)].bounds.set(k, lane.bounds);
+        if (lane.light >= 0) {
+            nodes_[size_t(index)].child[k] = ~lane.light;
+            trails_[size_t(lane.light)] = {lane_trail, depth + 1};
+        } else {
+            const int child = collapse(binary, lanes[size_t(k)].node, depth + 1, lane_trail);
+            nodes_[size_t(index)].child[k] = child;
+        }
+    }
     return index;
 }
 
@@ -153,10 +197,6 @@ float LightSampler::infinite_share() const {
     if (infinite_.empty()) return 0.0f;
     if (nodes_.empty()) return 1.0f;
     return float(infinite_.size()) / float(infinite_.size() + 1);
-}
-
-float LightSampler::branch_probability(float left, float right, bool take_right) {
-    return (take_right ? right : left) / (left + right);
 }
 
 LightChoice LightSampler::choose(const Vec3f& p, const Vec3f& n, float u) const {
@@ -174,21 +214,29 @@ LightChoice LightSampler::choose(const Vec3f& p, const Vec3f& n, float u) const 
         return {infinite_[k], share / float(infinite_.size())};
     }
     u = std::min((u - share) / (1 - share), kBelowOne);
-    if (!(nodes_[0].bounds.importance(p, n) > 0)) return {};
     float pmf = 1 - share;
-    size_t node = 0;
-    while (nodes_[node].light < 0) {
-        const size_t left = node + 1, right = size_t(nodes_[node].right);
-        const float il = nodes_[left].bounds.importance(p, n), ir = nodes_[right].bounds.importance(p, n);
-        if (!(il + ir > 0)) return {};
-        const float p_left = branch_probability(il, ir, false);
-        if (u < p_left) {
-            node = left, pmf *= p_left, u = std::min(u / p_left, kBelowOne);
-        } else {
-            node = right, pmf *= branch_probability(il, ir, true), u = std::min((u - p_left) / (1 - p_left), kBelowOne);
-        }
+    int node = 0;
+    for (;;) {
+        const Node& at = nodes_[size_t(node)];
+        float importance[4];
+        at.bounds.importance(p, n).store(importance);
+        // The lane whose share of [0, sum) holds u * sum (empty for a lane of importance 0; counting
+        // the bounds below it takes no branch and no division, which would wait for the sum), the
+        // last lane of positive importance where rounding leaves it past the sum; u is rescaled
+        // to [0, 1) within the lane.
+        const float c0 = importance[0], c1 = c0 + importance[1], c2 = c1 + importance[2];
+        const float sum = (importance[0] + importance[1]) + (importance[2] + importance[3]);
+        if (!(sum > 0)) return {};
+        const float x = u * sum;
+        int lane = int(x >= c0) + int(x >= c1) + int(x >= c2);
+        while (!(importance[lane] / sum > 0)) --lane;  // (a lane of positive importance, not so small its share rounds to 0)
+        const float below = lane == 0 ? 0.0f : lane == 1 ? c0 : lane == 2 ? c1 : c2;
+        pmf *= importance[lane] / sum;  // as pmf() multiplies it
+        u = std::min(std::max(0.0f, x - below) / importance[lane], kBelowOne);
+        const int child = at.child[lane];
+        if (child < 0) return {~child, pmf};
+        node = child;
     }
-    return {nodes_[node].light, pmf};
 }
 
 float LightSampler::pmf(const Vec3f& p, const Vec3f& n, int light) const {
@@ -202,16 +250,17 @@ float LightSampler::pmf(const Vec3f& p, const Vec3f& n, int light) const {
     const Trail& trail = trails_[size_t(light)];
     const float share = infinite_share();
     if (trail.depth < 0) return share / float(infinite_.size());
-    if (!(nodes_[0].bounds.importance(p, n) > 0)) return 0.0f;
     float pmf = 1 - share;
-    size_t node = 0;
+    int node = 0;
     for (int level = 0; level < trail.depth; ++level) {
-        const size_t left = node + 1, right = size_t(nodes_[node].right);
-        const float il = nodes_[left].bounds.importance(p, n), ir = nodes_[right].bounds.importance(p, n);
-        if (!(il + ir > 0)) return 0.0f;
-        const bool take_right = (trail.bits >> level) & 1;
-        pmf *= branch_probability(il, ir, take_right);
-        node = take_right ? right : left;
+        const Node& at = nodes_[size_t(node)];
+        float importance[4];
+        at.bounds.importance(p, n).store(importance);
+        const float sum = (importance[0] + importance[1]) + (importance[2] + importance[3]);
+        const int lane = int((trail.lanes >> (2 * level)) & 3);
+        if (!(sum > 0)) return 0.0f;
+        pmf *= importance[lane] / sum;  // as choose() multiplies it
+        node = at.child[lane];
     }
     return pmf;
 }

@@ -118,6 +118,16 @@ PixelRect parse_crop_option(const std::string& text) {
     return {int(v[0]), int(v[1]), int(v[2]), int(v[3])};
 }
 
+std::pair<int, int> parse_pixel_option(const std::string& text) {
+    const std::vector<std::string> items = split_comma_list(text);
+    std::vector<uint64_t> v;
+    for (const std::string& item : items)
+        if (const auto n = parse_whole_number(item, 0, kMaxResolution)) v.push_back(*n);
+    if (items.size() != 2 || v.size() != 2)
+        throw UsageError(fmt::format("--guide-pixel {}: give X,Y, a pixel's column and row from the top left", text));
+    return {int(v[0]), int(v[1])};
+}
+
 std::vector<const IntegratorInfo*> parse_algorithm_list(const std::string& spec) {
     std::vector<const IntegratorInfo*> infos;
     if (spec == "all") {  // every estimator, in `pathlab algorithms`' order

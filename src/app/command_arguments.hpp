@@ -12,6 +12,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "image/image.hpp"
@@ -57,6 +58,8 @@ SceneDefines parse_defines(const std::vector<std::string>& defines);
 // --crop X,Y,W,H (pixels, from the top left; whole numbers, W and H positive). Whether it fits
 // an image is checked against the image.
 PixelRect parse_crop_option(const std::string& text);
+// --guide-pixel X,Y: a pixel's column and row from the top left; a UsageError naming the option otherwise.
+std::pair<int, int> parse_pixel_option(const std::string& text);
 
 // -a/--algorithm in every command: one estimator or a comma-separated list (repeats refused).
 std::vector<const IntegratorInfo*> parse_algorithm_list(const std::string& spec);

@@ -4,7 +4,6 @@
 #include <unistd.h>
 
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <optional>
 
@@ -112,14 +111,9 @@ int run_report_command(const ReportOptions& o) {
     for (const std::string& c : o.crops) crops.push_back(parse_crop_option(c));
     std::optional<std::pair<int, int>> guide_pixel;
     if (!o.guide_pixel.empty()) {
-        int x = -1, y = -1;
-        char comma = 0, extra = 0;
-        if (std::sscanf(o.guide_pixel.c_str(), "%d%c%d%c", &x, &comma, &y, &extra) != 3 || comma != ',' || x < 0 || y < 0)
-            throw UsageError(fmt::format("--guide-pixel {}: give X,Y, a pixel's column and row from the top left", o.guide_pixel));
-        guide_pixel = std::pair{x, y};
-        bool guided = false;
-        for (const IntegratorInfo* e : infos) guided = guided || e->name == "ppg";
-        if (!guided) throw UsageError("--guide-pixel shows what ppg learned: add ppg to -a");
+        guide_pixel = parse_pixel_option(o.guide_pixel);
+        if (std::none_of(infos.begin(), infos.end(), [](const IntegratorInfo* e) { return e->name == "ppg"; }))
+            throw UsageError("--guide-pixel shows what ppg learned: add ppg to -a");
     }
     const size_t direct = size_t(std::count_if(infos.begin(), infos.end(), [](const IntegratorInfo* e) { return is_direct_illumination(*e); }));
     const bool all_direct = direct == infos.size();

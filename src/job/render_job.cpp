@@ -119,6 +119,15 @@ std::string non_reciprocal_material(const SceneDescription& d) {
     return "";
 }
 
+namespace {
+
+// Whether the render asks for --null-depth skip: the request's, else the scene file's.
+bool null_skip_requested(const JobRequest& r, const SceneDescription& d) {
+    return r.skip_null_events ? *r.skip_null_events : d.skip_null_events.value_or(false);
+}
+
+}  // namespace
+
 // The first material with a straight pass through it (kLobeNull: thindielectric, mask), named as
 // the scene file does ("" if none).
 std::string null_lobe_material(const SceneDescription& d) {
@@ -175,7 +184,7 @@ std::string integrator_refusal(const IntegratorInfo& info, const SceneDescriptio
                                "(f(wi, wo) != f(wo, wi)): {} would converge to another image. Render it with a camera-side "
                                "integrator (path, pt-mis3, pt-naive, volpath, direct, ic, pbgi)",
                                info.name, m, info.name);
-    if (!info.skips_null_events && (r.skip_null_events ? *r.skip_null_events : d.skip_null_events.value_or(false)) &&
+    if (!info.skips_null_events && null_skip_requested(r, d) &&
         (r.max_depth ? *r.max_depth : d.max_depth.value_or(-1)) >= 0)
         if (const std::string m = null_lobe_material(d); !m.empty())
             return fmt::format("{0} counts a straight pass through a surface as a bounce, and this render asks for --null-depth "
@@ -285,7 +294,7 @@ RenderJob::RenderJob(SceneChoice scene, const JobRequest& r) : choice_(std::move
     options_.pbgi_spacing = r.pbgi_spacing ? *r.pbgi_spacing : d.pbgi_spacing.value_or(options_.pbgi_spacing);
     options_.hide_emitters = d.hide_emitters.value_or(false);
     // (Only where it matters: a scene without thin glass or masks renders as it did.)
-    options_.skip_null_events = (r.skip_null_events ? *r.skip_null_events : d.skip_null_events.value_or(false)) && !null_lobe_material(d).empty();
+    options_.skip_null_events = null_skip_requested(r, d) && !null_lobe_material(d).empty();
     for (size_t i = 0; i < r.aovs.size(); ++i) {
         const std::vector<std::string>& names = aov_names();
         if (std::find(names.begin(), names.end(), r.aovs[i]) == names.end())

@@ -199,6 +199,17 @@ float LightSampler::infinite_share() const {
     return float(infinite_.size()) / float(infinite_.size() + 1);
 }
 
+namespace {
+
+// A node's four importances at (p, n) and their sum: choose() and pmf() read both from here, so
+// that they divide the same floats.
+float lane_importances(const LightBounds4& bounds, const Vec3f& p, const Vec3f& n, float importance[4]) {
+    bounds.importance(p, n).store(importance);
+    return (importance[0] + importance[1]) + (importance[2] + importance[3]);
+}
+
+}  // namespace
+
 LightChoice LightSampler::choose(const Vec3f& p, const Vec3f& n, float u) const {
     if (count_ == 0) return {};
     switch (kind_) {
@@ -219,13 +230,12 @@ LightChoice LightSampler::choose(const Vec3f& p, const Vec3f& n, float u) const 
     for (;;) {
         const Node& at = nodes_[size_t(node)];
         float importance[4];
-        at.bounds.importance(p, n).store(importance);
+        const float sum = lane_importances(at.bounds, p, n, importance);
         // The lane whose share of [0, sum) holds u * sum (empty for a lane of importance 0; counting
         // the bounds below it takes no branch and no division, which would wait for the sum), the
         // last lane of positive importance where rounding leaves it past the sum; u is rescaled
         // to [0, 1) within the lane.
         const float c0 = importance[0], c1 = c0 + importance[1], c2 = c1 + importance[2];
-        const float sum = (importance[0] + importance[1]) + (importance[2] + importance[3]);
         if (!(sum > 0)) return {};
         const float x = u * sum;
         int lane = int(x >= c0) + int(x >= c1) + int(x >= c2);
@@ -255,8 +265,7 @@ float LightSampler::pmf(const Vec3f& p, const Vec3f& n, int light) const {
     for (int level = 0; level < trail.depth; ++level) {
         const Node& at = nodes_[size_t(node)];
         float importance[4];
-        at.bounds.importance(p, n).store(importance);
-        const float sum = (importance[0] + importance[1]) + (importance[2] + importance[3]);
+        const float sum = lane_importances(at.bounds, p, n, importance);
         const int lane = int((trail.lanes >> (2 * level)) & 3);
         if (!(sum > 0)) return 0.0f;
         pmf *= importance[lane] / sum;  // as choose() multiplies it

@@ -85,5 +85,40 @@ TEST(PhotonSearch, ThePhotonAtExactlyTheRadiusCountsAndNothingIsFoundInNothing) 
     EXPECT_TRUE(found(tree, none, q, 0.1f).empty());
 }
 
+// The merge's order is part of the image's bytes: the overload that prefetches (in batches of
+// 16, the records of a batch asked for before its first call) must call f with the same indices
+// in the same order as the plain one, and prefetch each index exactly once, before its f.
+TEST(PhotonSearch, PrefetchingSearchCallsBackInTheSameOrder) {
+    Pcg32 rng(56, 78);
+    std::vector<Photon<RgbTransport>> photons = random_photons(rng, 6000);
+    PhotonGrid grid;
+    grid.build_sorted(photons, 0.3f);
+    size_t longest = 0;
+    for (int k = 0; k < 200; ++k) {
+        const Vec3f q = k % 2 == 0 ? photons[size_t(rng.next_u32() % photons.size())].p
+                                   : Vec3f(rng.next_float(), rng.next_float(), rng.next_float()) * 4.0f - Vec3f(1.0f);
+        const float r = 0.3f * rng.next_float();
+        std::vector<uint32_t> plain, called, asked;
+        std::vector<bool> asked_before(photons.size(), false);
+        bool in_order = true;
+        grid.for_each_within(q, r, [&](uint32_t i) { plain.push_back(i); });
+        grid.for_each_within(
+            q, r,
+            [&](uint32_t i) {
+                in_order = in_order && asked_before[i];
+                called.push_back(i);
+            },
+            [&](uint32_t i) {
+                asked_before[i] = true;
+                asked.push_back(i);
+            });
+        ASSERT_EQ(called, plain) << "query " << k;
+        ASSERT_EQ(asked, plain) << "query " << k;
+        ASSERT_TRUE(in_order) << "query " << k << ": an item was called back before it was prefetched";
+        longest = std::max(longest, plain.size());
+    }
+    EXPECT_GT(longest, 64u) << "some queries must span several batches";
+}
+
 }  // namespace
 }  // namespace pathlab::test

@@ -30,6 +30,13 @@ struct Positions {
     bool empty() const { return count == 0; }
 };
 
+// Asks for the cache lines of an item ahead of its use (for_each_within's prefetch).
+template <class P> inline void prefetch_item(const P& item) {
+    const char* first = reinterpret_cast<const char*>(&item);
+    __builtin_prefetch(first);
+    __builtin_prefetch(first + sizeof(P) - 1);
+}
+
 class PhotonGrid {
 public:
     // `radius`: the largest query radius to come. The items must stay where they are while the
@@ -43,7 +50,12 @@ public:
     // gets indices into the reordered items. `companion`, unless empty, is an array of as many
     // values that belong to the items (one each) and is reordered with them.
     template <class P, class Q = char> void build_sorted(std::vector<P>& items, float radius, std::vector<Q>* companion = nullptr);
-    template <typename F> void for_each_within(const Vec3f& q, float r, F&& f) const;
+    template <typename F> void for_each_within(const Vec3f& q, float r, F&& f) const { for_each_within(q, r, f, [](uint32_t) {}); }
+    // The same, calling prefetch(i) for the items found ahead of f(i): they are gathered in
+    // batches, all of a batch's prefetches issued before its first f, so that the reads of their
+    // records (random, each a cache miss once the photons outgrow the caches) overlap instead of
+    // each waiting for f to finish the one before. f still sees the items in the same order.
+    template <typename F, typename Prefetch> void for_each_within(const Vec3f& q, float r, F&& f, Prefetch&& prefetch) const;
     size_t memory_bytes() const {
         return cell_ends_.capacity() * sizeof(uint32_t) + order_.capacity() * sizeof(uint32_t) + cell_of_.capacity() * sizeof(uint32_t) +
                sorted_p_.capacity() * sizeof(Vec3f);
@@ -91,7 +103,7 @@ template <class P, class Q> void PhotonGrid::build_sorted(std::vector<P>& items,
     sorted_ = true;
 }
 
-template <typename F> void PhotonGrid::for_each_within(const Vec3f& q, float r, F&& f) const {
+template <typename F, typename Prefetch> void PhotonGrid::for_each_within(const Vec3f& q, float r, F&& f, Prefetch&& prefetch) const {
     if (positions_.empty()) return;
     const float r2 = r * r;
     // The cell holding q, and the neighbours on the side of q's position within it.
@@ -119,12 +131,23 @@ template <typename F> void PhotonGrid::for_each_within(const Vec3f& q, float r, 
     }
     for (int k = 0; k < n_visited; ++k)
         if (begins[k] < ends[k]) __builtin_prefetch(&positions_[sorted_ ? begins[k] : order_[begins[k]]]);
+    constexpr int kBatch = 16;
+    uint32_t batch[kBatch];
+    int n = 0;
     for (int c = 0; c < n_visited; ++c)
         for (uint32_t k = begins[c]; k < ends[c]; ++k) {
             const uint32_t i = sorted_ ? k : order_[k];
             const Vec3f d = positions_[i] - q;
-            if (dot(d, d) <= r2) f(i);
+            if (dot(d, d) <= r2) {
+                prefetch(i);
+                batch[n++] = i;
+                if (n == kBatch) {
+                    for (int j = 0; j < n; ++j) f(batch[j]);
+                    n = 0;
+                }
+            }
         }
+    for (int j = 0; j < n; ++j) f(batch[j]);
 }
 
 class PhotonKdTree {

@@ -313,7 +313,7 @@ ColourOf<T> Vcm<T>::merge(const Scene& scene, const std::vector<Vertex>& camera,
         // In media: the spectral MIS over the hero channel that both subpaths shared.
         if (media) c /= path_density_of(photon_r_[k] * z.r, ph.dispersed || z.dispersed);
         sum.add(c, ph.dispersed);
-    });
+    }, [&](uint32_t k) { prefetch_item(photons_[k]); });
     // The factor 4 once per path: a dispersed photon counts 4 times against a camera path of 4
     // lanes; against a dispersed camera path once, and that path's own hero_only() gives the 4.
     Wavelengths camera_wl = wl;

@@ -93,7 +93,7 @@ int main(int argc, char** argv) {
     bec->add_option("--repeats", be.repeats, "Timed renders per method (median reported)")->capture_default_str();
     bec->add_option("--ref-spp", be.ref_spp, "Samples per pixel of each reference (bdpt)")->capture_default_str();
     bec->add_option("--scenes", be.scenes, "Scene files of scenes/")->delimiter(',')->capture_default_str();
-    bec->add_option("--algorithms", be.algorithms, "Methods (the efficiencies are relative to the first); NAME:radius=R (the photon methods' first radius), NAME:max_depth=D, NAME:rr_depth=R, ppg:guiding_spp=N, ppg:guiding_rr=1, upbp:estimators=bpt+pb2d")
+    bec->add_option("--algorithms", be.algorithms, "Methods (the efficiencies are relative to the first); NAME:radius=R (the photon methods' first radius), NAME:max_depth=D, NAME:rr_depth=R, ppg:guiding_spp=N, ppg:guiding_rr=1, ppg:guiding_fraction=learned, upbp:estimators=bpt+pb2d")
         ->delimiter(',')->capture_default_str();
     bec->add_option("--samplers", be.samplers, "Pixel samplers: independent (the course's), sobol")->delimiter(',')->capture_default_str();
     bec->add_option("--max-depth", be.max_depth, "Bounces at most, for every method and the reference (-1: unlimited)")->capture_default_str();

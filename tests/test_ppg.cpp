@@ -107,6 +107,39 @@ TEST(SdTree, SplitsTheSpaceWhereRecordsPileUpAndRestructuresByEnergy) {
     EXPECT_EQ(near.building.energy(), 0.0);
 }
 
+// The learned BSDF fraction (BsdfFractionFit, Müller 2019) at a leaf that learned light from
+// around `peak`: a stand-in "BSDF" samples the sphere uniformly, and the product F is either the
+// light the tree learned (the tree samples it far better: the fraction must fall towards the
+// tree) or uniform (the BSDF samples it exactly, the tree badly: the fraction must rise). Each
+// step draws a direction from the current mixture and applies the gradient ppg records.
+float learned_fraction(bool product_is_the_trees) {
+    const Vec3f peak = normalize(Vec3f(0.3f, -0.5f, 0.8f));
+    SdTree tree = peaked_tree(peak);
+    Pcg32 rng(21, 5);
+    const Vec3f at(0.1f);
+    for (int i = 0; i < 4000; ++i) {
+        const GuidingLeaf& leaf = tree.leaf(at);
+        const float a = leaf.fraction.fraction();
+        const Vec2f u{rng.next_float(), rng.next_float()};
+        const Vec3f d = square_to_direction(rng.next_float() < a ? u : leaf.sampling.sample(u));
+        const float p_bsdf = 1 / (4 * kPi), p_tree = leaf.sampling.pdf(direction_to_square(d)) / (4 * kPi);
+        const float q = a * p_bsdf + (1 - a) * p_tree;
+        const float F = product_is_the_trees ? 0.05f + std::exp(40.0f * (dot(d, peak) - 1.0f)) * 50.0f : 1.0f;
+        tree.record_fraction_gradient(at, -(F / q) * (p_bsdf - p_tree) / q * a * (1 - a));
+    }
+    return tree.leaf(at).fraction.fraction();
+}
+
+TEST(SdTree, LearnedBsdfFractionMovesTowardsTheHalfThatSamplesTheProduct) {
+    EXPECT_EQ(BsdfFractionFit{}.fraction(), 0.5f);  // untrained: the paper's 1/2
+    const float towards_tree = learned_fraction(true), towards_bsdf = learned_fraction(false);
+    EXPECT_LT(towards_tree, 0.3f);
+    EXPECT_GT(towards_bsdf, 0.7f);
+    // Never 0 or 1: both halves stay in the mixture.
+    EXPECT_GT(towards_tree, 0.01f);
+    EXPECT_LT(towards_bsdf, 0.99f);
+}
+
 TEST(PathGuiding, TrainingIterationsDoubleAndTheLastTakesTheRest) {
     using P = PathGuiding<RgbTransport>;
     EXPECT_EQ(P::iteration_sizes(31), (std::vector<uint64_t>{1, 2, 4, 8, 16}));
@@ -167,6 +200,23 @@ TEST(PpgRouletteAgreement, ConvergesOnTheLampshadeAndFailsWithoutTheSurvivorsWei
         PathGuiding<RgbTransport> ppg(o, GuidingFaults{.drop_roulette_weight = fault});
         const AgreementResult r = compare_with_pt_mis(d, ppg, 16384, false, 16);
         EXPECT_EQ(r.agree, !fault) << (fault ? "with" : "without") << " the fault: " << r.describe();
+    }
+}
+
+// The learned fraction changes the mixture per leaf, not what it converges to; it is learned
+// (the leaves' mean moved off 1/2).
+TEST(PpgAgreement, ConvergesWithTheLearnedBsdfFraction) {
+    for (const int scene : {3, 6}) {
+        IntegratorOptions o = ppg_options();
+        o.guiding_fraction = kLearnedGuidingFraction;
+        PathGuiding<RgbTransport> ppg(o);
+        const AgreementResult r = compare_with_pt_mis(make_builtin_scene(scene), ppg, 2048);
+        EXPECT_TRUE(r.agree) << "scene " << scene << ": " << r.describe();
+        double mean = -1;
+        for (const IntegratorStatistic& s : ppg.statistics())
+            if (s.name == "guiding_fraction_mean") mean = s.value;
+        EXPECT_GT(mean, 0.0) << "scene " << scene;
+        EXPECT_NE(mean, 0.5) << "scene " << scene;
     }
 }
 
@@ -232,9 +282,10 @@ TEST(PathGuiding, WithoutTrainingIsPtMis) {
 }
 
 TEST(PathGuiding, SameBytesOnAnyThreadCountAndContinued) {
-    for (const bool adrrs : {false, true}) {
+    for (const int variant : {0, 1, 2}) {
         IntegratorOptions o = ppg_options();
-        o.guiding_rr = adrrs;
+        o.guiding_rr = variant == 1;
+        if (variant == 2) o.guiding_fraction = kLearnedGuidingFraction;
         expect_same_bytes_on_threads_and_continued([&] { return std::make_unique<PathGuiding<RgbTransport>>(o); });
     }
 }
@@ -250,8 +301,20 @@ TEST(PathGuiding, TrainingSppIsItsOption) {
     EXPECT_TRUE(job.integrator_options().guiding_rr);
     JobRequest other = r;
     other.algorithm = "pt-mis";
-    EXPECT_NE(refusal_of(other).find("--guiding-spp and --guiding-rr set the training and the roulette of ppg"), std::string::npos)
+    EXPECT_NE(refusal_of(other).find("--guiding-spp, --guiding-rr and --guiding-fraction set the training"), std::string::npos)
         << refusal_of(other);
+    EXPECT_EQ(job.integrator_options().guiding_fraction, 0.5f);  // the paper's, by default
+    for (const auto& [text, value] : std::vector<std::pair<std::string, float>>{{"learned", kLearnedGuidingFraction}, {"0.25", 0.25f}, {"1", 1.0f}}) {
+        JobRequest f = r;
+        f.guiding_fraction = text;
+        EXPECT_EQ(RenderJob(4, f).integrator_options().guiding_fraction, value) << text;
+    }
+    for (const std::string bad : {"0", "1.5", "-0.2", "half", ""}) {
+        JobRequest f = r;
+        f.guiding_fraction = bad;
+        EXPECT_NE(refusal_of(f).find("--guiding-fraction must be a number in (0, 1] or 'learned', got '" + bad + "'"), std::string::npos)
+            << refusal_of(f);
+    }
     JobRequest far = r;
     far.guiding_spp = -1;
     EXPECT_NE(refusal_of(far).find("--guiding-spp must be 0 to"), std::string::npos) << refusal_of(far);

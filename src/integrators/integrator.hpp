@@ -31,8 +31,10 @@
 //  4. finish() writes extra outputs only; with several processes it runs on rank 0 alone.
 #pragma once
 
+#include <cstdlib>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -48,6 +50,17 @@
 #include "integrators/common/transport.hpp"
 
 namespace pathlab {
+
+inline constexpr float kLearnedGuidingFraction = -1.0f;  // --guiding-fraction learned
+inline constexpr const char* kGuidingFractionHelp = "a number in (0, 1] or 'learned'";
+// --guiding-fraction: a number in (0, 1], or "learned" (kLearnedGuidingFraction); nullopt for anything else.
+inline std::optional<float> parse_guiding_fraction(const std::string& text) {
+    if (text == "learned") return kLearnedGuidingFraction;
+    char* end = nullptr;
+    const float a = std::strtof(text.c_str(), &end);
+    if (!text.empty() && end == text.c_str() + text.size() && a > 0 && a <= 1) return a;
+    return std::nullopt;
+}
 
 struct IntegratorOptions {
     int max_depth = -1;  // longest path in bounces (1 = direct illumination only); -1 = unlimited
@@ -98,6 +111,9 @@ struct IntegratorOptions {
     // ppg: samples per pixel of the SD-tree's training (iterations of 1, 2, 4, ...; 0: no guiding).
     int guiding_spp = 31;
     bool guiding_rr = false;  // ppg: adjoint-driven Russian roulette and splitting (ADRRS)
+    // ppg: the probability of sampling the BSDF rather than the SD-tree where a leaf guides, in
+    // (0, 1]; kLearnedGuidingFraction: learned per leaf (Müller 2019).
+    float guiding_fraction = 0.5f;
     // Paths of no bounce (emitters and the environment seen directly) are left out (Mitsuba's hide_emitters).
     bool hide_emitters = false;
     // --null-depth skip: a straight pass through a surface (a kLobeNull sample: thindielectric's

@@ -75,6 +75,9 @@ std::string options_text(const IntegratorOptions& o) {
                 : fmt::format(" chains={} bootstrap={} large_step={} sigma={}", o.mlt_chains, o.mlt_bootstrap, hex_float(o.mlt_large_step),
                               hex_float(o.mlt_sigma))) +
            (o.guiding_spp == defaults.guiding_spp ? "" : fmt::format(" guiding_spp={}", o.guiding_spp)) + (o.guiding_rr ? " guiding_rr=1" : "") +
+           (o.guiding_fraction == defaults.guiding_fraction
+                ? ""
+                : o.guiding_fraction == kLearnedGuidingFraction ? " guiding_fraction=learned" : " guiding_fraction=" + hex_float(o.guiding_fraction)) +
            (o.estimators.empty() ? "" : " estimators=" + o.estimators) +
            (o.photon_beams == 0 ? "" : fmt::format(" photon_beams={}", o.photon_beams)) +
            (o.beam_radius == 0 ? "" : " beam_radius=" + hex_float(o.beam_radius));  // the text of the defaults as it always was

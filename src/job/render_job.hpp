@@ -63,6 +63,7 @@ struct JobRequest {
     std::optional<int> pbgi_spacing;          // --pbgi-spacing (pbgi)
     std::optional<int> guiding_spp;           // --guiding-spp (ppg)
     bool guiding_rr = false;                  // --guiding-rr (ppg)
+    std::optional<std::string> guiding_fraction;  // --guiding-fraction (ppg)
     std::optional<std::string> estimators;    // --estimators (upbp)
     std::optional<int64_t> photon_beams;      // --photon-beams (upbp)
     std::optional<float> beam_radius;         // --beam-radius (upbp)

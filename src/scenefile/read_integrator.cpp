@@ -128,6 +128,12 @@ void read_plain_integrator(XmlSource& xml, const pugi::xml_node& n, SceneBuilder
         positive("gather_spacing", 1, 64, b.desc.pbgi_spacing);
         positive("training_spp", 0, 1 << 20, b.desc.guiding_spp);  // ppg
         if (plugin.find("guiding_rr") && p.has("guiding_rr")) b.desc.guiding_rr = p.get_bool("guiding_rr");
+        if (plugin.find("guiding_fraction") && p.has("guiding_fraction")) {
+            const std::string text = p.get_string("guiding_fraction");
+            if (!parse_guiding_fraction(text))
+                p.fail("guiding_fraction", fmt::format("guiding_fraction must be {}, got '{}'", kGuidingFractionHelp, text));
+            b.desc.guiding_fraction = text;
+        }
         if (plugin.find("estimators") && p.has("estimators")) b.desc.estimators = p.get_string("estimators");
         if (plugin.find("photon_beams") && p.has("photon_beams")) {
             const int count = p.get_int("photon_beams");

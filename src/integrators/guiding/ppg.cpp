@@ -1,7 +1,9 @@
 // Practical path guiding (Müller, Gross and Novák, EGSR 2017): pt-mis whose continuation
 // direction is drawn, where the SD-tree (sd_tree.hpp) has learned something, from the one-sample
-// mixture of the BSDF (probability 1/2) and the tree's distribution of arriving radiance:
-//   p(wo) = a p_bsdf(wo) + (1 - a) p_tree(wo),   a = kBsdfFraction.
+// mixture of the BSDF (probability a) and the tree's distribution of arriving radiance:
+//   p(wo) = a p_bsdf(wo) + (1 - a) p_tree(wo),
+// a = --guiding-fraction (1/2, the paper's, by default), or learned per leaf during training
+// (BsdfFractionFit in sd_tree.hpp; Müller 2019).
 // Both halves stay in the mixture for every direction, so every direction the BSDF reaches stays
 // reachable (guiding cannot lose light; it can only move variance). Next-event estimation is
 // kept: a light sample is weighed against the mixture's density, the emission the continuation
@@ -113,9 +115,11 @@ void PathGuiding<T>::prepare(const RenderContext& ctx, const PassProgress& progr
                 }
             });
             for (int r = 0; r < rows; ++r)
-                for (const Record& rec : row_records[size_t(r)])
-                    if (rec.outgoing) tree_.record_outgoing(rec.p, rec.value);
-                    else tree_.record(rec.p, rec.direction, rec.value);
+                for (const Record& rec : row_records[size_t(r)]) switch (rec.kind) {
+                        case Record::kIncoming: tree_.record(rec.p, rec.direction, rec.value); break;
+                        case Record::kOutgoing: tree_.record_outgoing(rec.p, rec.value); break;
+                        case Record::kFraction: tree_.record_fraction_gradient(rec.p, rec.value); break;
+                    }
             done += spp * uint64_t(rows);
             if (progress) progress(double(done) / double(total * uint64_t(h)));
         }
@@ -125,6 +129,11 @@ void PathGuiding<T>::prepare(const RenderContext& ctx, const PassProgress& progr
     }
     training_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     prepared_.set(ctx);
+}
+
+template <class T>
+float PathGuiding<T>::bsdf_fraction(const GuidingLeaf& leaf) const {
+    return options_.guiding_fraction == kLearnedGuidingFraction ? leaf.fraction.fraction() : options_.guiding_fraction;
 }
 
 template <class T>
@@ -152,17 +161,18 @@ ColourOf<T> PathGuiding<T>::walk(const Scene& scene, Intersection hit, Vec3f dir
     int n = 0;
     const bool power = rules_.power_mis();
     const GuidingLeaf* next_leaf = nullptr;  // the leaf of `hit`, when the roulette has looked it up
+    const bool learn_fraction = records && options_.guiding_fraction == kLearnedGuidingFraction;
     for (int bounces = first_bounce; rules_.may_bounce(bounces); ++bounces) {
         const ShadingPoint sp = make_shading_point(scene, hit, dir);
         if (sp.material->is_black()) break;
         const GuidingLeaf* leaf = guided_ ? (next_leaf ? next_leaf : &tree_.leaf(sp.p)) : nullptr;
         const bool guide = leaf && leaf->usable && (sp.material->lobes() & (kLobeDiffuse | kLobeGlossy)) != 0;
-        const float a = guide ? kBsdfFraction : 1.0f;
-        // The continuation's density for a direction (local) of BSDF density pdf_bsdf.
+        const float a = guide ? bsdf_fraction(*leaf) : 1.0f;
+        // The tree's solid-angle density of a direction (local), and the continuation's of one of BSDF density pdf_bsdf.
+        const auto tree_pdf = [&](const Vec3f& w) { return leaf->sampling.pdf(direction_to_square(sp.frame.to_world(w))) * (1.0f / (4.0f * kPi)); };
         const auto mixture_pdf = [&](const Vec3f& w, float pdf_bsdf) {
             if (!guide) return pdf_bsdf;
-            const float tree_pdf = leaf->sampling.pdf(direction_to_square(sp.frame.to_world(w))) * (1.0f / (4.0f * kPi));
-            return a * pdf_bsdf + (1.0f - a) * tree_pdf;
+            return a * pdf_bsdf + (1.0f - a) * tree_pdf(w);
         };
         const auto light_mis_pdf = [&](const Vec3f& w, float pdf_bsdf) {
             return faults_.drop_guide_pdf_in_mis ? pdf_bsdf : mixture_pdf(w, pdf_bsdf);
@@ -171,7 +181,7 @@ ColourOf<T> PathGuiding<T>::walk(const Scene& scene, Intersection hit, Vec3f dir
         if (v) *v = {sp.p, Vec3f(0.0f), 0.0f, false, L, beta, L, beta};
         LightSampleSeen<Wl> light;
         L += beta * estimate_light_sample(scene, sp, sampler, /*mis=*/true, wl, power, light_mis_pdf, records ? &light : nullptr);
-        if (records && light.found) records->push_back({sp.p, light.wi, mean_of(light.Li), false});
+        if (records && light.found) records->push_back({sp.p, light.wi, mean_of(light.Li), Record::kIncoming});
 
         // The continuation: the BSDF's sample (always without guiding), or the tree's.
         const Vec2f u = sampler.next2d();
@@ -196,7 +206,10 @@ ColourOf<T> PathGuiding<T>::walk(const Scene& scene, Intersection hit, Vec3f dir
         if (!s || !(pdf > 0)) break;
         const Colour step = f * (std::abs(s->wo.z) / pdf);
         const Vec3f wo_world = sp.frame.to_world(s->wo);
-        if (v && !s->delta) v->direction = wo_world, v->pdf = pdf, v->guided_record = true, v->L_before = L, v->beta_after = beta * step;
+        if (v && !s->delta) {
+            v->direction = wo_world, v->pdf = pdf, v->guided_record = true, v->L_before = L, v->beta_after = beta * step;
+            if (guide && learn_fraction) v->a = a, v->f_cos = mean_of(f) * std::abs(s->wo.z), v->pdf_bsdf = s->pdfW, v->pdf_tree = tree_pdf(s->wo);
+        }
         const EmitterHit found = trace_to_emitter(scene, sp.spawn(s->wo), sp.p, sp.frame.n);
         if (!is_black(found.Le)) {
             const float weight = s->delta ? 1.0f : mis_heuristic(power, pdf, found.pdf_light);
@@ -236,17 +249,32 @@ ColourOf<T> PathGuiding<T>::walk(const Scene& scene, Intersection hit, Vec3f dir
     // the vertex sent back: all the path gathered from it on, over the throughput that reached it.
     for (int i = 0; i < n; ++i) {
         const PathVertex& v = vertices[i];
-        if (v.guided_record) records->push_back({v.p, v.direction, mean_ratio(L - v.L_before, v.beta_after) / v.pdf, false});
-        records->push_back({v.p, Vec3f(0.0f), mean_ratio(L - v.L_start, v.beta_start), true});
+        if (v.guided_record) {
+            const float Li = mean_ratio(L - v.L_before, v.beta_after);
+            records->push_back({v.p, v.direction, Li / v.pdf, Record::kIncoming});
+            if (v.a < 1) {  // the fraction's gradient (BsdfFractionFit), where the vertex was guided
+                const float F_over_q = v.f_cos * Li / v.pdf;
+                records->push_back({v.p, v.direction, -F_over_q * (v.pdf_bsdf - v.pdf_tree) / v.pdf * v.a * (1 - v.a), Record::kFraction});
+            }
+        }
+        records->push_back({v.p, Vec3f(0.0f), mean_ratio(L - v.L_start, v.beta_start), Record::kOutgoing});
     }
     return L;
 }
 
 template <class T>
 std::vector<IntegratorStatistic> PathGuiding<T>::statistics() const {
-    return {{"guiding_training_seconds", training_seconds_},
-            {"guiding_leaves", double(tree_.leaf_count())},
-            {"guiding_tree_mib", double(tree_.memory_bytes()) / (1024.0 * 1024.0)}};
+    std::vector<IntegratorStatistic> stats{{"guiding_training_seconds", training_seconds_},
+                                           {"guiding_leaves", double(tree_.leaf_count())},
+                                           {"guiding_tree_mib", double(tree_.memory_bytes()) / (1024.0 * 1024.0)}};
+    if (options_.guiding_fraction == kLearnedGuidingFraction) {  // the learned BSDF fractions' mean over the leaves that guide
+        double sum = 0;
+        size_t n = 0;
+        for (const GuidingLeaf& l : tree_.leaves())
+            if (l.usable) sum += l.fraction.fraction(), ++n;
+        stats.push_back({"guiding_fraction_mean", n ? sum / double(n) : 0.5});
+    }
+    return stats;
 }
 
 template class PathGuiding<RgbTransport>;
@@ -259,6 +287,10 @@ std::vector<ParamInfo> ppg_params() {
     p.push_back({"training_spp", ParamType::Integer, "31",
                  "samples per pixel of the SD-tree's training, in iterations of 1, 2, 4, ... (not in the image; --guiding-spp wins)", ""});
     p.push_back({"guiding_rr", ParamType::Boolean, "false", "adjoint-driven Russian roulette and splitting (or --guiding-rr)", ""});
+    p.push_back({"guiding_fraction", ParamType::String, "0.5",
+                 "the probability of sampling the BSDF rather than the SD-tree where it guides: a number in (0, 1] or 'learned' (per leaf, "
+                 "Müller 2019; or --guiding-fraction)",
+                 ""});
     return p;
 }
 

@@ -21,8 +21,10 @@ public:
     using Colour = ColourOf<T>;
     using Wl = WavelengthsOf<T>;
 
-    // The probability of sampling the BSDF rather than the SD-tree where a leaf guides (Müller's 0.5).
-    static constexpr float kBsdfFraction = 0.5f;
+    // The probability of sampling the BSDF rather than the SD-tree where a leaf guides: the
+    // options' guiding_fraction (Müller's 0.5 by default), or with kLearnedGuidingFraction each
+    // leaf's learned one (BsdfFractionFit).
+    float bsdf_fraction(const GuidingLeaf& leaf) const;
 
     explicit PathGuiding(const IntegratorOptions& o, GuidingFaults faults = {});
     // Trains the SD-tree: iterations of 1, 2, 4, ... samples per pixel (the last takes what is
@@ -38,10 +40,12 @@ public:
 
     // One record of a training path (sd_tree.hpp): the radiance arriving from `direction` over
     // its density, or (outgoing) the radiance the vertex sent back.
+    // Or (fraction) a gradient of the leaf's BSDF fraction's fit.
     struct Record {
+        enum Kind : uint8_t { kIncoming, kOutgoing, kFraction };
         Vec3f p, direction;
         float value;
-        bool outgoing;
+        Kind kind;
     };
 
     // Adjoint-driven roulette and splitting (--guiding-rr): the weight window's ratio, the most
@@ -53,11 +57,14 @@ private:
     // A training path's vertex: where its continuation left from, in which direction, with what
     // density, the radiance gathered before its light came in and the throughput after it; and
     // the radiance gathered before the vertex and the throughput that reached it.
+    // With a learned fraction, a guided vertex also keeps what the fraction's gradient needs: the
+    // fraction a, f |cos| of the continuation and its two densities.
     struct PathVertex {
         Vec3f p, direction;
         float pdf;
         bool guided_record;
         Colour L_start, beta_start, L_before, beta_after;
+        float a = 1, f_cos = 0, pdf_bsdf = 0, pdf_tree = 0;
     };
     static constexpr int kRecordedVertices = 64;  // a training path records its first 64 vertices
 

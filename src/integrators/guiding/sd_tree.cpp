@@ -183,6 +183,21 @@ void SdTree::record_outgoing(const Vec3f& p, float radiance) {
     ++l.outgoing_count;
 }
 
+void BsdfFractionFit::step(float gradient) {
+    if (!std::isfinite(gradient)) return;
+    constexpr float kBeta1 = 0.9f, kBeta2 = 0.999f, kEpsilon = 1e-8f;
+    const float g = gradient + kRegularisation * theta;
+    // (to 0 once they no longer matter, rather than through the slow denormal floats)
+    beta1_t = beta1_t > 1e-20f ? beta1_t * kBeta1 : 0.0f, beta2_t = beta2_t > 1e-20f ? beta2_t * kBeta2 : 0.0f;
+    m = kBeta1 * m + (1 - kBeta1) * g;
+    v = kBeta2 * v + (1 - kBeta2) * g * g;
+    const float m_hat = m / (1 - beta1_t), v_hat = v / (1 - beta2_t);
+    theta = std::clamp(theta - kLearningRate * m_hat / (std::sqrt(v_hat) + kEpsilon), -kMaxTheta, kMaxTheta);
+    a = 1.0f / (1.0f + std::exp(-theta));
+}
+
+void SdTree::record_fraction_gradient(const Vec3f& p, float gradient) { leaf(p).fraction.step(gradient); }
+
 void SdTree::split(uint32_t node) {
     const uint32_t leaf = nodes_[node].leaf;
     const uint8_t axis = uint8_t((nodes_[node].axis + 1) % 3);

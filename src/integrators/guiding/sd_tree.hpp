@@ -63,6 +63,24 @@ private:
     std::vector<Node> nodes_;
 };
 
+// The probability of sampling the BSDF rather than the tree, learned per leaf (--guiding-fraction
+// learned; Müller, "Practical Path Guiding in Production", 2019): a = sigmoid(theta), theta moved
+// by Adam along the gradient of the KL divergence from the product F = f Li |cos| (normalised) to
+// the continuation's mixture q = a p_bsdf + (1 - a) p_tree, estimated at each guided training
+// vertex from its direction w (drawn from q):
+//   dD/dtheta = -(F(w) / q(w)) (p_bsdf(w) - p_tree(w)) / q(w) a (1 - a)
+// (an L2 term 0.01 theta pulls theta towards 0, a = 1/2, where the vertices say little; theta is
+// kept within [-4, 4], a within [0.018, 0.982], so that neither half is ever off).
+struct BsdfFractionFit {
+    static constexpr float kLearningRate = 0.01f, kRegularisation = 0.01f, kMaxTheta = 4.0f;
+    float theta = 0, m = 0, v = 0;  // the parameter and Adam's moments
+    float beta1_t = 1, beta2_t = 1;  // Adam's decay rates to the power of the steps taken
+    float a = 0.5f;                  // sigmoid(theta), kept for the paths that read it
+
+    float fraction() const { return a; }
+    void step(float gradient);
+};
+
 struct GuidingLeaf {
     QuadTree sampling, building;
     uint64_t records = 0;  // vertices recorded in this iteration
@@ -73,6 +91,7 @@ struct GuidingLeaf {
     float outgoing = 0;
     double outgoing_sum = 0;
     uint64_t outgoing_count = 0;
+    BsdfFractionFit fraction;  // --guiding-fraction learned (a split leaf's children start from its fit)
 };
 
 class SdTree {
@@ -91,6 +110,8 @@ public:
     void record(const Vec3f& p, const Vec3f& direction, float value);
     // The radiance a path vertex at p sent back towards where the path came from (an estimate).
     void record_outgoing(const Vec3f& p, float radiance);
+    // One step of the BSDF fraction's fit of the leaf holding p (BsdfFractionFit).
+    void record_fraction_gradient(const Vec3f& p, float gradient);
 
     // After an iteration of `iteration_spp` samples per pixel: split, swap, restructure.
     void refine(uint64_t iteration_spp);

@@ -220,6 +220,21 @@ TEST(PpgAgreement, ConvergesWithTheLearnedBsdfFraction) {
     }
 }
 
+// The scenes shipped for guiding (scripts/make-guiding-scenes.py): the torus in a glass box, lit
+// through panes no shadow ray passes, and the room whose light is behind a glass panel; with the
+// adjoint-driven roulette and the learned fraction, everything ppg has.
+TEST(PpgAgreement, ConvergesOnTheShippedGuidingScenes) {
+    for (const char* name : {"torus-glass.xml", "glass-panel.xml"}) {
+        const SceneDescription d = load_scene_file(std::string(PATHLAB_SOURCE_DIR) + "/scenes/" + name);
+        IntegratorOptions o = ppg_options();
+        o.guiding_rr = true;
+        o.guiding_fraction = kLearnedGuidingFraction;
+        PathGuiding<RgbTransport> ppg(o);
+        const AgreementResult r = compare_with_pt_mis(d, ppg, 4096, false, 16);
+        EXPECT_TRUE(r.agree) << name << ": " << r.describe();
+    }
+}
+
 TEST(PpgAgreement, ConvergesInSpectralMode) {
     PathGuiding<SpectralTransport> ppg(ppg_options(true));
     const AgreementResult r = compare_with_pt_mis(make_builtin_scene(5), ppg, 2048, true);

@@ -133,6 +133,7 @@ def test_load_takes_indices_names_and_files_with_defines():
     ("3", "ic", ["--ic-rays", "16", "--ic-error", "0.5", "--ic-no-gradients"]),
     ("3", "pbgi", ["--pbgi-surfels", "400", "--pbgi-bounces", "1", "--pbgi-cutoff", "0.1"]),
     ("scenes/fog-box.xml", "pm", ["--volume-estimate", "points", "--photons", "200"]),
+    ("3", "ppg", ["--guiding-spp", "3", "--guiding-rr", "--guiding-fraction", "learned"]),
     ("scenes/gltf/room.glb", "pt-mis", []),  # a glTF scene
 ])
 def test_render_equals_the_command_line_bit_for_bit(tmp_path, scene, algorithm, extra):
@@ -188,6 +189,10 @@ def test_estimator_options_are_refused_as_on_the_command_line():
         pathlab.render(3, "sppm", spp=1, resolution=(4, 4), photon=100)
     with pytest.raises(ValueError, match="unknown mis 'heuristic'; valid: balance, power"):
         pathlab.render(3, "bdpt", spp=1, resolution=(4, 4), mis="heuristic")
+    with pytest.raises(ValueError, match="--guiding-fraction must be a number in \\(0, 1\\] or 'learned', got '0'"):
+        pathlab.render(3, "ppg", spp=1, resolution=(4, 4), guiding_fraction=0)
+    with pytest.raises(ValueError, match="--guiding-fraction must be a number in \\(0, 1\\] or 'learned', got 'most'"):
+        pathlab.render(3, "ppg", spp=1, resolution=(4, 4), guiding_fraction="most")
 
 
 def test_a_scene_files_own_settings_as_on_the_command_line(tmp_path):

@@ -335,5 +335,30 @@ TEST(PathGuiding, TrainingSppIsItsOption) {
     EXPECT_NE(refusal_of(far).find("--guiding-spp must be 0 to"), std::string::npos) << refusal_of(far);
 }
 
+// The scene file's ppg integrator sets the fraction as a number (<float>) or 'learned' (<string>);
+// the command line wins; a bad value names the file and line.
+TEST(PathGuiding, GuidingFractionFromTheSceneFile) {
+    const auto options = [](const std::string& element, const JobRequest& r = {}) {
+        const SceneDescription d = load_scene_text("<scene version=\"3.0.0\"><integrator type=\"ppg\">" + element +
+                                                       "</integrator><shape type=\"rectangle\"/><emitter type=\"constant\"/></scene>",
+                                                   "ppg.xml", ".");
+        return RenderJob(scene_choice_of(d), r).integrator_options();
+    };
+    EXPECT_EQ(options("<float name=\"guiding_fraction\" value=\"0.3\"/>").guiding_fraction, 0.3f);
+    EXPECT_EQ(options("<string name=\"guiding_fraction\" value=\"learned\"/>").guiding_fraction, kLearnedGuidingFraction);
+    EXPECT_EQ(options("").guiding_fraction, 0.5f);
+    JobRequest r;
+    r.guiding_fraction = "0.8";
+    EXPECT_EQ(options("<string name=\"guiding_fraction\" value=\"learned\"/>", r).guiding_fraction, 0.8f);
+    try {
+        (void)load_scene_text("<scene version=\"3.0.0\">\n<integrator type=\"ppg\"><float name=\"guiding_fraction\" value=\"0\"/></integrator></scene>",
+                              "bad.xml", ".");
+        ADD_FAILURE() << "guiding_fraction = 0 was accepted";
+    } catch (const std::exception& e) {
+        EXPECT_NE(std::string(e.what()).find("bad.xml:2"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("guiding_fraction must be a number in (0, 1] or 'learned', got '0'"), std::string::npos) << e.what();
+    }
+}
+
 }  // namespace
 }  // namespace pathlab::test

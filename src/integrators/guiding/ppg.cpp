@@ -287,7 +287,7 @@ std::vector<ParamInfo> ppg_params() {
     p.push_back({"training_spp", ParamType::Integer, "31",
                  "samples per pixel of the SD-tree's training, in iterations of 1, 2, 4, ... (not in the image; --guiding-spp wins)", ""});
     p.push_back({"guiding_rr", ParamType::Boolean, "false", "adjoint-driven Russian roulette and splitting (or --guiding-rr)", ""});
-    p.push_back({"guiding_fraction", ParamType::String, "0.5",
+    p.push_back({"guiding_fraction", ParamType::FloatOrString, "0.5",
                  "the probability of sampling the BSDF rather than the SD-tree where it guides: a number in (0, 1] or 'learned' (per leaf, "
                  "Müller 2019; or --guiding-fraction)",
                  ""});

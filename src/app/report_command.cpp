@@ -328,6 +328,13 @@ int run_report_command(const ReportOptions& o) {
                         entry.guide_map = guide_map(*tree, hit.p);
                         entry.guide_note = fmt::format("pixel ({}, {}): first hit at ({:.3g}, {:.3g}, {:.3g})", guide_pixel->first,
                                                        guide_pixel->second, hit.p.x, hit.p.y, hit.p.z);
+                        // Where the leaf guides: how much of the mixture is the BSDF's (--guiding-fraction).
+                        const GuidingLeaf& leaf = tree->leaf(hit.p);
+                        const float fraction = job.integrator_options().guiding_fraction;
+                        if (leaf.usable)
+                            entry.guide_note += fraction == kLearnedGuidingFraction
+                                                    ? fmt::format("; BSDF sampling fraction there {:.3g} (learned)", leaf.fraction.fraction())
+                                                    : fmt::format("; BSDF sampling fraction there {:.3g} (--guiding-fraction)", fraction);
                     } else {
                         entry.guide_note = fmt::format("pixel ({}, {}): its ray leaves the scene", guide_pixel->first, guide_pixel->second);
                     }

@@ -125,7 +125,7 @@ float learned_fraction(bool product_is_the_trees) {
         const float p_bsdf = 1 / (4 * kPi), p_tree = leaf.sampling.pdf(direction_to_square(d)) / (4 * kPi);
         const float q = a * p_bsdf + (1 - a) * p_tree;
         const float F = product_is_the_trees ? 0.05f + std::exp(40.0f * (dot(d, peak) - 1.0f)) * 50.0f : 1.0f;
-        tree.record_fraction_gradient(at, -(F / q) * (p_bsdf - p_tree) / q * a * (1 - a));
+        tree.record_fraction_gradient(at, BsdfFractionFit::gradient(F / q, q, p_bsdf, p_tree, a));
     }
     return tree.leaf(at).fraction.fraction();
 }

@@ -19,6 +19,7 @@
 #include "scene/builtin_scenes.hpp"
 #include "cameras/camera.hpp"
 #include "integrators/guiding/guide_map.hpp"
+#include "integrators/guiding/ppg.hpp"
 #include "judge/html_report.hpp"
 #include "judge/image_compare.hpp"
 #include "judge/reference_manifest.hpp"
@@ -330,11 +331,10 @@ int run_report_command(const ReportOptions& o) {
                                                        guide_pixel->second, hit.p.x, hit.p.y, hit.p.z);
                         // Where the leaf guides: how much of the mixture is the BSDF's (--guiding-fraction).
                         const GuidingLeaf& leaf = tree->leaf(hit.p);
-                        const float fraction = job.integrator_options().guiding_fraction;
+                        const IntegratorOptions& options = job.integrator_options();
                         if (leaf.usable)
-                            entry.guide_note += fraction == kLearnedGuidingFraction
-                                                    ? fmt::format("; BSDF sampling fraction there {:.3g} (learned)", leaf.fraction.fraction())
-                                                    : fmt::format("; BSDF sampling fraction there {:.3g} (--guiding-fraction)", fraction);
+                            entry.guide_note += fmt::format("; BSDF sampling fraction there {:.3g} ({})", guiding_bsdf_fraction(options, leaf),
+                                                            options.guiding_fraction == kLearnedGuidingFraction ? "learned" : "--guiding-fraction");
                     } else {
                         entry.guide_note = fmt::format("pixel ({}, {}): its ray leaves the scene", guide_pixel->first, guide_pixel->second);
                     }

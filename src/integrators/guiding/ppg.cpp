@@ -132,11 +132,6 @@ void PathGuiding<T>::prepare(const RenderContext& ctx, const PassProgress& progr
 }
 
 template <class T>
-float PathGuiding<T>::bsdf_fraction(const GuidingLeaf& leaf) const {
-    return options_.guiding_fraction == kLearnedGuidingFraction ? leaf.fraction.fraction() : options_.guiding_fraction;
-}
-
-template <class T>
 ColourOf<T> PathGuiding<T>::radiance(const Scene& scene, const Ray& ray, Sampler& sampler, Wl& wl) const {
     return trace(scene, ray, sampler, wl, nullptr);
 }
@@ -167,7 +162,7 @@ ColourOf<T> PathGuiding<T>::walk(const Scene& scene, Intersection hit, Vec3f dir
         if (sp.material->is_black()) break;
         const GuidingLeaf* leaf = guided_ ? (next_leaf ? next_leaf : &tree_.leaf(sp.p)) : nullptr;
         const bool guide = leaf && leaf->usable && (sp.material->lobes() & (kLobeDiffuse | kLobeGlossy)) != 0;
-        const float a = guide ? bsdf_fraction(*leaf) : 1.0f;
+        const float a = guide ? guiding_bsdf_fraction(options_, *leaf) : 1.0f;
         // The tree's solid-angle density of a direction (local), and the continuation's of one of BSDF density pdf_bsdf.
         const auto tree_pdf = [&](const Vec3f& w) { return leaf->sampling.pdf(direction_to_square(sp.frame.to_world(w))) * (1.0f / (4.0f * kPi)); };
         const auto mixture_pdf = [&](const Vec3f& w, float pdf_bsdf) {
@@ -253,8 +248,8 @@ ColourOf<T> PathGuiding<T>::walk(const Scene& scene, Intersection hit, Vec3f dir
             const float Li = mean_ratio(L - v.L_before, v.beta_after);
             records->push_back({v.p, v.direction, Li / v.pdf, Record::kIncoming});
             if (v.a < 1) {  // the fraction's gradient (BsdfFractionFit), where the vertex was guided
-                const float F_over_q = v.f_cos * Li / v.pdf;
-                records->push_back({v.p, v.direction, -F_over_q * (v.pdf_bsdf - v.pdf_tree) / v.pdf * v.a * (1 - v.a), Record::kFraction});
+                const float gradient = BsdfFractionFit::gradient(v.f_cos * Li / v.pdf, v.pdf, v.pdf_bsdf, v.pdf_tree, v.a);
+                records->push_back({v.p, v.direction, gradient, Record::kFraction});
             }
         }
         records->push_back({v.p, Vec3f(0.0f), mean_ratio(L - v.L_start, v.beta_start), Record::kOutgoing});

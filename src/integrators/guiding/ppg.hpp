@@ -15,16 +15,18 @@ struct GuidingFaults {
     bool drop_roulette_weight = false;   // adjoint-driven roulette's survivors keep their throughput
 };
 
+// The probability of sampling the BSDF rather than the SD-tree in a leaf that guides: the
+// options' guiding_fraction (Müller's 0.5 by default), or with kLearnedGuidingFraction the leaf's
+// learned one (BsdfFractionFit).
+inline float guiding_bsdf_fraction(const IntegratorOptions& o, const GuidingLeaf& leaf) {
+    return o.guiding_fraction == kLearnedGuidingFraction ? leaf.fraction.fraction() : o.guiding_fraction;
+}
+
 template <class T>
 class PathGuiding final : public PixelIntegrator<T> {
 public:
     using Colour = ColourOf<T>;
     using Wl = WavelengthsOf<T>;
-
-    // The probability of sampling the BSDF rather than the SD-tree where a leaf guides: the
-    // options' guiding_fraction (Müller's 0.5 by default), or with kLearnedGuidingFraction each
-    // leaf's learned one (BsdfFractionFit).
-    float bsdf_fraction(const GuidingLeaf& leaf) const;
 
     explicit PathGuiding(const IntegratorOptions& o, GuidingFaults faults = {});
     // Trains the SD-tree: iterations of 1, 2, 4, ... samples per pixel (the last takes what is

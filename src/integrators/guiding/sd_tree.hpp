@@ -79,6 +79,11 @@ struct BsdfFractionFit {
 
     float fraction() const { return a; }
     void step(float gradient);
+    // The gradient's estimate from one direction drawn from the mixture with fraction `fraction`:
+    // F / q there, the mixture's density q and its two halves' densities.
+    static float gradient(float F_over_q, float q, float p_bsdf, float p_tree, float fraction) {
+        return -F_over_q * (p_bsdf - p_tree) / q * fraction * (1 - fraction);
+    }
 };
 
 struct GuidingLeaf {

@@ -15,7 +15,7 @@ RenderResult run(const Scene& scene, const std::string& algorithm, int size, int
                  std::function<void(const Film&, const RenderStats&)> after_pass, SamplerKind sampler) {
     JobRequest r;
     // "name:key=value:...": radius (the photon methods' first radius), max_depth, rr_depth, ppg's
-    // guiding_spp, guiding_rr (1: on) and guiding_fraction (a number or learned), and upbp's estimators (joined by '+': estimators=bpt+pb2d).
+    // guiding_spp, guiding_rr (1: on), guiding_fraction (a number or learned) and guiding (sd-tree or vmm), and upbp's estimators (joined by '+': estimators=bpt+pb2d).
     r.algorithm = algorithm.substr(0, algorithm.find(':'));
     for (size_t at = algorithm.find(':'); at != std::string::npos;) {
         const size_t next = algorithm.find(':', at + 1);
@@ -28,6 +28,7 @@ RenderResult run(const Scene& scene, const std::string& algorithm, int size, int
         else if (key == "guiding_spp") r.guiding_spp = std::stoi(value);
         else if (key == "guiding_rr") r.guiding_rr = value != "0";
         else if (key == "guiding_fraction") r.guiding_fraction = value;
+        else if (key == "guiding") r.guiding = value;
         else if (key == "beam_radius") r.beam_radius = std::stof(value);
         else if (key == "estimators") {
             std::string list = value;
@@ -35,7 +36,7 @@ RenderResult run(const Scene& scene, const std::string& algorithm, int size, int
             r.estimators = list;
         } else
             throw std::runtime_error(
-                fmt::format("{}: unknown setting '{}' (radius, max_depth, rr_depth, guiding_spp, guiding_rr, guiding_fraction, estimators, beam_radius)", algorithm, key));
+                fmt::format("{}: unknown setting '{}' (radius, max_depth, rr_depth, guiding_spp, guiding_rr, guiding_fraction, guiding, estimators, beam_radius)", algorithm, key));
         at = next;
     }
     r.width = r.height = size;

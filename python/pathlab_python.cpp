@@ -236,7 +236,7 @@ void apply_estimator_options(JobRequest& r, const py::kwargs& options) {
     constexpr int kIntMax = std::numeric_limits<int>::max();
     static const char* const kNames =
         "mis, photons, radius, alpha, volume_estimate, no_merging, no_connections, ic_rays, ic_error, ic_no_gradients, pbgi_surfels, "
-        "pbgi_cutoff, pbgi_bounces, pbgi_resolution, pbgi_direct_samples, pbgi_spacing, guiding_spp, guiding_rr, guiding_fraction, estimators, photon_beams, beam_radius, "
+        "pbgi_cutoff, pbgi_bounces, pbgi_resolution, pbgi_direct_samples, pbgi_spacing, guiding_spp, guiding_rr, guiding_fraction, guiding, estimators, photon_beams, beam_radius, "
         "null_depth";
     const auto number = [](const py::handle& v, const std::string& name) {
         if (!py::isinstance<py::int_>(v) && !py::isinstance<py::float_>(v))
@@ -284,6 +284,8 @@ void apply_estimator_options(JobRequest& r, const py::kwargs& options) {
             r.guiding_rr = flag(v, name);
         } else if (name == "guiding_fraction") {
             r.guiding_fraction = py::isinstance<py::str>(v) ? std::string(py::str(v)) : fmt::format("{}", number(v, name));
+        } else if (name == "guiding") {
+            r.guiding = string_argument(v, "guiding", "sd-tree or vmm");
         } else if (name == "estimators") {
             r.estimators = string_argument(v, "estimators", "a comma-separated list of bpt, surf, pp3d, pb2d, bb1d");
         } else if (name == "no_connections") {
@@ -712,7 +714,7 @@ PYBIND11_MODULE(pathlab, m) {
           "light_sampler ('uniform', 'power', 'bvh', 'ris') and ris_candidates are --spectral, --rr-depth, --light-sampler and\n"
           "--ris-candidates. The estimators' own options go by their command-line names: mis='power', photons, radius, alpha,\n"
           "volume_estimate='points', no_merging=True, no_connections=True, ic_rays, ic_error, ic_no_gradients=True, pbgi_surfels,\n"
-          "pbgi_cutoff, pbgi_bounces, pbgi_resolution, pbgi_direct_samples, pbgi_spacing, guiding_spp, guiding_rr=True, guiding_fraction (0.5 or 'learned'), estimators, photon_beams, beam_radius (refused for another estimator),\n"
+          "pbgi_cutoff, pbgi_bounces, pbgi_resolution, pbgi_direct_samples, pbgi_spacing, guiding_spp, guiding_rr=True, guiding_fraction (0.5 or 'learned'), guiding ('sd-tree' or 'vmm'), estimators, photon_beams, beam_radius (refused for another estimator),\n"
           "null_depth='skip' (--null-depth).\n"
           "first_sample is --first-sample: the index of the first sample (pass), so that renders of disjoint ranges add up, with\n"
           "`pathlab merge`, to one render (give them checkpoint= files: merge takes checkpoints, exactly). checkpoint=FILE saves\n"

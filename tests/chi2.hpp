@@ -62,7 +62,7 @@ double sidak_alpha(int tests, double family_alpha = 0.01);
 // (test_microfacet.cpp: 79 at present), 32 for emission sampling, camera importance and the
 // adjoint BSDFs, 16 for the phase functions and free-flight sampling (test_media.cpp: 15), 16 for
 // the envmap, spot and IES lights (10 at present), 8 for the Markov chains' toy targets
-// (test_pssmlt.cpp: 3 at present), 8 for path guiding's distributions (test_ppg.cpp: 1 at present).
+// (test_pssmlt.cpp: 3 at present), 8 for path guiding's distributions (test_ppg.cpp: 6 at present).
 constexpr int kSuiteChi2Tests = 64 + 96 + 32 + 16 + 16 + 8 + 8;
 inline double suite_chi2_alpha() { return sidak_alpha(kSuiteChi2Tests); }
 

@@ -1,9 +1,12 @@
-// ppg (practical path guiding): the SD-tree's directional distributions sample what their
-// density says (chi-square) and integrate to 1; the spatial tree splits where records pile up;
+// ppg (practical path guiding): the SD-tree's directional distributions, and the von Mises-Fisher
+// mixtures of --guiding vmm, sample what their density says (chi-square) and integrate to 1; the
+// mixtures' on-line EM finds the light's lobes; the spatial tree splits where records pile up;
 // the guided path tracer converges to pt-mis's image (per-pixel z-tests on the course scenes, in
 // spectral mode), with adjoint-driven roulette and splitting too; it fails when light sampling's MIS weight leaves out the guiding density; it is
 // deterministic (1 and 2 threads, a render continued); its option is its own.
 #include <gtest/gtest.h>
+
+#include <limits>
 
 #include "chi2.hpp"
 #include "core/rng.hpp"
@@ -21,16 +24,16 @@ namespace {
 // everywhere), as training teaches it: directions drawn half uniformly, half from the tree of the
 // round before, recorded with the radiance over that mixture's density; refined between rounds,
 // so that the quadtree deepens where the energy is.
-SdTree peaked_tree(const Vec3f& peak, int rounds = 6) {
-    SdTree tree(Vec3f(0.0f), 1.0f);
+SdTree peaked_tree(const Vec3f& peak, int rounds = 6, GuidingModel model = GuidingModel::kSdTree) {
+    SdTree tree(Vec3f(0.0f), 1.0f, model);
     Pcg32 rng(7, 11);
     for (int round = 0; round < rounds; ++round) {
         const GuidingLeaf& leaf = tree.leaf(Vec3f(0.1f));
         for (int i = 0; i < 20000; ++i) {
             const Vec2f u{rng.next_float(), rng.next_float()};
             const bool guided = leaf.usable && rng.next_float() < 0.5f;
-            const Vec3f d = square_to_direction(guided ? leaf.sampling.sample(u) : u);
-            const float pdf = (leaf.usable ? 0.5f * (1 + leaf.sampling.pdf(direction_to_square(d))) : 1.0f) / (4 * kPi);
+            const Vec3f d = guided ? leaf.sample(u) : square_to_direction(u);
+            const float pdf = leaf.usable ? 0.5f * (1 / (4 * kPi) + leaf.pdf(d)) : 1 / (4 * kPi);
             const float radiance = 0.05f + std::exp(40.0f * (dot(d, peak) - 1.0f)) * 50.0f;
             tree.record(Vec3f(0.1f), d, radiance / pdf);
         }
@@ -140,6 +143,105 @@ TEST(SdTree, LearnedBsdfFractionMovesTowardsTheHalfThatSamplesTheProduct) {
     EXPECT_LT(towards_bsdf, 0.99f);
 }
 
+// --guiding vmm. A lobe's density integrates to 1 and matches its samples, broad or sharp.
+TEST(VmfMixture, LobeIntegratesToOneAndMatchesItsSamples) {
+    for (const float kappa : {0.3f, 20.0f, 400.0f}) {
+        const VmfLobe lobe{normalize(Vec3f(0.2f, 0.7f, -0.4f)), kappa, 1.0f};
+        Chi2Options o;
+        o.samples = 400'000;
+        const Chi2Result r = chi2_directions([&](Vec2f u) -> std::optional<Vec3f> { return lobe.sample(u); },
+                                             [&](const Vec3f& d) { return lobe.pdf(d); }, lobe.mean, o);
+        EXPECT_NEAR(r.pdf_integral, 1.0, 2e-3) << "kappa " << kappa;
+        EXPECT_GT(r.p_value, suite_chi2_alpha()) << "kappa " << kappa << ": " << r.describe();
+    }
+}
+
+// Directions drawn uniformly, weighted by a two-lobe target over the uniform density (as ppg's
+// records are: radiance over the density the direction was drawn with), in a fixed order.
+float two_lobes(const Vec3f& a, const Vec3f& b, const Vec3f& d) { return 0.7f * VmfLobe{a, 60.0f, 1.0f}.pdf(d) + 0.3f * VmfLobe{b, 15.0f, 1.0f}.pdf(d); }
+
+VmfMixtureFit fitted_to_two_lobes(const Vec3f& a, const Vec3f& b, int directions) {
+    VmfMixtureFit fit;
+    Pcg32 rng(5, 3);
+    for (int i = 0; i < directions; ++i) {
+        const Vec3f d = square_to_direction({rng.next_float(), rng.next_float()});
+        fit.add(d, two_lobes(a, b, d) * (4 * kPi));
+    }
+    fit.flush();
+    return fit;
+}
+
+// The on-line EM finds the target's lobes: at each of its two directions the fitted density is
+// the target's within 20% (far higher than opposite it); and the fitted mixture samples what its
+// density says. Test of the test: the density with the lobes' weights left out (equal shares) no
+// longer matches the samples. (Blending each batch's statistics per unit of its own weight, the
+// many batches that miss the small bright lobe outvote the few that find it: 0.6 of its density,
+// seen.)
+TEST(VmfMixture, OnlineEmFindsTheLightsLobesAndSamplesItsDensity) {
+    const Vec3f a = normalize(Vec3f(0.3f, -0.5f, 0.8f)), b = normalize(Vec3f(-0.6f, 0.2f, -0.3f));
+    const VmfMixtureFit fit = fitted_to_two_lobes(a, b, 200'000);
+    const VmfMixture& m = fit.mixture();
+    EXPECT_EQ(fit.directions(), 200'000u);
+    EXPECT_NEAR(m.pdf(a) / two_lobes(a, b, a), 1.0f, 0.2f);
+    EXPECT_NEAR(m.pdf(b) / two_lobes(a, b, b), 1.0f, 0.2f);
+    EXPECT_GT(m.pdf(a), 100 * m.pdf(-a));
+    EXPECT_GT(m.pdf(b), 20 * m.pdf(-b));
+    // The lobes' weights sum to 1, and most of the weight sits on lobes near the two directions.
+    float sum = 0, near = 0;
+    for (const VmfLobe& l : m.lobes()) {
+        sum += l.weight;
+        if (dot(l.mean, a) > 0.9f || dot(l.mean, b) > 0.9f) near += l.weight;
+    }
+    EXPECT_NEAR(sum, 1.0f, 1e-5f);
+    EXPECT_GT(near, 0.8f);
+    Chi2Options o;
+    o.samples = 400'000;
+    const auto sample = [&](Vec2f u) -> std::optional<Vec3f> { return m.sample(u); };
+    const Chi2Result r = chi2_directions(sample, [&](const Vec3f& d) { return m.pdf(d); }, a, o);
+    EXPECT_NEAR(r.pdf_integral, 1.0, 2e-3);
+    EXPECT_GT(r.p_value, suite_chi2_alpha()) << r.describe();
+    const auto equal_shares = [&](const Vec3f& d) {
+        float p = 0;
+        for (const VmfLobe& l : m.lobes()) p += l.pdf(d) / float(VmfMixture::kLobes);
+        return p;
+    };
+    EXPECT_LT(chi2_directions(sample, equal_shares, a, o).p_value, 1e-6);
+}
+
+// The fit is the same for the same directions in the same order (ppg's records are ordered), and
+// directions of no weight teach it nothing.
+TEST(VmfMixture, FitIsDeterministicAndIgnoresZeroWeights) {
+    const Vec3f a = normalize(Vec3f(0.3f, -0.5f, 0.8f)), b = normalize(Vec3f(-0.6f, 0.2f, -0.3f));
+    const VmfMixture m1 = fitted_to_two_lobes(a, b, 5000).mixture(), m2 = fitted_to_two_lobes(a, b, 5000).mixture();
+    for (int k = 0; k < VmfMixture::kLobes; ++k) {
+        EXPECT_EQ(m1.lobes()[size_t(k)].kappa, m2.lobes()[size_t(k)].kappa);
+        EXPECT_EQ(m1.lobes()[size_t(k)].weight, m2.lobes()[size_t(k)].weight);
+    }
+    VmfMixtureFit fit;
+    fit.add(a, 0.0f), fit.add(a, -1.0f), fit.add(a, std::numeric_limits<float>::infinity());
+    fit.flush();
+    EXPECT_EQ(fit.directions(), 0u);
+    EXPECT_EQ(fit.mixture().pdf(a), VmfMixture().pdf(a));
+}
+
+// In ppg's spatial tree: a vmm leaf trained as the SD-tree's is (peaked_tree) guides towards the
+// light through the leaf's density and sampling, which agree (chi-square) and integrate to 1.
+TEST(VmfMixture, SpatialLeafLearnsTheLightAndSamplesItsDensity) {
+    const Vec3f peak = normalize(Vec3f(0.3f, -0.5f, 0.8f));
+    const SdTree tree = peaked_tree(peak, 6, GuidingModel::kVmm);
+    const GuidingLeaf& leaf = tree.leaf(Vec3f(0.1f));
+    ASSERT_TRUE(leaf.usable);
+    EXPECT_EQ(leaf.model, GuidingModel::kVmm);
+    EXPECT_EQ(leaf.sampling.node_count(), 1u);  // no quadtree was built
+    EXPECT_GT(leaf.pdf(peak), 50 * leaf.pdf(-peak));
+    Chi2Options o;
+    o.samples = 400'000;
+    const Chi2Result r = chi2_directions([&](Vec2f u) -> std::optional<Vec3f> { return leaf.sample(u); },
+                                         [&](const Vec3f& d) { return leaf.pdf(d); }, peak, o);
+    EXPECT_NEAR(r.pdf_integral, 1.0, 2e-3);
+    EXPECT_GT(r.p_value, suite_chi2_alpha()) << r.describe();
+}
+
 TEST(PathGuiding, TrainingIterationsDoubleAndTheLastTakesTheRest) {
     using P = PathGuiding<RgbTransport>;
     EXPECT_EQ(P::iteration_sizes(31), (std::vector<uint64_t>{1, 2, 4, 8, 16}));
@@ -177,6 +279,19 @@ TEST_P(PpgAgreement, ConvergesToPtMisImage) {
     EXPECT_GT(ppg.tree().leaf_count(), 0u);
 }
 INSTANTIATE_TEST_SUITE_P(Scenes, PpgAgreement, ::testing::Values(0, 1, 2, 3, 4, 5, 6, 7));
+
+// The mixtures of --guiding vmm guide the same paths to the same answer.
+class VmmAgreement : public ::testing::TestWithParam<int> {};
+
+TEST_P(VmmAgreement, ConvergesToPtMisImage) {
+    IntegratorOptions o = ppg_options();
+    o.guiding = GuidingModel::kVmm;
+    PathGuiding<RgbTransport> ppg(o);
+    const AgreementResult r = compare_with_pt_mis(make_builtin_scene(GetParam()), ppg, 2048);
+    EXPECT_TRUE(r.agree) << "scene " << GetParam() << ": " << r.describe();
+    EXPECT_EQ(ppg.tree().leaves()[0].model, GuidingModel::kVmm);
+}
+INSTANTIATE_TEST_SUITE_P(Scenes, VmmAgreement, ::testing::Values(0, 3, 5, 6));
 
 // Adjoint-driven roulette and splitting change how many paths go on, not what they converge to.
 class PpgRouletteAgreement : public ::testing::TestWithParam<int> {};
@@ -229,16 +344,23 @@ TEST(PpgAgreement, ConvergesOnTheShippedGuidingScenes) {
         IntegratorOptions o = ppg_options();
         o.guiding_rr = true;
         o.guiding_fraction = kLearnedGuidingFraction;
-        PathGuiding<RgbTransport> ppg(o);
-        const AgreementResult r = compare_with_pt_mis(d, ppg, 4096, false, 16);
-        EXPECT_TRUE(r.agree) << name << ": " << r.describe();
+        for (const GuidingModel model : {GuidingModel::kSdTree, GuidingModel::kVmm}) {
+            o.guiding = model;
+            PathGuiding<RgbTransport> ppg(o);
+            const AgreementResult r = compare_with_pt_mis(d, ppg, 4096, false, 16);
+            EXPECT_TRUE(r.agree) << name << " (" << guiding_model_name(model) << "): " << r.describe();
+        }
     }
 }
 
 TEST(PpgAgreement, ConvergesInSpectralMode) {
-    PathGuiding<SpectralTransport> ppg(ppg_options(true));
-    const AgreementResult r = compare_with_pt_mis(make_builtin_scene(5), ppg, 2048, true);
-    EXPECT_TRUE(r.agree) << r.describe();
+    for (const GuidingModel model : {GuidingModel::kSdTree, GuidingModel::kVmm}) {
+        IntegratorOptions o = ppg_options(true);
+        o.guiding = model;
+        PathGuiding<SpectralTransport> ppg(o);
+        const AgreementResult r = compare_with_pt_mis(make_builtin_scene(5), ppg, 2048, true);
+        EXPECT_TRUE(r.agree) << guiding_model_name(model) << ": " << r.describe();
+    }
 }
 
 // Test of the test: light sampling weighed against the BSDF's density alone, while the
@@ -246,11 +368,14 @@ TEST(PpgAgreement, ConvergesInSpectralMode) {
 // to 1 (too little light where the tree guides less than the BSDF would: under the sky of scene
 // 6). The same comparison agrees without the fault (bias z about -7 with it, seen).
 TEST(PpgAgreement, FailsWhenLightSamplingIgnoresTheGuidingDensity) {
-    for (const bool fault : {false, true}) {
-        PathGuiding<RgbTransport> ppg(ppg_options(), GuidingFaults{.drop_guide_pdf_in_mis = fault});
-        const AgreementResult r = compare_with_pt_mis(make_builtin_scene(6), ppg, 8192, false, 16);
-        EXPECT_EQ(r.agree, !fault) << (fault ? "with" : "without") << " the fault: " << r.describe();
-    }
+    for (const GuidingModel model : {GuidingModel::kSdTree, GuidingModel::kVmm})
+        for (const bool fault : {false, true}) {
+            IntegratorOptions o = ppg_options();
+            o.guiding = model;
+            PathGuiding<RgbTransport> ppg(o, GuidingFaults{.drop_guide_pdf_in_mis = fault});
+            const AgreementResult r = compare_with_pt_mis(make_builtin_scene(6), ppg, 8192, false, 16);
+            EXPECT_EQ(r.agree, !fault) << guiding_model_name(model) << (fault ? " with" : " without") << " the fault: " << r.describe();
+        }
 }
 
 // Without training ppg is pt-mis's estimator with pt-mis's random numbers: the same image up to
@@ -259,21 +384,24 @@ TEST(PpgAgreement, FailsWhenLightSamplingIgnoresTheGuidingDensity) {
 // an equal area of the sphere, sum to 1 / (4 pi / pixels); the peak lies where the light came
 // from; a leaf that learned nothing is black; only a trained ppg has a tree to show.
 TEST(PathGuiding, GuideMapIsTheLeafsDensityOverTheSphere) {
-    const Vec3f peak = normalize(Vec3f(0.3f, -0.5f, 0.8f));
-    const SdTree tree = peaked_tree(peak);
-    const int w = 512, h = 256;
-    const Image map = guide_map(tree, Vec3f(0.1f), w, h);
-    double sum = 0;
-    size_t brightest = 0;
-    for (size_t i = 0; i < map.pixel_count(); ++i) {
-        sum += map[i].x;
-        if (map[i].x > map[brightest].x) brightest = i;
+    for (const GuidingModel model : {GuidingModel::kSdTree, GuidingModel::kVmm}) {
+        SCOPED_TRACE(guiding_model_name(model));
+        const Vec3f peak = normalize(Vec3f(0.3f, -0.5f, 0.8f));
+        const SdTree tree = peaked_tree(peak, 6, model);
+        const int w = 512, h = 256;
+        const Image map = guide_map(tree, Vec3f(0.1f), w, h);
+        double sum = 0;
+        size_t brightest = 0;
+        for (size_t i = 0; i < map.pixel_count(); ++i) {
+            sum += map[i].x;
+            if (map[i].x > map[brightest].x) brightest = i;
+        }
+        EXPECT_NEAR(sum * 4 * kPi / (w * h), 1.0, 2e-3);
+        // The brightest pixel's direction: column = azimuth, row = cos theta from +z down.
+        const float phi = 2 * kPi * (float(brightest % w) + 0.5f) / w, cos_theta = 1 - 2 * (float(brightest / w) + 0.5f) / h;
+        const float sin_theta = std::sqrt(1 - cos_theta * cos_theta);
+        EXPECT_GT(dot(Vec3f(sin_theta * std::cos(phi), sin_theta * std::sin(phi), cos_theta), peak), 0.95f);
     }
-    EXPECT_NEAR(sum * 4 * kPi / (w * h), 1.0, 2e-3);
-    // The brightest pixel's direction: column = azimuth, row = cos theta from +z down.
-    const float phi = 2 * kPi * (float(brightest % w) + 0.5f) / w, cos_theta = 1 - 2 * (float(brightest / w) + 0.5f) / h;
-    const float sin_theta = std::sqrt(1 - cos_theta * cos_theta);
-    EXPECT_GT(dot(Vec3f(sin_theta * std::cos(phi), sin_theta * std::sin(phi), cos_theta), peak), 0.95f);
     const Image empty = guide_map(SdTree(Vec3f(0.0f), 1.0f), Vec3f(0.1f), 16, 8);
     for (size_t i = 0; i < empty.pixel_count(); ++i) EXPECT_EQ(empty[i].x, 0.0f);
     IntegratorOptions o;
@@ -297,10 +425,11 @@ TEST(PathGuiding, WithoutTrainingIsPtMis) {
 }
 
 TEST(PathGuiding, SameBytesOnAnyThreadCountAndContinued) {
-    for (const int variant : {0, 1, 2}) {
+    for (const int variant : {0, 1, 2, 3}) {
         IntegratorOptions o = ppg_options();
-        o.guiding_rr = variant == 1;
-        if (variant == 2) o.guiding_fraction = kLearnedGuidingFraction;
+        o.guiding_rr = variant == 1 || variant == 3;
+        if (variant >= 2) o.guiding_fraction = kLearnedGuidingFraction;
+        if (variant == 3) o.guiding = GuidingModel::kVmm;
         expect_same_bytes_on_threads_and_continued([&] { return std::make_unique<PathGuiding<RgbTransport>>(o); });
     }
 }
@@ -316,8 +445,16 @@ TEST(PathGuiding, TrainingSppIsItsOption) {
     EXPECT_TRUE(job.integrator_options().guiding_rr);
     JobRequest other = r;
     other.algorithm = "pt-mis";
-    EXPECT_NE(refusal_of(other).find("--guiding-spp, --guiding-rr and --guiding-fraction set the training"), std::string::npos)
+    EXPECT_NE(refusal_of(other).find("--guiding, --guiding-spp, --guiding-rr and --guiding-fraction set the model"), std::string::npos)
         << refusal_of(other);
+    other.guiding_spp.reset(), other.guiding_rr = false, other.guiding = "vmm";
+    EXPECT_NE(refusal_of(other).find("pt-mis learns nothing"), std::string::npos) << refusal_of(other);
+    EXPECT_EQ(job.integrator_options().guiding, GuidingModel::kSdTree);  // by default
+    JobRequest vmm = r;
+    vmm.guiding = "vmm";
+    EXPECT_EQ(RenderJob(4, vmm).integrator_options().guiding, GuidingModel::kVmm);
+    vmm.guiding = "quadtree";
+    EXPECT_NE(refusal_of(vmm).find("--guiding must be sd-tree or vmm, got 'quadtree'"), std::string::npos) << refusal_of(vmm);
     EXPECT_EQ(job.integrator_options().guiding_fraction, 0.5f);  // the paper's, by default
     for (const auto& [text, value] : std::vector<std::pair<std::string, float>>{{"learned", kLearnedGuidingFraction}, {"0.25", 0.25f}, {"1", 1.0f}}) {
         JobRequest f = r;
@@ -335,8 +472,8 @@ TEST(PathGuiding, TrainingSppIsItsOption) {
     EXPECT_NE(refusal_of(far).find("--guiding-spp must be 0 to"), std::string::npos) << refusal_of(far);
 }
 
-// The scene file's ppg integrator sets the fraction as a number (<float>) or 'learned' (<string>);
-// the command line wins; a bad value names the file and line.
+// The scene file's ppg integrator sets the fraction as a number (<float>) or 'learned' (<string>),
+// and the model (<string name="guiding">); the command line wins; a bad value names the file and line.
 TEST(PathGuiding, GuidingFractionFromTheSceneFile) {
     const auto options = [](const std::string& element, const JobRequest& r = {}) {
         const SceneDescription d = load_scene_text("<scene version=\"3.0.0\"><integrator type=\"ppg\">" + element +
@@ -350,6 +487,17 @@ TEST(PathGuiding, GuidingFractionFromTheSceneFile) {
     JobRequest r;
     r.guiding_fraction = "0.8";
     EXPECT_EQ(options("<string name=\"guiding_fraction\" value=\"learned\"/>", r).guiding_fraction, 0.8f);
+    EXPECT_EQ(options("<string name=\"guiding\" value=\"vmm\"/>").guiding, GuidingModel::kVmm);
+    r.guiding = "sd-tree";
+    EXPECT_EQ(options("<string name=\"guiding\" value=\"vmm\"/>", r).guiding, GuidingModel::kSdTree);
+    try {
+        (void)load_scene_text("<scene version=\"3.0.0\">\n<integrator type=\"ppg\"><string name=\"guiding\" value=\"vfm\"/></integrator></scene>",
+                              "bad.xml", ".");
+        ADD_FAILURE() << "guiding = vfm was accepted";
+    } catch (const std::exception& e) {
+        EXPECT_NE(std::string(e.what()).find("bad.xml:2"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("guiding must be sd-tree or vmm, got 'vfm'"), std::string::npos) << e.what();
+    }
     try {
         (void)load_scene_text("<scene version=\"3.0.0\">\n<integrator type=\"ppg\"><float name=\"guiding_fraction\" value=\"0\"/></integrator></scene>",
                               "bad.xml", ".");

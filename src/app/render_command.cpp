@@ -151,6 +151,9 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
     app.add_option("--guiding-fraction", o.guiding_fraction,
                    "ppg: the probability of sampling the BSDF rather than the SD-tree where it guides: a number in (0, 1] (default 0.5, "
                    "the paper's) or 'learned' (per spatial leaf during training, by Adam on the KL divergence's gradient; Mueller 2019)");
+    app.add_option("--guiding", o.guiding,
+                   "ppg: what each spatial leaf learns of the arriving light: sd-tree (a quadtree over directions, Mueller et al. 2017; "
+                   "the default) or vmm (a mixture of von Mises-Fisher lobes fitted by on-line EM, Vorba et al. 2014)");
     app.add_option("--estimators", o.estimators,
                    "upbp: the estimators it combines by MIS, comma-separated, of bpt (bdpt's connections), surf (photon merging on "
                    "surfaces), pp3d (photon points merged at points in media), pb2d (photon points gathered along the camera rays in "
@@ -255,6 +258,7 @@ std::vector<RenderJob> make_jobs(const RenderCommandOptions& o, bool check_paths
     request.guiding_spp = o.guiding_spp;
     request.guiding_rr = o.guiding_rr;
     if (!o.guiding_fraction.empty()) request.guiding_fraction = o.guiding_fraction;
+    if (!o.guiding.empty()) request.guiding = o.guiding;
     request.estimators = o.estimators;
     request.photon_beams = o.photon_beams;
     request.beam_radius = o.beam_radius;

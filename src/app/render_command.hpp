@@ -59,6 +59,7 @@ struct RenderCommandOptions {
     std::optional<int> guiding_spp;
     bool guiding_rr = false;
     std::string guiding_fraction;
+    std::string guiding;
     std::optional<std::string> estimators;
     std::optional<int64_t> photon_beams;
     std::optional<float> beam_radius;

@@ -48,6 +48,7 @@
 #include "scene/scene.hpp"
 #include "integrators/common/first_vertex.hpp"
 #include "integrators/common/transport.hpp"
+#include "integrators/guiding/guiding_model.hpp"
 
 namespace pathlab {
 
@@ -114,6 +115,7 @@ struct IntegratorOptions {
     // ppg: the probability of sampling the BSDF rather than the SD-tree where a leaf guides, in
     // (0, 1]; kLearnedGuidingFraction: learned per leaf (Müller 2019).
     float guiding_fraction = 0.5f;
+    GuidingModel guiding = GuidingModel::kSdTree;  // ppg: what a spatial leaf learns (--guiding sd-tree|vmm)
     // Paths of no bounce (emitters and the environment seen directly) are left out (Mitsuba's hide_emitters).
     bool hide_emitters = false;
     // --null-depth skip: a straight pass through a surface (a kLobeNull sample: thindielectric's

@@ -78,6 +78,7 @@ std::string options_text(const IntegratorOptions& o) {
            (o.guiding_fraction == defaults.guiding_fraction
                 ? ""
                 : o.guiding_fraction == kLearnedGuidingFraction ? " guiding_fraction=learned" : " guiding_fraction=" + hex_float(o.guiding_fraction)) +
+           (o.guiding == defaults.guiding ? "" : fmt::format(" guiding={}", guiding_model_name(o.guiding))) +
            (o.estimators.empty() ? "" : " estimators=" + o.estimators) +
            (o.photon_beams == 0 ? "" : fmt::format(" photon_beams={}", o.photon_beams)) +
            (o.beam_radius == 0 ? "" : " beam_radius=" + hex_float(o.beam_radius));  // the text of the defaults as it always was

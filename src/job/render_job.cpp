@@ -239,8 +239,12 @@ static std::string option_refusal(const IntegratorInfo& info, const JobRequest& 
     if ((r.pbgi_surfels || r.pbgi_cutoff || r.pbgi_bounces || r.pbgi_resolution || r.pbgi_direct_samples || r.pbgi_spacing) && a != "pbgi")
         return fmt::format(
             "--pbgi-surfels, --pbgi-cutoff, --pbgi-bounces, --pbgi-resolution, --pbgi-direct-samples and --pbgi-spacing are pbgi's, not {}'s", a);
-    if ((r.guiding_spp || r.guiding_rr || r.guiding_fraction) && a != "ppg")
-        return fmt::format("--guiding-spp, --guiding-rr and --guiding-fraction set the training, the roulette and the BSDF's share of ppg's SD-tree; {} learns nothing", a);
+    if ((r.guiding_spp || r.guiding_rr || r.guiding_fraction || r.guiding) && a != "ppg")
+        return fmt::format(
+            "--guiding, --guiding-spp, --guiding-rr and --guiding-fraction set the model, the training, the roulette and the BSDF's share of "
+            "ppg's guiding; {} learns nothing",
+            a);
+    if (r.guiding && !parse_guiding_model(*r.guiding)) return fmt::format("--guiding must be {}, got '{}'", kGuidingModelHelp, *r.guiding);
     if (r.guiding_fraction && !parse_guiding_fraction(*r.guiding_fraction))
         return fmt::format("--guiding-fraction must be {}, got '{}'", kGuidingFractionHelp, *r.guiding_fraction);
     if ((r.mlt_chains || r.mlt_bootstrap || r.mlt_large_step || r.mlt_sigma) && !one_of({"pssmlt", "mmlt"}))
@@ -312,6 +316,7 @@ RenderJob::RenderJob(SceneChoice scene, const JobRequest& r) : choice_(std::move
     options_.guiding_rr = r.guiding_rr || d.guiding_rr.value_or(false);
     if (const auto fraction = r.guiding_fraction ? r.guiding_fraction : d.guiding_fraction)
         options_.guiding_fraction = *parse_guiding_fraction(*fraction);
+    if (const auto model = r.guiding ? r.guiding : d.guiding) options_.guiding = *parse_guiding_model(*model);
     if (info_->name == "upbp") {
         options_.estimators = r.estimators ? *r.estimators : d.estimators.value_or("all");
         try {

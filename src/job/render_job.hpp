@@ -64,6 +64,7 @@ struct JobRequest {
     std::optional<int> guiding_spp;           // --guiding-spp (ppg)
     bool guiding_rr = false;                  // --guiding-rr (ppg)
     std::optional<std::string> guiding_fraction;  // --guiding-fraction (ppg)
+    std::optional<std::string> guiding;           // --guiding sd-tree|vmm (ppg)
     std::optional<std::string> estimators;    // --estimators (upbp)
     std::optional<int64_t> photon_beams;      // --photon-beams (upbp)
     std::optional<float> beam_radius;         // --beam-radius (upbp)

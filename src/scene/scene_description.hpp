@@ -66,6 +66,7 @@ struct SceneDescription {
     std::optional<int> guiding_spp;                                                        // ppg: training_spp
     std::optional<bool> guiding_rr;                                                        // ppg: guiding_rr
     std::optional<std::string> guiding_fraction;                                           // ppg: guiding_fraction
+    std::optional<std::string> guiding;  // ppg: guiding (sd-tree or vmm)
     std::optional<std::string> estimators;                                                 // upbp: estimators
     std::optional<int64_t> photon_beams;                                                   // upbp: photon_beams
     std::optional<float> beam_radius;                                                      // upbp: beam_radius

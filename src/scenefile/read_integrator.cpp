@@ -134,6 +134,11 @@ void read_plain_integrator(XmlSource& xml, const pugi::xml_node& n, SceneBuilder
                 p.fail("guiding_fraction", fmt::format("guiding_fraction must be {}, got '{}'", kGuidingFractionHelp, text));
             b.desc.guiding_fraction = text;
         }
+        if (plugin.find("guiding") && p.has("guiding")) {
+            const std::string text = p.get_string("guiding");
+            if (!parse_guiding_model(text)) p.fail("guiding", fmt::format("guiding must be {}, got '{}'", kGuidingModelHelp, text));
+            b.desc.guiding = text;
+        }
         if (plugin.find("estimators") && p.has("estimators")) b.desc.estimators = p.get_string("estimators");
         if (plugin.find("photon_beams") && p.has("photon_beams")) {
             const int count = p.get_int("photon_beams");

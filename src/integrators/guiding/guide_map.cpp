@@ -13,7 +13,8 @@ Image guide_map(const SdTree& tree, const Vec3f& p, int width, int height) {
         for (int x = 0; x < width; ++x) {
             // The square's point (u.x = (cos theta + 1) / 2, u.y = phi / 2 pi) at the pixel's centre.
             const Vec2f u(1.0f - (float(y) + 0.5f) / float(height), (float(x) + 0.5f) / float(width));
-            map.at(x, y) = Rgb(leaf.sampling.pdf(u) / (4.0f * kPi));
+            // (the quadtree's density read on its own square, not through a direction and back)
+            map.at(x, y) = Rgb(leaf.model == GuidingModel::kSdTree ? leaf.sampling.pdf(u) / (4.0f * kPi) : leaf.pdf(square_to_direction(u)));
         }
     return map;
 }

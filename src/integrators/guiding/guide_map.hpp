@@ -1,4 +1,5 @@
-// What ppg's SD-tree learned at a point: the guiding density of the spatial leaf holding it, as
+// What ppg's SD-tree learned at a point: the guiding density of the spatial leaf holding it (its
+// quadtree, or with --guiding vmm its mixture), as
 // an image of the sphere of directions for the comparison report (`pathlab report
 // --guide-pixel`, issue 39).
 #pragma once

@@ -87,7 +87,7 @@ template <class T>
 void PathGuiding<T>::prepare(const RenderContext& ctx, const PassProgress& progress) {
     if (prepared_.matches(ctx)) return;
     const auto start = std::chrono::steady_clock::now();
-    tree_ = SdTree(ctx.scene.bounds_center(), ctx.scene.bounds_radius());
+    tree_ = SdTree(ctx.scene.bounds_center(), ctx.scene.bounds_radius(), options_.guiding);
     guided_ = false;
     const std::vector<uint64_t> sizes = iteration_sizes(uint64_t(std::max<int64_t>(0, options_.guiding_spp)));
     uint64_t total = 0, done = 0, first = 0;
@@ -164,7 +164,7 @@ ColourOf<T> PathGuiding<T>::walk(const Scene& scene, Intersection hit, Vec3f dir
         const bool guide = leaf && leaf->usable && (sp.material->lobes() & (kLobeDiffuse | kLobeGlossy)) != 0;
         const float a = guide ? guiding_bsdf_fraction(options_, *leaf) : 1.0f;
         // The tree's solid-angle density of a direction (local), and the continuation's of one of BSDF density pdf_bsdf.
-        const auto tree_pdf = [&](const Vec3f& w) { return leaf->sampling.pdf(direction_to_square(sp.frame.to_world(w))) * (1.0f / (4.0f * kPi)); };
+        const auto tree_pdf = [&](const Vec3f& w) { return leaf->pdf(sp.frame.to_world(w)); };
         const auto mixture_pdf = [&](const Vec3f& w, float pdf_bsdf) {
             if (!guide) return pdf_bsdf;
             return a * pdf_bsdf + (1.0f - a) * tree_pdf(w);
@@ -190,7 +190,7 @@ ColourOf<T> PathGuiding<T>::walk(const Scene& scene, Intersection hit, Vec3f dir
                 pdf = s->delta ? a * s->pdfW : mixture_pdf(s->wo, s->pdfW);
             }
         } else {
-            const Vec3f wo = sp.frame.to_local(square_to_direction(leaf->sampling.sample(u)));
+            const Vec3f wo = sp.frame.to_local(leaf->sample(u));
             float pdf_bsdf = 0;
             f = bsdf_eval(sp, wo, wl, pdf_bsdf);
             if (!is_black(f)) {
@@ -285,6 +285,10 @@ std::vector<ParamInfo> ppg_params() {
     p.push_back({"guiding_fraction", ParamType::FloatOrString, "0.5",
                  "the probability of sampling the BSDF rather than the SD-tree where it guides: a number in (0, 1] or 'learned' (per leaf, "
                  "Müller 2019; or --guiding-fraction)",
+                 ""});
+    p.push_back({"guiding", ParamType::String, "sd-tree",
+                 "what each spatial leaf learns of the arriving light: sd-tree (a quadtree over directions) or vmm (von Mises-Fisher lobes "
+                 "fitted by on-line EM, Vorba et al. 2014; or --guiding)",
                  ""});
     return p;
 }

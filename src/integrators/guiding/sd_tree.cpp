@@ -150,7 +150,15 @@ QuadTree QuadTree::refined(float rho, int max_depth) const {
     return out;
 }
 
-SdTree::SdTree(const Vec3f& center, float radius) {
+float GuidingLeaf::pdf(const Vec3f& d) const {
+    if (!usable) return 0.0f;
+    return model == GuidingModel::kVmm ? mixture.pdf(d) : sampling.pdf(direction_to_square(d)) * (1.0f / (4.0f * kPi));
+}
+
+Vec3f GuidingLeaf::sample(Vec2f r) const { return model == GuidingModel::kVmm ? mixture.sample(r) : square_to_direction(sampling.sample(r)); }
+
+SdTree::SdTree(const Vec3f& center, float radius, GuidingModel model) {
+    leaves_[0].model = model;
     const float r = radius > 0 && std::isfinite(radius) ? radius : 1.0f;
     min_ = center - Vec3f(r);
     size_ = 2.0f * r;
@@ -173,7 +181,11 @@ size_t SdTree::leaf_index(const Vec3f& p) const {
 void SdTree::record(const Vec3f& p, const Vec3f& direction, float value) {
     GuidingLeaf& l = leaf(p);
     ++l.records;
-    if (value > 0 && std::isfinite(value)) l.building.record(direction_to_square(direction), value);
+    if (!(value > 0) || !std::isfinite(value)) return;
+    if (l.model == GuidingModel::kVmm)
+        l.fit.add(direction, value);
+    else
+        l.building.record(direction_to_square(direction), value);
 }
 
 void SdTree::record_outgoing(const Vec3f& p, float radiance) {
@@ -215,9 +227,15 @@ void SdTree::refine(uint64_t iteration_spp) {
     for (uint32_t node = 0; node < nodes_.size(); ++node)
         if (nodes_[node].child[0] == 0 && double(leaves_[nodes_[node].leaf].records) > threshold) split(node);
     for (GuidingLeaf& l : leaves_) {
-        l.sampling = std::move(l.building);
-        l.usable = l.sampling.energy() > 0;
-        l.building = l.sampling.refined(kEnergyFraction, kMaxQuadDepth);
+        if (l.model == GuidingModel::kVmm) {
+            l.fit.flush();
+            l.mixture = l.fit.mixture();
+            l.usable = l.fit.directions() > 0;
+        } else {
+            l.sampling = std::move(l.building);
+            l.usable = l.sampling.energy() > 0;
+            l.building = l.sampling.refined(kEnergyFraction, kMaxQuadDepth);
+        }
         l.records = 0;
         l.outgoing = l.outgoing_count ? float(l.outgoing_sum / double(l.outgoing_count)) : 0.0f;
         l.outgoing_sum = 0, l.outgoing_count = 0;

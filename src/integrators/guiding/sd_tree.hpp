@@ -20,6 +20,11 @@
 // A record is (vertex position, direction of the arriving light, value = the radiance estimate
 // arriving from that direction over the density with which the direction was sampled), so that
 // a quadtree cell's sum estimates the integral of the arriving radiance over the cell.
+// With --guiding vmm the directional part is a mixture of von Mises-Fisher lobes instead
+// (vmf_mixture.hpp; Vorba et al. 2014's model in the spatial tree of this one, as Open PGL keeps
+// its mixtures in a kd-tree): the same records feed its on-line EM, which goes on across the
+// iterations (a leaf's fit is not restarted), and refine() hands its mixture to the sampling side.
+//
 // record() is not thread-safe: records are added in a fixed order (the training loop's pixel
 // order), which keeps the tree, and every guided image, the same with any thread count.
 #pragma once
@@ -29,6 +34,8 @@
 #include <vector>
 
 #include "core/vec.hpp"
+#include "integrators/guiding/guiding_model.hpp"
+#include "integrators/guiding/vmf_mixture.hpp"
 
 namespace pathlab {
 
@@ -87,7 +94,10 @@ struct BsdfFractionFit {
 };
 
 struct GuidingLeaf {
-    QuadTree sampling, building;
+    GuidingModel model = GuidingModel::kSdTree;
+    QuadTree sampling, building;  // kSdTree
+    VmfMixture mixture;           // kVmm: the sampling mixture, and the fit that goes on learning
+    VmfMixtureFit fit;
     uint64_t records = 0;  // vertices recorded in this iteration
     // Whether the sampling tree holds any energy (else guiding is off here: BSDF sampling only).
     bool usable = false;
@@ -97,6 +107,11 @@ struct GuidingLeaf {
     double outgoing_sum = 0;
     uint64_t outgoing_count = 0;
     BsdfFractionFit fraction;  // --guiding-fraction learned (a split leaf's children start from its fit)
+
+    // The sampling distribution's density per steradian of the world direction d (0 where the
+    // leaf does not guide), and a direction drawn from it (r in [0, 1)^2).
+    float pdf(const Vec3f& d) const;
+    Vec3f sample(Vec2f r) const;
 };
 
 class SdTree {
@@ -106,8 +121,9 @@ public:
     static constexpr int kMaxQuadDepth = 20;
 
     SdTree() = default;
-    // A tree over the cube of half-side `radius` around `center` (the scene's bounds).
-    SdTree(const Vec3f& center, float radius);
+    // A tree over the cube of half-side `radius` around `center` (the scene's bounds), whose
+    // leaves learn directions by `model`.
+    SdTree(const Vec3f& center, float radius, GuidingModel model = GuidingModel::kSdTree);
 
     // The leaf whose cell holds p (points outside the cube go to the nearest cell).
     const GuidingLeaf& leaf(const Vec3f& p) const { return leaves_[leaf_index(p)]; }

@@ -5,6 +5,7 @@
 // spectral mode), with adjoint-driven roulette and splitting too; it fails when light sampling's MIS weight leaves out the guiding density; it is
 // deterministic (1 and 2 threads, a render continued); its option is its own.
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <limits>
 
@@ -12,6 +13,7 @@
 #include "core/rng.hpp"
 #include "integrators/guiding/guide_map.hpp"
 #include "integrators/guiding/ppg.hpp"
+#include "integrators/path/volpath.hpp"
 #include "job/render_job.hpp"
 #include "judge/image_statistics.hpp"
 #include "render_helpers.hpp"
@@ -376,6 +378,86 @@ TEST(PpgAgreement, FailsWhenLightSamplingIgnoresTheGuidingDensity) {
             const AgreementResult r = compare_with_pt_mis(make_builtin_scene(6), ppg, 8192, false, 16);
             EXPECT_EQ(r.agree, !fault) << guiding_model_name(model) << (fault ? " with" : " without") << " the fault: " << r.describe();
         }
+}
+
+// In media ppg walks as volpath does and guides at surfaces and at points in media (between the
+// phase function and the leaf): it converges to volpath's image in the fog box (Henyey-Greenstein
+// fog), the heterogeneous smoke (a grid: ratio tracking) and the smoky lamp (light that reaches
+// the room by scattering above the shade), with either model; with the learned fraction too.
+AgreementResult compare_with_volpath(const SceneDescription& d, Integrator& ppg, uint64_t spp, int size, bool spectral = false) {
+    const RenderResult a = render_integrator(d, ppg, size, size, spp, 501);
+    IntegratorOptions o;
+    o.spectral = spectral;
+    const auto volpath = make_volpath(o);
+    const RenderResult b = render_integrator(d, *volpath, size, size, spp, 502);
+    EXPECT_EQ(a.stats.invalid_samples, 0u);
+    return test_agreement(a.film.mean(), a.film.standard_error(), b.film.mean(), b.film.standard_error(), kAgreement);
+}
+
+SceneDescription shipped_scene(const char* name) { return load_scene_file(std::string(PATHLAB_SOURCE_DIR) + "/scenes/" + name); }
+
+TEST(PpgInMedia, ConvergesToVolpathsImage) {
+    for (const char* name : {"fog-box.xml", "smoke.xml", "smoky-lamp.xml"})
+        for (const GuidingModel model : {GuidingModel::kSdTree, GuidingModel::kVmm}) {
+            IntegratorOptions o = ppg_options();
+            o.guiding = model;
+            o.guiding_fraction = model == GuidingModel::kVmm ? kLearnedGuidingFraction : 0.5f;
+            PathGuiding<RgbTransport> ppg(o);
+            const AgreementResult r = compare_with_volpath(shipped_scene(name), ppg, 1024, 12);
+            EXPECT_TRUE(r.agree) << name << " (" << guiding_model_name(model) << "): " << r.describe();
+        }
+}
+
+TEST(PpgInMedia, ConvergesInSpectralMode) {
+    PathGuiding<SpectralTransport> ppg(ppg_options(true));
+    const AgreementResult r = compare_with_volpath(shipped_scene("fog-box.xml"), ppg, 1024, 12, true);
+    EXPECT_TRUE(r.agree) << r.describe();
+}
+
+// Test of the test in media: light sampling at points in the fog weighed against the phase
+// function's density alone, while the continuation is drawn from the mixture.
+TEST(PpgInMedia, FailsWhenLightSamplingIgnoresTheGuidingDensity) {
+    for (const bool fault : {false, true}) {
+        PathGuiding<RgbTransport> ppg(ppg_options(), GuidingFaults{.drop_guide_pdf_in_mis = fault});
+        const AgreementResult r = compare_with_volpath(shipped_scene("fog-env.xml"), ppg, 4096, 16);
+        EXPECT_EQ(r.agree, !fault) << (fault ? "with" : "without") << " the fault: " << r.describe();
+    }
+}
+
+TEST(PpgInMedia, SameBytesOnOneAndTwoThreads) {
+    const SceneDescription d = shipped_scene("smoke.xml");
+    for (const GuidingModel model : {GuidingModel::kSdTree, GuidingModel::kVmm}) {
+        const auto with_threads = [&](int threads) {
+            tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+            IntegratorOptions o = ppg_options();
+            o.guiding = model;
+            PathGuiding<RgbTransport> ppg(o);
+            return render_integrator(d, ppg, 16, 12, 4, 5);
+        };
+        const RenderResult one = with_threads(1), two = with_threads(2);
+        EXPECT_TRUE(bit_identical(one.film.mean(), two.film.mean())) << guiding_model_name(model);
+        EXPECT_EQ(one.stats.rays, two.stats.rays) << guiding_model_name(model);
+    }
+}
+
+// --guiding-rr's splitting does not follow paths through media: refused there, by name.
+TEST(PpgInMedia, RefusesTheAdjointDrivenRouletteInMedia) {
+    const auto refusal_of = [](const SceneDescription& d, const JobRequest& q) -> std::string {
+        try {
+            RenderJob job(scene_choice_of(d), q);
+        } catch (const UsageError& e) {
+            return e.what();
+        }
+        return "";
+    };
+    JobRequest r;
+    r.algorithm = "ppg";
+    r.spp = 1;
+    r.guiding_rr = true;
+    const std::string why = refusal_of(shipped_scene("fog-box.xml"), r);
+    EXPECT_NE(why.find("ppg's --guiding-rr (adjoint-driven roulette and splitting) does not follow paths through media yet"), std::string::npos) << why;
+    r.guiding_rr = false;
+    EXPECT_EQ(refusal_of(shipped_scene("fog-box.xml"), r), "");
 }
 
 // Without training ppg is pt-mis's estimator with pt-mis's random numbers: the same image up to

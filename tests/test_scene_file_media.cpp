@@ -324,11 +324,11 @@ TEST_F(SceneFileMedia, IntegratorsWithoutMediaRefuseScenesWithMedia) {
             }
             EXPECT_TRUE(contains(message, info.name + " does not render participating media")) << message;
             EXPECT_TRUE(contains(message, where)) << message;
-            EXPECT_TRUE(contains(message, "The integrators that render media: lt, bdpt, pm, ppm, sppm, bpm, vcm, upbp, volpath, pssmlt, mmlt")) << message;
+            EXPECT_TRUE(contains(message, "The integrators that render media: lt, bdpt, pm, ppm, sppm, bpm, vcm, upbp, volpath, pssmlt, mmlt, ppg")) << message;
             ++refusing;
         }
     }
-    EXPECT_EQ(refusing, 2 * (int(integrators().size()) - 11));  // all but lt, bdpt, pm, ppm, sppm, bpm, vcm, upbp, volpath, pssmlt, mmlt
+    EXPECT_EQ(refusing, 2 * (int(integrators().size()) - 12));  // all but lt, bdpt, pm, ppm, sppm, bpm, vcm, upbp, volpath, pssmlt, mmlt, ppg
     // From the command line: exit code 2, and `pathlab algorithms` says which render media.
     std::ofstream(path("fog.xml")) << "<scene version=\"3.0.0\">\n<medium type=\"homogeneous\" id=\"fog\"/>\n"
                                       "<shape type=\"cube\"><ref name=\"interior\" id=\"fog\"/></shape>\n" + rest + "</scene>\n";
@@ -353,7 +353,7 @@ TEST_F(SceneFileMedia, IntegratorsWithoutMediaRefuseScenesWithMedia) {
     EXPECT_TRUE(contains(other.err, "--volume-estimate chooses how sppm, ppm and pm gather photons in media")) << other.err;
     EXPECT_FALSE(fs::exists(path("bad.exr")));
     const CliResult list = run({"algorithms"});
-    EXPECT_TRUE(contains(list.out, "Participating media (scenes with a <medium>): lt, bdpt, pm, ppm, sppm, bpm, vcm, upbp, volpath, pssmlt, mmlt;")) << list.out;
+    EXPECT_TRUE(contains(list.out, "Participating media (scenes with a <medium>): lt, bdpt, pm, ppm, sppm, bpm, vcm, upbp, volpath, pssmlt, mmlt, ppg;")) << list.out;
 }
 
 }  // namespace

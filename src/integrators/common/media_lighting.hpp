@@ -21,11 +21,29 @@ struct ScatterVertex {
     int32_t medium = -1;  // the medium the path arrived in
 };
 
+// A guided path tracer's distribution of directions at a vertex (ppg in media): the continuation
+// is drawn from the one-sample mixture a p_scatter + (1 - a) p_guide (a Dirac lobe only from the
+// BSDF half, with probability a times its own), and light sampling is weighed against the
+// mixture's density. NoGuide, volpath's: the BSDF or phase function alone (a = 1).
+//   bool guides() const;              whether the vertex is guided (else a = 1)
+//   float fraction() const;           a
+//   float pdf(const Vec3f& w) const;  p_guide of a world direction, per steradian
+//   Vec3f sample(Vec2f u) const;      a world direction drawn from p_guide
+//   float mis_pdf(const Vec3f& w, float pdf_scatter) const;  the density light sampling is weighed against
+struct NoGuide {
+    bool guides() const { return false; }
+    float fraction() const { return 1.0f; }
+    float pdf(const Vec3f&) const { return 0.0f; }
+    Vec3f sample(Vec2f) const { return Vec3f(0.0f, 0.0f, 1.0f); }
+    float mis_pdf(const Vec3f&, float pdf_scatter) const { return pdf_scatter; }
+};
+
 // Next-event estimation at a vertex: pt-mis's estimate_light_sample (the same random numbers,
-// the same arithmetic at a surface), with the shadow ray's transmittance.
-template <class T>
+// the same arithmetic at a surface), with the shadow ray's transmittance. With `seen`, the light
+// it found (its direction, and Le Tr times the MIS weight over the sample's density).
+template <class T, class Guide = NoGuide>
 ColourOf<T> estimate_light(const Scene& scene, const ScatterVertex& v, Sampler& sampler, MediumState<T>& st, bool mis,
-                           WavelengthsOf<T>& wl, bool power = false) {
+                           WavelengthsOf<T>& wl, bool power = false, const Guide& guide = {}, LightSampleSeen<WavelengthsOf<T>>* seen = nullptr) {
     using Colour = ColourOf<T>;
     const auto nee = sample_nee(scene, v.p, v.sp ? v.sp->frame.n : Vec3f(0.0f), sampler, nee_candidates(scene, v.sp, wl),
                                 [&](const LightSample& c, int) {
@@ -64,9 +82,11 @@ ColourOf<T> estimate_light(const Scene& scene, const ScatterVertex& v, Sampler& 
     if (!st.pass_null && scene.media_separated(medium, scene.light_medium(choice.index))) return Colour(0.0f);  // blocked: no ray needed
     const Colour Tr = shadow_transmittance(scene, shadow, medium, st);
     if (is_black(Tr)) return Colour(0.0f);
-    const float weight = !ls->delta ? (mis ? mis_heuristic(power, nee->pdf_source, pdf_scatter) : 1.0f) : 1.0f;
+    const float weight = !ls->delta ? (mis ? mis_heuristic(power, nee->pdf_source, guide.mis_pdf(ls->wi, pdf_scatter)) : 1.0f) : 1.0f;
     const Colour contribution = f * light_colour(scene, choice.index, ls->Le, wl) * (cosine * weight / nee->pdf);
-    return scene.has_media() || st.pass_null ? contribution * Tr : contribution;
+    const bool attenuated = scene.has_media() || st.pass_null;
+    if (seen) *seen = {true, ls->wi, light_colour(scene, choice.index, ls->Le, wl) * (attenuated ? Tr : Colour(1.0f)) * (weight / nee->pdf)};
+    return attenuated ? contribution * Tr : contribution;
 }
 
 // The radiance a walk that ended on a surface or in the sky finds (Le towards the path, in RGB),
@@ -114,51 +134,81 @@ struct ScatterSample {
     ColourOf<T> found{0.0f};          // the emission the walk reached, times f cos / pdf and the MIS weight against light sampling
     uint32_t lobe = 0;                // the BSDF lobe sampled (BsdfLobe; 0 for a phase sample)
     float pdf = 0;                    // the solid-angle density of the sampled direction
+    float pdf_scatter = 0;            // ... the BSDF's or phase function's own (pdf without a guide)
     bool delta = false;               // ... a Dirac delta's coefficient
 };
 
 // The second half of the MIS pair at v (the first is estimate_light): a BSDF sample at a surface
 // (whose vertex and walk are v.sp and v.hit) or a phase sample in a medium, and the emission its
 // walk finds; the caller adds beta * next_seg * found / density. With `null_origin`, emission
-// found by a straight pass (kLobeNull) is weighed against light sampling at that origin.
-template <class T>
+// found by a straight pass (kLobeNull) is weighed against light sampling at that origin. Where
+// `guide` guides, the direction comes from its mixture (NoGuide: the BSDF's or phase function's
+// sample alone); its random numbers are u, then the choice of half, then the half's own.
+template <class T, class Guide = NoGuide>
 ScatterSample<T> sample_scatter(const Scene& scene, const ScatterVertex& v, Sampler& sampler, MediumState<T>& st, bool mis,
-                                WavelengthsOf<T>& wl, bool power = false, const MisOrigin* null_origin = nullptr) {
+                                WavelengthsOf<T>& wl, bool power = false, const MisOrigin* null_origin = nullptr, const Guide& guide = {}) {
     using Colour = ColourOf<T>;
     ScatterSample<T> n;
     int light;
+    const Vec2f u = sampler.next2d();
+    const bool guided = guide.guides() && !(sampler.next1d() < guide.fraction());  // (NoGuide draws no choice)
+    // The continuation's density of a world direction w whose BSDF or phase density is pdf_scatter.
+    const auto mixture = [&](const Vec3f& w, float pdf_scatter) {
+        return guide.guides() ? guide.fraction() * pdf_scatter + (1.0f - guide.fraction()) * guide.pdf(w) : pdf_scatter;
+    };
     if (v.sp) {
         const ShadingPoint& sp = *v.sp;
         const MediumWalk& w = *v.hit;
-        const auto s = bsdf_sample(sp, sampler.next2d(), wl);
-        if (!s) return n;
+        std::optional<BsdfSample> s;
+        Colour f;
+        if (!guided) {
+            s = bsdf_sample(sp, u, wl);
+            if (!s) return n;
+            f = bsdf_sample_colour(sp, *s, wl);
+        } else {
+            const Vec3f wo = sp.frame.to_local(guide.sample(u));
+            float pdf_bsdf = 0;
+            f = bsdf_eval(sp, wo, wl, pdf_bsdf);
+            if (is_black(f)) return n;
+            s = BsdfSample{wo, Rgb(0.0f), pdf_bsdf, false, 0, 0};
+        }
+        const Vec3f wo_world = sp.frame.to_world(s->wo);
         n.sampled = true;
         n.lobe = s->lobe;
-        n.pdf = s->pdfW;
+        n.pdf_scatter = s->pdfW;
+        n.pdf = s->delta ? guide.fraction() * s->pdfW : mixture(wo_world, s->pdfW);
+        if (guide.guides() && !(n.pdf > 0)) return ScatterSample<T>{};
         n.delta = s->delta;
         n.ray = sp.spawn(s->wo);
-        n.medium = medium_after(w.media, w.isect.ng, sp.frame.to_world(s->wo), w.medium);
+        n.medium = medium_after(w.media, w.isect.ng, wo_world, w.medium);
         n.next = walk_media(scene, n.ray, n.medium, st, n.next_seg);
-        const Colour f = bsdf_sample_colour(sp, *s, wl);
-        n.weight = f * (std::abs(s->wo.z) / s->pdfW);
+        n.weight = f * (std::abs(s->wo.z) / n.pdf);
         const bool passed = null_origin && (s->lobe & kLobeNull);
-        const MisOrigin here{sp.p, sp.frame.n, s->pdfW, s->delta};
+        const MisOrigin here{sp.p, sp.frame.n, n.pdf, s->delta};
         const MisOrigin& o = passed ? *null_origin : here;
         const EmitterHit e = emission_found(scene, n.next, o.p, o.n, light);
         const float weight = o.delta ? 1.0f : (mis ? mis_heuristic(power, o.pdf, e.pdf_light) : 0.0f);
-        if (!is_black(e.Le)) n.found = f * light_colour(scene, light, e.Le, wl) * (std::abs(s->wo.z) * weight / s->pdfW);
+        if (!is_black(e.Le)) n.found = f * light_colour(scene, light, e.Le, wl) * (std::abs(s->wo.z) * weight / n.pdf);
     } else {
-        const PhaseSample ps = phase_sample(*v.phase, v.wi, sampler.next2d());
+        PhaseSample ps;
+        if (!guided) {
+            ps = phase_sample(*v.phase, v.wi, u);
+        } else {
+            ps.wo = guide.sample(u);
+            ps.p = phase_eval(*v.phase, v.wi, ps.wo);
+            ps.pdfW = phase_pdf(*v.phase, v.wi, ps.wo);
+        }
         if (!(ps.pdfW > 0)) return n;
         n.sampled = true;
-        n.pdf = ps.pdfW;
+        n.pdf_scatter = ps.pdfW;
+        n.pdf = mixture(ps.wo, ps.pdfW);
         n.ray = Ray{v.p, ps.wo, kInf};
         n.medium = v.medium;
         n.next = walk_media(scene, n.ray, n.medium, st, n.next_seg);
         const EmitterHit e = emission_found(scene, n.next, v.p, Vec3f(0.0f), light);
-        const float weight = mis ? mis_heuristic(power, ps.pdfW, e.pdf_light) : 0.0f;
-        if (!is_black(e.Le)) n.found = Colour(ps.p) * light_colour(scene, light, e.Le, wl) * (weight / ps.pdfW);
-        n.weight = Colour(ps.p / ps.pdfW);
+        const float weight = mis ? mis_heuristic(power, n.pdf, e.pdf_light) : 0.0f;
+        if (!is_black(e.Le)) n.found = Colour(ps.p) * light_colour(scene, light, e.Le, wl) * (weight / n.pdf);
+        n.weight = Colour(ps.p / n.pdf);
     }
     return n;
 }

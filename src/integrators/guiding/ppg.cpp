@@ -36,6 +36,7 @@
 #include "core/sampling.hpp"
 #include "integrators/common/camera_ray.hpp"
 #include "integrators/common/direct_lighting.hpp"
+#include "integrators/common/media_lighting.hpp"
 #include "integrators/integrators.hpp"
 
 namespace pathlab {
@@ -63,6 +64,7 @@ float mean_of(const C& c) {
     for (int i = 0; i < lanes; ++i) sum += c[i];
     return sum / float(lanes);
 }
+
 
 }  // namespace
 
@@ -138,6 +140,7 @@ ColourOf<T> PathGuiding<T>::radiance(const Scene& scene, const Ray& ray, Sampler
 
 template <class T>
 ColourOf<T> PathGuiding<T>::trace(const Scene& scene, const Ray& camera_ray, Sampler& sampler, Wl& wl, std::vector<Record>* records) const {
+    if (scene.has_media()) return trace_in_media(scene, camera_ray, sampler, wl, records);
     const bool seen_directly = !options_.hide_emitters;
     Intersection hit;
     if (!scene.intersect(camera_ray, hit)) return seen_directly ? escaped_radiance(scene, camera_ray.d, wl) : Colour(0.0f);
@@ -161,17 +164,13 @@ ColourOf<T> PathGuiding<T>::walk(const Scene& scene, Intersection hit, Vec3f dir
         const ShadingPoint sp = make_shading_point(scene, hit, dir);
         if (sp.material->is_black()) break;
         const GuidingLeaf* leaf = guided_ ? (next_leaf ? next_leaf : &tree_.leaf(sp.p)) : nullptr;
-        const bool guide = leaf && leaf->usable && (sp.material->lobes() & (kLobeDiffuse | kLobeGlossy)) != 0;
-        const float a = guide ? guiding_bsdf_fraction(options_, *leaf) : 1.0f;
+        const LeafGuide g = leaf_guide(leaf, (sp.material->lobes() & (kLobeDiffuse | kLobeGlossy)) != 0);
+        const bool guide = g.on;
+        const float a = g.a;
         // The tree's solid-angle density of a direction (local), and the continuation's of one of BSDF density pdf_bsdf.
         const auto tree_pdf = [&](const Vec3f& w) { return leaf->pdf(sp.frame.to_world(w)); };
-        const auto mixture_pdf = [&](const Vec3f& w, float pdf_bsdf) {
-            if (!guide) return pdf_bsdf;
-            return a * pdf_bsdf + (1.0f - a) * tree_pdf(w);
-        };
-        const auto light_mis_pdf = [&](const Vec3f& w, float pdf_bsdf) {
-            return faults_.drop_guide_pdf_in_mis ? pdf_bsdf : mixture_pdf(w, pdf_bsdf);
-        };
+        const auto mixture_pdf = [&](const Vec3f& w, float pdf_bsdf) { return g.mixture(sp.frame.to_world(w), pdf_bsdf); };
+        const auto light_mis_pdf = [&](const Vec3f& w, float pdf_bsdf) { return g.mis_pdf(sp.frame.to_world(w), pdf_bsdf); };
         PathVertex* v = records && n < kRecordedVertices ? &vertices[n++] : nullptr;
         if (v) *v = {sp.p, Vec3f(0.0f), 0.0f, false, L, beta, L, beta};
         LightSampleSeen<Wl> light;
@@ -239,9 +238,22 @@ ColourOf<T> PathGuiding<T>::walk(const Scene& scene, Intersection hit, Vec3f dir
         hit = found.isect;
         dir = wo_world;
     }
+    if (records) add_records(vertices, n, L, *records);
+    return L;
+}
+
+template <class T>
+LeafGuide PathGuiding<T>::leaf_guide(const GuidingLeaf* leaf, bool guidable) const {
+    const bool on = leaf && leaf->usable && guidable;
+    return {leaf, on ? guiding_bsdf_fraction(options_, *leaf) : 1.0f, on, faults_.drop_guide_pdf_in_mis};
+}
+
+template <class T>
+void PathGuiding<T>::add_records(const PathVertex* vertices, int n, const Colour& L, std::vector<Record>& out) {
     // What arrived at each recorded vertex along its continuation: all the path gathered after
     // it, over the throughput to the next vertex; recorded over the direction's density. And what
     // the vertex sent back: all the path gathered from it on, over the throughput that reached it.
+    std::vector<Record>* records = &out;
     for (int i = 0; i < n; ++i) {
         const PathVertex& v = vertices[i];
         if (v.guided_record) {
@@ -254,6 +266,70 @@ ColourOf<T> PathGuiding<T>::walk(const Scene& scene, Intersection hit, Vec3f dir
         }
         records->push_back({v.p, Vec3f(0.0f), mean_ratio(L - v.L_start, v.beta_start), Record::kOutgoing});
     }
+}
+
+template <class T>
+ColourOf<T> PathGuiding<T>::trace_in_media(const Scene& scene, const Ray& camera_ray, Sampler& sampler, Wl& wl,
+                                           std::vector<Record>* records) const {
+    // volpath's loop (path/volpath.cpp) with each vertex's leaf guiding its continuation (at a
+    // surface as above; in a medium between the phase function and the leaf), through
+    // media_lighting.hpp's Guide. The throughput that the records divide by is beta / density.
+    MediumState<T> st{sampler, wl};
+    Colour seg(1.0f);
+    MediumWalk w = walk_media(scene, camera_ray, scene.camera_medium(), st, seg);
+    Colour beta = seg, L(0.0f);
+    const bool seen_directly = !options_.hide_emitters;
+    if (w.kind == MediumWalk::kEscaped) return seen_directly ? beta * escaped_radiance(scene, w.dir, wl) / st.density() : Colour(0.0f);
+    if (w.kind == MediumWalk::kSurface && seen_directly) L = beta * emitted_radiance(scene, w.isect, -w.dir, wl) / st.density();
+    std::array<PathVertex, kRecordedVertices> vertices;
+    int n = 0;
+    const bool power = rules_.power_mis();
+    const bool learn_fraction = records && options_.guiding_fraction == kLearnedGuidingFraction;
+    for (int bounces = 0; w.kind != MediumWalk::kLost && rules_.may_bounce(bounces); ++bounces) {
+        ScatterVertex v;
+        v.medium = w.medium;
+        ShadingPoint sp;
+        bool guidable = true;
+        if (w.kind == MediumWalk::kSurface) {
+            sp = make_shading_point(scene, w.isect, w.dir);
+            if (sp.material->is_black()) break;
+            v.sp = &sp, v.hit = &w, v.p = sp.p;
+            guidable = (sp.material->lobes() & (kLobeDiffuse | kLobeGlossy)) != 0;
+        } else {
+            v.p = w.p;
+            v.wi = -w.dir / length(w.dir);
+            v.phase = &medium_phase(scene.medium(w.medium));
+        }
+        const LeafGuide g = leaf_guide(guided_ ? &tree_.leaf(v.p) : nullptr, guidable);
+        PathVertex* pv = records && n < kRecordedVertices ? &vertices[size_t(n++)] : nullptr;
+        const Colour throughput = beta / st.density();
+        if (pv) *pv = {v.p, Vec3f(0.0f), 0.0f, false, L, throughput, L, throughput};
+        LightSampleSeen<Wl> light;
+        L += beta * estimate_light(scene, v, sampler, st, /*mis=*/true, wl, power, g, records ? &light : nullptr) / st.density();
+        if (records && light.found) records->push_back({v.p, light.wi, mean_of(light.Li), Record::kIncoming});
+        const Colour L_before = L;
+        const ScatterSample<T> s = sample_scatter(scene, v, sampler, st, /*mis=*/true, wl, power, nullptr, g);
+        if (!s.sampled) break;
+        L += beta * s.next_seg * s.found / st.density();
+        const Vec3f wo = normalize(s.ray.d);
+        if (!rules_.may_bounce(bounces + 1) || s.next.kind == MediumWalk::kEscaped || s.next.kind == MediumWalk::kLost) {
+            if (pv && !s.delta) pv->direction = wo, pv->pdf = s.pdf, pv->guided_record = true, pv->L_before = L_before, pv->beta_after = beta * s.next_seg * s.weight / st.density();
+            break;
+        }
+        beta = beta * s.next_seg * s.weight;
+        if (pv && !s.delta) {
+            pv->direction = wo, pv->pdf = s.pdf, pv->guided_record = true, pv->L_before = L_before, pv->beta_after = beta / st.density();
+            if (g.on && learn_fraction) {
+                pv->a = g.a, pv->f_cos = mean_of(s.weight) * s.pdf, pv->pdf_bsdf = s.pdf_scatter, pv->pdf_tree = g.pdf(wo);
+            }
+        }
+        // Russian roulette on beta / density (volpath's).
+        Colour weight = beta / st.density();
+        if (!rules_.survive_roulette(bounces + 1, weight, sampler)) break;
+        beta = weight * st.density();
+        w = s.next;
+    }
+    if (records) add_records(vertices.data(), n, L, *records);
     return L;
 }
 
@@ -296,9 +372,15 @@ std::vector<ParamInfo> ppg_params() {
 }  // namespace
 
 const IntegratorInfo& ppg_integrator() {
-    static const IntegratorInfo info = sampling_lights(IntegratorInfo{
-        "ppg", {"guided", "guided_path"}, "path tracing guided by a learned SD-tree of arriving radiance (practical path guiding), NEE by MIS", false, true,
-        ppg_params(), [](const IntegratorOptions& o) { return make_for_transport<PathGuiding>(o); }});
+    static const IntegratorInfo info = [] {
+        IntegratorInfo i = sampling_lights(IntegratorInfo{
+            "ppg", {"guided", "guided_path"},
+            "path tracing guided by a learned SD-tree of arriving radiance (practical path guiding), NEE by MIS; in media too (volpath's walk, "
+            "guided phase sampling)",
+            false, true, ppg_params(), [](const IntegratorOptions& o) { return make_for_transport<PathGuiding>(o); }});
+        i.media = true;
+        return i;
+    }();
     return info;
 }
 

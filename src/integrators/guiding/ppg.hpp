@@ -22,6 +22,22 @@ inline float guiding_bsdf_fraction(const IntegratorOptions& o, const GuidingLeaf
     return o.guiding_fraction == kLearnedGuidingFraction ? leaf.fraction.fraction() : o.guiding_fraction;
 }
 
+// A leaf's guiding distribution at a vertex, as media_lighting.hpp's sampling and light sampling
+// take it (its Guide): the one-sample mixture a p_scatter + (1 - a) p_leaf where `on`.
+struct LeafGuide {
+    const GuidingLeaf* leaf = nullptr;
+    float a = 1;
+    bool on = false;
+    bool drop_in_mis = false;  // GuidingFaults::drop_guide_pdf_in_mis
+
+    bool guides() const { return on; }
+    float fraction() const { return a; }
+    float pdf(const Vec3f& w) const { return leaf->pdf(w); }
+    Vec3f sample(Vec2f u) const { return leaf->sample(u); }
+    float mixture(const Vec3f& w, float pdf_scatter) const { return on ? a * pdf_scatter + (1.0f - a) * leaf->pdf(w) : pdf_scatter; }
+    float mis_pdf(const Vec3f& w, float pdf_scatter) const { return drop_in_mis ? pdf_scatter : mixture(w, pdf_scatter); }
+};
+
 template <class T>
 class PathGuiding final : public PixelIntegrator<T> {
 public:
@@ -78,6 +94,13 @@ private:
     // the path being one of `copies`.
     Colour walk(const Scene& scene, Intersection hit, Vec3f dir, Colour beta, int first_bounce, Sampler& sampler, Wl& wl,
                 std::vector<Record>* records, PathVertex* vertices, float pixel, int copies) const;
+    // The estimate of a camera sample in a scene with media (volpath's walk, guided at surfaces and
+    // at points in media).
+    Colour trace_in_media(const Scene& scene, const Ray& ray, Sampler& sampler, Wl& wl, std::vector<Record>* records) const;
+    // The guiding at a vertex whose leaf is `leaf` (null: untrained), where the BSDF may be guided.
+    LeafGuide leaf_guide(const GuidingLeaf* leaf, bool guidable) const;
+    // A training path's records, from its recorded vertices and all it gathered (L).
+    static void add_records(const PathVertex* vertices, int n, const Colour& L, std::vector<Record>& out);
 
     IntegratorOptions options_;
     PathRules rules_;

@@ -348,11 +348,12 @@ TEST_F(Lab, ReportShowsWhatTheGuideLearnedAtAPixel) {
     EXPECT_TRUE(contains(html, "What the guide learned"));
     EXPECT_TRUE(contains(html, "pixel (12, 10): first hit at"));
     EXPECT_TRUE(contains(html, "BSDF sampling fraction there 0.5 (--guiding-fraction)"));
-    // A scene file asking ppg for the learned fraction: the leaf's own.
+    // A scene file asking ppg for the learned fraction and the mixtures: the leaf's own fraction, and the model named.
     std::string lampshade = read_text(std::string(PATHLAB_SOURCE_DIR) + "/scenes/lampshade.xml");
     const std::string bdpt = "<integrator type=\"bdpt\"/>";
     ASSERT_NE(lampshade.find(bdpt), std::string::npos);
-    lampshade.replace(lampshade.find(bdpt), bdpt.size(), "<integrator type=\"ppg\"><string name=\"guiding_fraction\" value=\"learned\"/></integrator>");
+    lampshade.replace(lampshade.find(bdpt), bdpt.size(), "<integrator type=\"ppg\"><string name=\"guiding_fraction\" value=\"learned\"/>"
+                      "<string name=\"guiding\" value=\"vmm\"/></integrator>");
     {
         std::ofstream(path("learned.xml")) << lampshade;
     }
@@ -360,6 +361,7 @@ TEST_F(Lab, ReportShowsWhatTheGuideLearnedAtAPixel) {
                                    "--guide-pixel", "12,12", "-q", "-o", path("l.html")});
     ASSERT_EQ(learned.code, 0) << learned.err;
     EXPECT_TRUE(contains(read_text(path("l.html")), "(learned)")) << "the learned fraction of the leaf at pixel (12, 12)";
+    EXPECT_TRUE(contains(read_text(path("l.html")), "von Mises-Fisher mixture (--guiding vmm)"));
     EXPECT_TRUE(fs::exists(path("g_files/ppg_guide.png")));
     EXPECT_FALSE(fs::exists(path("g_files/pt-mis_guide.png")));
     EXPECT_EQ(read_png8(path("g_files/ppg_guide.png")).width, 256);

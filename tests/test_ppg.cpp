@@ -431,6 +431,7 @@ TEST(PpgInMedia, SameBytesOnOneAndTwoThreads) {
             tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
             IntegratorOptions o = ppg_options();
             o.guiding = model;
+            o.guiding_rr = model == GuidingModel::kVmm;
             PathGuiding<RgbTransport> ppg(o);
             return render_integrator(d, ppg, 16, 12, 4, 5);
         };
@@ -440,24 +441,16 @@ TEST(PpgInMedia, SameBytesOnOneAndTwoThreads) {
     }
 }
 
-// --guiding-rr's splitting does not follow paths through media: refused there, by name.
-TEST(PpgInMedia, RefusesTheAdjointDrivenRouletteInMedia) {
-    const auto refusal_of = [](const SceneDescription& d, const JobRequest& q) -> std::string {
-        try {
-            RenderJob job(scene_choice_of(d), q);
-        } catch (const UsageError& e) {
-            return e.what();
-        }
-        return "";
-    };
-    JobRequest r;
-    r.algorithm = "ppg";
-    r.spp = 1;
-    r.guiding_rr = true;
-    const std::string why = refusal_of(shipped_scene("fog-box.xml"), r);
-    EXPECT_NE(why.find("ppg's --guiding-rr (adjoint-driven roulette and splitting) does not follow paths through media yet"), std::string::npos) << why;
-    r.guiding_rr = false;
-    EXPECT_EQ(refusal_of(shipped_scene("fog-box.xml"), r), "");
+// --guiding-rr in media: adjoint-driven roulette (no splitting there) changes how many paths go on,
+// not what they converge to; survivors not divided by their probability make it fail.
+TEST(PpgInMedia, ConvergesWithTheAdjointDrivenRouletteAndFailsWithoutTheSurvivorsWeight) {
+    for (const bool fault : {false, true}) {
+        IntegratorOptions o = ppg_options();
+        o.guiding_rr = true;
+        PathGuiding<RgbTransport> ppg(o, GuidingFaults{.drop_roulette_weight = fault});
+        const AgreementResult r = compare_with_volpath(shipped_scene("fog-box.xml"), ppg, 2048, 12);
+        EXPECT_EQ(r.agree, !fault) << (fault ? "with" : "without") << " the fault: " << r.describe();
+    }
 }
 
 // Without training ppg is pt-mis's estimator with pt-mis's random numbers: the same image up to

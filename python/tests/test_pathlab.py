@@ -134,6 +134,7 @@ def test_load_takes_indices_names_and_files_with_defines():
     ("3", "pbgi", ["--pbgi-surfels", "400", "--pbgi-bounces", "1", "--pbgi-cutoff", "0.1"]),
     ("scenes/fog-box.xml", "pm", ["--volume-estimate", "points", "--photons", "200"]),
     ("3", "ppg", ["--guiding-spp", "3", "--guiding-rr", "--guiding-fraction", "learned"]),
+    ("scenes/fog-box.xml", "ppg", ["--guiding-spp", "3", "--guiding", "vmm"]),  # guided in media, by mixtures
     ("scenes/gltf/room.glb", "pt-mis", []),  # a glTF scene
 ])
 def test_render_equals_the_command_line_bit_for_bit(tmp_path, scene, algorithm, extra):
@@ -193,6 +194,8 @@ def test_estimator_options_are_refused_as_on_the_command_line():
         pathlab.render(3, "ppg", spp=1, resolution=(4, 4), guiding_fraction=0)
     with pytest.raises(ValueError, match="--guiding-fraction must be a number in \\(0, 1\\] or 'learned', got 'most'"):
         pathlab.render(3, "ppg", spp=1, resolution=(4, 4), guiding_fraction="most")
+    with pytest.raises(ValueError, match="--guiding must be sd-tree or vmm, got 'gmm'"):
+        pathlab.render(3, "ppg", spp=1, resolution=(4, 4), guiding="gmm")
 
 
 def test_a_scene_files_own_settings_as_on_the_command_line(tmp_path):

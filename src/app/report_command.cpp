@@ -335,6 +335,7 @@ int run_report_command(const ReportOptions& o) {
                         if (leaf.usable)
                             entry.guide_note += fmt::format("; BSDF sampling fraction there {:.3g} ({})", guiding_bsdf_fraction(options, leaf),
                                                             options.guiding_fraction == kLearnedGuidingFraction ? "learned" : "--guiding-fraction");
+                        if (options.guiding == GuidingModel::kVmm) entry.guide_note += "; von Mises-Fisher mixture (--guiding vmm)";
                     } else {
                         entry.guide_note = fmt::format("pixel ({}, {}): its ray leaves the scene", guide_pixel->first, guide_pixel->second);
                     }

@@ -165,11 +165,6 @@ std::string integrator_refusal(const IntegratorInfo& info, const SceneDescriptio
             return fmt::format("{0} does not render participating media, and this scene has the {1}: {0} would render "
                                "the scene as if the medium were not there. The integrators that render media: {2}",
                                info.name, medium, media_integrator_names());
-    if (info.name == "ppg" && (r.guiding_rr || d.guiding_rr.value_or(false)))
-        if (const std::string medium = medium_in_use(d); !medium.empty())
-            return fmt::format("ppg's --guiding-rr (adjoint-driven roulette and splitting) does not follow paths through media yet, and "
-                               "this scene has the {}: render it with ppg without --guiding-rr (guided in media too) or with volpath",
-                               medium);
     if (info.name == "upbp") {
         bool beams = true;
         try {

@@ -380,8 +380,9 @@ std::vector<std::string> write_html_report(const ReportData& data, const std::st
     }
     const std::string guide_section =
         guides.empty() ? ""
-                       : "<h2>What the guide learned</h2>\n<p>The directional distribution ppg's SD-tree learned in the spatial cell of the "
-                         "point, over the sphere of directions as its quadtree sees it: columns are the azimuth from +x (left) towards "
+                       : "<h2>What the guide learned</h2>\n<p>The directional distribution ppg learned in the spatial cell of the "
+                         "point (its quadtree, or with --guiding vmm its mixture of lobes), over the sphere of directions in the "
+                         "quadtree's cylindrical coordinates: columns are the azimuth from +x (left) towards "
                          "+y, rows the cosine of the angle from +z (top: up the z axis, bottom: down it), an equal-area map, so a "
                          "region's share of the picture is its share of directions; bright where the training paths found light coming "
                          "from.</p>\n<div class=\"grid\">\n" +

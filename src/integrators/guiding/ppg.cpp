@@ -217,9 +217,7 @@ ColourOf<T> PathGuiding<T>::walk(const Scene& scene, Intersection hit, Vec3f dir
         next_leaf = pixel > 0 ? &tree_.leaf(found.isect.p) : nullptr;
         const float next = next_leaf ? next_leaf->outgoing : 0.0f;
         if (next > 0) {
-            // The throughput at which the path's expected contribution is the pixel's, and a
-            // window of ratio kWindow around it.
-            const float centre = pixel / next, lower = 2.0f * centre / (1.0f + kWindow), upper = kWindow * lower;
+            const auto [lower, upper] = weight_window(pixel, next);
             const float b = mean_of(beta);
             if (b < lower) {
                 const float q = std::max(b / lower, 1e-3f);
@@ -240,6 +238,14 @@ ColourOf<T> PathGuiding<T>::walk(const Scene& scene, Intersection hit, Vec3f dir
     }
     if (records) add_records(vertices, n, L, *records);
     return L;
+}
+
+template <class T>
+std::pair<float, float> PathGuiding<T>::weight_window(float pixel, float next) {
+    // The throughput at which the path's expected contribution is the pixel's, and a window of
+    // ratio kWindow around it.
+    const float centre = pixel / next, lower = 2.0f * centre / (1.0f + kWindow);
+    return {lower, kWindow * lower};
 }
 
 template <class T>
@@ -285,6 +291,10 @@ ColourOf<T> PathGuiding<T>::trace_in_media(const Scene& scene, const Ray& camera
     int n = 0;
     const bool power = rules_.power_mis();
     const bool learn_fraction = records && options_.guiding_fraction == kLearnedGuidingFraction;
+    // Adjoint-driven roulette's estimate of the pixel: the radiance the first vertex's leaf sends back.
+    const float pixel = guided_ && options_.guiding_rr && !records && w.kind != MediumWalk::kLost
+                            ? tree_.leaf(w.kind == MediumWalk::kSurface ? w.isect.p : w.p).outgoing
+                            : 0.0f;
     for (int bounces = 0; w.kind != MediumWalk::kLost && rules_.may_bounce(bounces); ++bounces) {
         ScatterVertex v;
         v.medium = w.medium;
@@ -323,11 +333,22 @@ ColourOf<T> PathGuiding<T>::trace_in_media(const Scene& scene, const Ray& camera
                 pv->a = g.a, pv->f_cos = mean_of(s.weight) * s.pdf, pv->pdf_bsdf = s.pdf_scatter, pv->pdf_tree = g.pdf(wo);
             }
         }
-        // Russian roulette on beta / density (volpath's).
-        Colour weight = beta / st.density();
-        if (!rules_.survive_roulette(bounces + 1, weight, sampler)) break;
-        beta = weight * st.density();
         w = s.next;
+        // Adjoint-driven roulette on beta / density where the next vertex's leaf knows its
+        // radiance (no splitting in media: a copy would need its own media state), else volpath's.
+        const float next = pixel > 0 ? tree_.leaf(w.kind == MediumWalk::kSurface ? w.isect.p : w.p).outgoing : 0.0f;
+        Colour weight = beta / st.density();
+        if (next > 0) {
+            const float b = mean_of(weight), lower = weight_window(pixel, next).first;
+            if (b < lower) {
+                const float q = std::max(b / lower, 1e-3f);
+                if (sampler.next1d() >= q) break;
+                if (!faults_.drop_roulette_weight) beta /= q;
+            }
+        } else {
+            if (!rules_.survive_roulette(bounces + 1, weight, sampler)) break;
+            beta = weight * st.density();
+        }
     }
     if (records) add_records(vertices.data(), n, L, *records);
     return L;

@@ -97,6 +97,9 @@ private:
     // The estimate of a camera sample in a scene with media (volpath's walk, guided at surfaces and
     // at points in media).
     Colour trace_in_media(const Scene& scene, const Ray& ray, Sampler& sampler, Wl& wl, std::vector<Record>* records) const;
+    // Adjoint-driven roulette's window of throughputs (lower, upper) for a path whose next vertex's
+    // leaf sends back `next`, against the pixel's `pixel`.
+    static std::pair<float, float> weight_window(float pixel, float next);
     // The guiding at a vertex whose leaf is `leaf` (null: untrained), where the BSDF may be guided.
     LeafGuide leaf_guide(const GuidingLeaf* leaf, bool guidable) const;
     // A training path's records, from its recorded vertices and all it gathered (L).

@@ -25,6 +25,10 @@
 // the next vertex's leaf radiance; against the pixel's (estimated by the first hit's leaf) it is
 // kept within a window of ratio kWindow: roulette below it (survivors divided by their
 // probability), splitting into copies above it. Both are unbiased; only the variance changes.
+//
+// In a scene with media (trace_in_media) ppg follows volpath's walk (media_lighting.hpp, whose
+// light sample and BSDF-or-phase sample take a LeafGuide) and guides at points in media too,
+// between the phase function and the leaf; --guiding-rr plays only the roulette there.
 #include "integrators/guiding/ppg.hpp"
 
 #include <tbb/parallel_for.h>
@@ -64,7 +68,6 @@ float mean_of(const C& c) {
     for (int i = 0; i < lanes; ++i) sum += c[i];
     return sum / float(lanes);
 }
-
 
 }  // namespace
 
@@ -259,18 +262,17 @@ void PathGuiding<T>::add_records(const PathVertex* vertices, int n, const Colour
     // What arrived at each recorded vertex along its continuation: all the path gathered after
     // it, over the throughput to the next vertex; recorded over the direction's density. And what
     // the vertex sent back: all the path gathered from it on, over the throughput that reached it.
-    std::vector<Record>* records = &out;
     for (int i = 0; i < n; ++i) {
         const PathVertex& v = vertices[i];
         if (v.guided_record) {
             const float Li = mean_ratio(L - v.L_before, v.beta_after);
-            records->push_back({v.p, v.direction, Li / v.pdf, Record::kIncoming});
+            out.push_back({v.p, v.direction, Li / v.pdf, Record::kIncoming});
             if (v.a < 1) {  // the fraction's gradient (BsdfFractionFit), where the vertex was guided
                 const float gradient = BsdfFractionFit::gradient(v.f_cos * Li / v.pdf, v.pdf, v.pdf_bsdf, v.pdf_tree, v.a);
-                records->push_back({v.p, v.direction, gradient, Record::kFraction});
+                out.push_back({v.p, v.direction, gradient, Record::kFraction});
             }
         }
-        records->push_back({v.p, Vec3f(0.0f), mean_ratio(L - v.L_start, v.beta_start), Record::kOutgoing});
+        out.push_back({v.p, Vec3f(0.0f), mean_ratio(L - v.L_start, v.beta_start), Record::kOutgoing});
     }
 }
 
@@ -321,18 +323,14 @@ ColourOf<T> PathGuiding<T>::trace_in_media(const Scene& scene, const Ray& camera
         const ScatterSample<T> s = sample_scatter(scene, v, sampler, st, /*mis=*/true, wl, power, nullptr, g);
         if (!s.sampled) break;
         L += beta * s.next_seg * s.found / st.density();
-        const Vec3f wo = normalize(s.ray.d);
-        if (!rules_.may_bounce(bounces + 1) || s.next.kind == MediumWalk::kEscaped || s.next.kind == MediumWalk::kLost) {
-            if (pv && !s.delta) pv->direction = wo, pv->pdf = s.pdf, pv->guided_record = true, pv->L_before = L_before, pv->beta_after = beta * s.next_seg * s.weight / st.density();
-            break;
-        }
-        beta = beta * s.next_seg * s.weight;
+        const Colour beta_next = beta * s.next_seg * s.weight;
         if (pv && !s.delta) {
-            pv->direction = wo, pv->pdf = s.pdf, pv->guided_record = true, pv->L_before = L_before, pv->beta_after = beta / st.density();
-            if (g.on && learn_fraction) {
-                pv->a = g.a, pv->f_cos = mean_of(s.weight) * s.pdf, pv->pdf_bsdf = s.pdf_scatter, pv->pdf_tree = g.pdf(wo);
-            }
+            const Vec3f wo = normalize(s.ray.d);
+            pv->direction = wo, pv->pdf = s.pdf, pv->guided_record = true, pv->L_before = L_before, pv->beta_after = beta_next / st.density();
+            if (g.on && learn_fraction) pv->a = g.a, pv->f_cos = mean_of(s.weight) * s.pdf, pv->pdf_bsdf = s.pdf_scatter, pv->pdf_tree = g.pdf(wo);
         }
+        if (!rules_.may_bounce(bounces + 1) || s.next.kind == MediumWalk::kEscaped || s.next.kind == MediumWalk::kLost) break;
+        beta = beta_next;
         w = s.next;
         // Adjoint-driven roulette on beta / density where the next vertex's leaf knows its
         // radiance (no splitting in media: a copy would need its own media state), else volpath's.

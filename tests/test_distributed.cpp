@@ -528,8 +528,11 @@ void Distributed::expect_two_ranks_equal_one_process(const std::vector<std::stri
     for (const std::string& a : algorithms) {
         std::string text = a == "volpath" ? fog : scene;
         if (a != "volpath")
-            text.insert(text.find(open) + open.size(), a == "pbgi" ? "<integrator type=\"pbgi\"><integer name=\"surfels\" value=\"1500\"/></integrator>"
-                                                                   : "<integrator type=\"" + a + "\"/>");
+            text.insert(text.find(open) + open.size(),
+                        a == "pbgi"  ? "<integrator type=\"pbgi\"><integer name=\"surfels\" value=\"1500\"/></integrator>"
+                        : a == "ppg" ? "<integrator type=\"ppg\"><string name=\"guiding_fraction\" value=\"learned\"/><boolean "
+                                       "name=\"guiding_rr\" value=\"true\"/></integrator>"
+                                     : "<integrator type=\"" + a + "\"/>");
         std::ofstream(path(a + ".xml")) << text;
         list += (list.empty() ? "" : ",") + path(a + ".xml");
     }
@@ -543,15 +546,17 @@ void Distributed::expect_two_ranks_equal_one_process(const std::vector<std::stri
     }
 }
 
+// ppg's ranks train one tree together (each traces a share of the rows, the records exchanged and
+// added in row order), here with the learned fraction and the adjoint-driven roulette.
 TEST_F(Distributed, TwoRanksOfOneThreadEqualOneProcessOfTwoThreadsForEveryIntegrator) {
-    expect_two_ranks_equal_one_process({"pt-mis", "lt", "bdpt", "sppm", "ppm", "pm", "vcm", "bpm", "ic", "pbgi", "volpath", "pssmlt"}, "");
+    expect_two_ranks_equal_one_process({"pt-mis", "lt", "bdpt", "sppm", "ppm", "pm", "vcm", "bpm", "ic", "pbgi", "volpath", "pssmlt", "ppg"}, "");
     expect_two_ranks_equal_one_process({"mmlt"}, "--max-depth 5");
 }
 
 // Spectral mode's wavelengths come from per-sample (or per-pass) streams, so ranks give the
 // one-process bytes there too.
 TEST_F(Distributed, TwoRanksEqualOneProcessInSpectralMode) {
-    expect_two_ranks_equal_one_process({"pt-mis", "lt", "bdpt", "sppm", "pm", "vcm", "ic", "pbgi", "volpath"}, "--spectral");
+    expect_two_ranks_equal_one_process({"pt-mis", "lt", "bdpt", "sppm", "pm", "vcm", "ic", "pbgi", "volpath", "ppg"}, "--spectral");
 }
 
 // --display-server with two ranks: the root sends the ranks' films summed. The first update

@@ -2,8 +2,10 @@
 
 #include <mpi.h>
 
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -70,6 +72,20 @@ public:
         MPI_Bcast(&len, 1, MPI_UINT64_T, 0, MPI_COMM_WORLD);
         text.resize(len);
         MPI_Bcast(text.data(), int(len), MPI_CHAR, 0, MPI_COMM_WORLD);
+    }
+
+    std::vector<std::string> all_gather(const std::string& bytes) override {
+        int len = int(bytes.size());
+        std::vector<int> lens(static_cast<size_t>(size_)), offsets(static_cast<size_t>(size_));
+        MPI_Allgather(&len, 1, MPI_INT, lens.data(), 1, MPI_INT, MPI_COMM_WORLD);
+        int64_t total = 0;
+        for (size_t r = 0; r < lens.size(); ++r) offsets[r] = int(total), total += lens[r];
+        if (total > INT32_MAX) throw std::runtime_error("all_gather: more than 2 GiB from all ranks together");
+        std::string all(size_t(total), '\0');
+        MPI_Allgatherv(bytes.data(), len, MPI_CHAR, all.data(), lens.data(), offsets.data(), MPI_CHAR, MPI_COMM_WORLD);
+        std::vector<std::string> out;
+        for (size_t r = 0; r < lens.size(); ++r) out.push_back(all.substr(size_t(offsets[r]), size_t(lens[r])));
+        return out;
     }
 
     void abort(int code) override { MpiSession::abort(code); }

@@ -130,6 +130,14 @@ struct IntegratorOptions {
     int ris_candidates = kDefaultRisCandidates;  // --ris-candidates: the light samples ris resamples
 };
 
+// The processes that render one image together (MPI ranks), as prepare() may share its work
+// among them: all_gather(bytes) gives every rank's bytes in rank order, on every rank (all ranks
+// call it at the same points). One process alone: rank 0 of 1.
+struct PrepareRanks {
+    int rank = 0, size = 1;
+    std::function<std::vector<std::string>(const std::string&)> all_gather;
+};
+
 // What every pass of one render sees; fixed for the whole render.
 struct RenderContext {
     const Scene& scene;
@@ -143,6 +151,8 @@ struct RenderContext {
     // --aovs: the first non-specular vertex of every camera sample, summed per pixel (pixel
     // integrators only: records_aovs()); null: none.
     AovFilm* aovs = nullptr;
+    // The ranks rendering this image (null: this process alone).
+    const PrepareRanks* ranks = nullptr;
 
     size_t pixel_count() const { return size_t(width) * size_t(height); }
 };

@@ -36,6 +36,8 @@ public:
     virtual std::vector<std::string> gather_text(const std::string& text) = 0;
     // The root's text on every rank.
     virtual void broadcast_text(std::string& text) = 0;
+    // Every rank's bytes (of any lengths, each below 2 GiB), in rank order, on every rank.
+    virtual std::vector<std::string> all_gather(const std::string& bytes) = 0;
     // The films of all ranks summed (PixelSums::merge), chunk by chunk of at most
     // `chunk_pixels` pixels: on the root `use(first pixel, sums, count)` sees every chunk once,
     // in order; `film` is not changed.
@@ -80,6 +82,7 @@ public:
     std::vector<double> gather(std::span<const double> values) override { return {values.begin(), values.end()}; }
     std::vector<std::string> gather_text(const std::string& text) override { return {text}; }
     void broadcast_text(std::string&) override {}
+    std::vector<std::string> all_gather(const std::string& bytes) override { return {bytes}; }
     void abort(int) override {}
     void reduce_film(const Film& film, size_t chunk_pixels, const ChunkUse& use) override {
         for (size_t first = 0; first < film.pixel_count(); first += chunk_pixels)

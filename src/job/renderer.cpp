@@ -3,6 +3,7 @@
 #include <chrono>
 #include <algorithm>
 #include <new>
+#include <span>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -72,7 +73,21 @@ RenderStats render_into(const Scene& scene, Integrator& integrator, const Render
     const int rank_count = ranks.size(), me = ranks.rank();
     const PerspectiveCamera camera(scene.camera(), w, h);
     const PixelFilter filter(scene.description().filter, w, h);
-    const RenderContext ctx{scene, camera, w, h, settings.seed, settings.sampler, settings.tile_size, &filter, settings.aovs};
+    // prepare()'s exchange between the ranks, in pieces of at most 256 MiB from each (MPI counts
+    // are ints): every rank's bytes on every rank.
+    PrepareRanks prepare_ranks{me, rank_count, [&ranks, rank_count](const std::string& mine) {
+                                   constexpr size_t kPiece = size_t(1) << 28;
+                                   double rounds = double((mine.size() + kPiece - 1) / kPiece);
+                                   ranks.all_max(std::span<double>(&rounds, 1));
+                                   std::vector<std::string> all(static_cast<size_t>(rank_count));
+                                   for (size_t k = 0; k < size_t(rounds); ++k) {
+                                       const std::vector<std::string> pieces =
+                                           ranks.all_gather(k * kPiece < mine.size() ? mine.substr(k * kPiece, kPiece) : std::string());
+                                       for (size_t r = 0; r < all.size(); ++r) all[r] += pieces[r];
+                                   }
+                                   return all;
+                               }};
+    const RenderContext ctx{scene, camera, w, h, settings.seed, settings.sampler, settings.tile_size, &filter, settings.aovs, &prepare_ranks};
     const bool show_progress = settings.progress && ranks.root();
     Progress progress(show_progress);
     const auto start = std::chrono::steady_clock::now();

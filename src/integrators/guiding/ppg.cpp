@@ -36,6 +36,9 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cstring>
+#include <string>
+#include <type_traits>
 
 #include "core/sampling.hpp"
 #include "integrators/common/camera_ray.hpp"
@@ -98,8 +101,12 @@ void PathGuiding<T>::prepare(const RenderContext& ctx, const PassProgress& progr
     uint64_t total = 0, done = 0, first = 0;
     for (uint64_t s : sizes) total += s;
     const int w = ctx.width, h = ctx.height;
-    // Rows are traced in parallel a block at a time, and their records added in row order.
+    // Rows are traced in parallel a block at a time, and their records added in row order. With
+    // several ranks (MPI) each traces every size-th row of a block, and the ranks exchange their
+    // rows' records before every rank adds all of them in row order: the same tree everywhere, and
+    // the same as one process's, in a share of its time.
     const int block_rows = std::max(1, std::min(h, 65536 / std::max(1, w)));
+    const int rank = ctx.ranks ? ctx.ranks->rank : 0, ranks = ctx.ranks && ctx.ranks->all_gather ? ctx.ranks->size : 1;
     std::vector<std::vector<Record>> row_records(static_cast<size_t>(block_rows));
     for (const uint64_t spp : sizes) {
         for (int y0 = 0; y0 < h; y0 += block_rows) {
@@ -107,6 +114,7 @@ void PathGuiding<T>::prepare(const RenderContext& ctx, const PassProgress& progr
             tbb::parallel_for(0, rows, [&](int r) {
                 std::vector<Record>& out = row_records[size_t(r)];
                 out.clear();
+                if (r % ranks != rank) return;
                 const int y = y0 + r;
                 for (int x = 0; x < w; ++x) {
                     const size_t pixel = size_t(y) * size_t(w) + size_t(x);
@@ -119,6 +127,7 @@ void PathGuiding<T>::prepare(const RenderContext& ctx, const PassProgress& progr
                     }
                 }
             });
+            if (ranks > 1) exchange_rows(*ctx.ranks, row_records, rows);
             for (int r = 0; r < rows; ++r)
                 for (const Record& rec : row_records[size_t(r)]) switch (rec.kind) {
                         case Record::kIncoming: tree_.record(rec.p, rec.direction, rec.value); break;
@@ -134,6 +143,32 @@ void PathGuiding<T>::prepare(const RenderContext& ctx, const PassProgress& progr
     }
     training_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     prepared_.set(ctx);
+}
+
+template <class T>
+void PathGuiding<T>::exchange_rows(const PrepareRanks& ranks, std::vector<std::vector<Record>>& row_records, int rows) {
+    // This rank's rows (every size-th from its rank on), each its record count and its records.
+    static_assert(std::is_trivially_copyable_v<Record>);
+    std::string mine;
+    for (int r = ranks.rank; r < rows; r += ranks.size) {
+        const std::vector<Record>& records = row_records[size_t(r)];
+        const uint64_t n = records.size();
+        mine.append(reinterpret_cast<const char*>(&n), sizeof n).append(reinterpret_cast<const char*>(records.data()), n * sizeof(Record));
+    }
+    const std::vector<std::string> all = ranks.all_gather(mine);
+    for (int k = 0; k < ranks.size; ++k) {
+        const std::string& bytes = all[size_t(k)];
+        size_t at = 0;
+        for (int r = k; r < rows; r += ranks.size) {
+            uint64_t n = 0;
+            std::memcpy(&n, bytes.data() + at, sizeof n);
+            at += sizeof n;
+            std::vector<Record>& records = row_records[size_t(r)];
+            records.resize(size_t(n));
+            std::memcpy(records.data(), bytes.data() + at, size_t(n) * sizeof(Record));
+            at += size_t(n) * sizeof(Record);
+        }
+    }
 }
 
 template <class T>
@@ -239,7 +274,7 @@ ColourOf<T> PathGuiding<T>::walk(const Scene& scene, Intersection hit, Vec3f dir
         hit = found.isect;
         dir = wo_world;
     }
-    if (records) add_records(vertices, n, L, *records);
+    if (records) add_records(vertices, n, L, options_.guiding_rr, *records);
     return L;
 }
 
@@ -258,10 +293,11 @@ LeafGuide PathGuiding<T>::leaf_guide(const GuidingLeaf* leaf, bool guidable) con
 }
 
 template <class T>
-void PathGuiding<T>::add_records(const PathVertex* vertices, int n, const Colour& L, std::vector<Record>& out) {
+void PathGuiding<T>::add_records(const PathVertex* vertices, int n, const Colour& L, bool outgoing, std::vector<Record>& out) {
     // What arrived at each recorded vertex along its continuation: all the path gathered after
     // it, over the throughput to the next vertex; recorded over the direction's density. And what
-    // the vertex sent back: all the path gathered from it on, over the throughput that reached it.
+    // the vertex sent back: all the path gathered from it on, over the throughput that reached it
+    // (for adjoint-driven roulette only: `outgoing`).
     for (int i = 0; i < n; ++i) {
         const PathVertex& v = vertices[i];
         if (v.guided_record) {
@@ -272,7 +308,7 @@ void PathGuiding<T>::add_records(const PathVertex* vertices, int n, const Colour
                 out.push_back({v.p, v.direction, gradient, Record::kFraction});
             }
         }
-        out.push_back({v.p, Vec3f(0.0f), mean_ratio(L - v.L_start, v.beta_start), Record::kOutgoing});
+        if (outgoing) out.push_back({v.p, Vec3f(0.0f), mean_ratio(L - v.L_start, v.beta_start), Record::kOutgoing});
     }
 }
 
@@ -348,7 +384,7 @@ ColourOf<T> PathGuiding<T>::trace_in_media(const Scene& scene, const Ray& camera
             beta = weight * st.density();
         }
     }
-    if (records) add_records(vertices.data(), n, L, *records);
+    if (records) add_records(vertices.data(), n, L, options_.guiding_rr, *records);
     return L;
 }
 

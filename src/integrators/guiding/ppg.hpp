@@ -102,8 +102,10 @@ private:
     static std::pair<float, float> weight_window(float pixel, float next);
     // The guiding at a vertex whose leaf is `leaf` (null: untrained), where the BSDF may be guided.
     LeafGuide leaf_guide(const GuidingLeaf* leaf, bool guidable) const;
+    // The records of a block's `rows` rows, each traced by one rank (row r by rank r % size), on every rank.
+    static void exchange_rows(const PrepareRanks& ranks, std::vector<std::vector<Record>>& row_records, int rows);
     // A training path's records, from its recorded vertices and all it gathered (L).
-    static void add_records(const PathVertex* vertices, int n, const Colour& L, std::vector<Record>& out);
+    static void add_records(const PathVertex* vertices, int n, const Colour& L, bool outgoing, std::vector<Record>& out);
 
     IntegratorOptions options_;
     PathRules rules_;

@@ -35,14 +35,28 @@ Vec3f VmfLobe::sample(Vec2f u) const {
 VmfMixture::VmfMixture() {
     for (int k = 0; k < kLobes; ++k) {
         const Vec3f corner(k & 1 ? 1.0f : -1.0f, k & 2 ? 1.0f : -1.0f, k & 4 ? 1.0f : -1.0f);
-        lobes_[size_t(k)] = {normalize(corner), kInitialKappa, 1.0f / float(kLobes)};
+        set_lobe(k, {normalize(corner), kInitialKappa, 1.0f / float(kLobes)});
     }
 }
 
-float VmfMixture::pdf(const Vec3f& d) const {
-    float p = 0;
-    for (const VmfLobe& l : lobes_) p += l.weight * l.pdf(d);
+void VmfMixture::set_lobe(int k, const VmfLobe& lobe) {
+    const size_t i = size_t(k);
+    lobes_[i] = lobe;
+    const bool uniform = lobe.kappa < kUniformKappa;
+    kappa_[i] = uniform ? 0.0f : lobe.kappa;
+    scale_[i] = lobe.weight * (uniform ? uniform_sphere_pdf() : lobe.kappa / (2.0f * kPi * -std::expm1(-2.0f * lobe.kappa)));
+}
+
+std::array<float, VmfMixture::kLobes> VmfMixture::weighted_lobe_pdfs(const Vec3f& d) const {
+    std::array<float, kLobes> p;
+    for (size_t k = 0; k < size_t(kLobes); ++k) p[k] = scale_[k] * std::exp(kappa_[k] * (std::min(dot(lobes_[k].mean, d), 1.0f) - 1.0f));
     return p;
+}
+
+float VmfMixture::pdf(const Vec3f& d) const {
+    float sum = 0;
+    for (const float p : weighted_lobe_pdfs(d)) sum += p;
+    return sum;
 }
 
 Vec3f VmfMixture::sample(Vec2f u) const {
@@ -63,13 +77,9 @@ void VmfMixtureFit::add(const Vec3f& d, float weight) {
     if (!(weight > 0) || !std::isfinite(weight)) return;
     ++directions_;
     // The responsibilities of the lobes of the mixture before this batch.
-    std::array<float, VmfMixture::kLobes> gamma{};
+    const std::array<float, VmfMixture::kLobes> gamma = mixture_.weighted_lobe_pdfs(d);
     float total = 0;
-    for (int k = 0; k < VmfMixture::kLobes; ++k) {
-        const VmfLobe& l = mixture_.lobes()[size_t(k)];
-        gamma[size_t(k)] = l.weight * l.pdf(d);
-        total += gamma[size_t(k)];
-    }
+    for (const float g : gamma) total += g;
     if (!(total > 0)) return;
     for (int k = 0; k < VmfMixture::kLobes; ++k) {
         const double g = double(weight) * double(gamma[size_t(k)] / total);
@@ -105,15 +115,17 @@ void VmfMixtureFit::step() {
     constexpr float kFloor = kWeightPrior / float(VmfMixture::kLobes);
     for (int k = 0; k < VmfMixture::kLobes; ++k) {
         const size_t i = size_t(k);
-        VmfLobe& l = mixture_.lobes()[i];
+        VmfLobe l = mixture_.lobes()[i];
         l.weight = float(s0_[i] / s0_sum) * (1.0f - kWeightPrior) + kFloor;
         const double length_s1 = std::sqrt(s1_[i][0] * s1_[i][0] + s1_[i][1] * s1_[i][1] + s1_[i][2] * s1_[i][2]);
-        if (!(s0_[i] > 0) || !(length_s1 > 0)) continue;  // a lobe no direction reached keeps its shape
-        l.mean = normalize(Vec3f(float(s1_[i][0]), float(s1_[i][1]), float(s1_[i][2])));
-        // The mean cosine, pulled towards 0 by the prior's virtual directions (n: the directions the lobe took).
-        const double n = s0_[i] / s0_sum * double(directions_);
-        const float r = std::min(float(length_s1 / s0_[i] * n / (n + double(kMeanCosinePrior))), kMaxMeanCosine);
-        l.kappa = r * (3.0f - r * r) / (1.0f - r * r);
+        if (s0_[i] > 0 && length_s1 > 0) {  // (a lobe no direction reached keeps its shape)
+            l.mean = normalize(Vec3f(float(s1_[i][0]), float(s1_[i][1]), float(s1_[i][2])));
+            // The mean cosine, pulled towards 0 by the prior's virtual directions (n: the directions the lobe took).
+            const double n = s0_[i] / s0_sum * double(directions_);
+            const float r = std::min(float(length_s1 / s0_[i] * n / (n + double(kMeanCosinePrior))), kMaxMeanCosine);
+            l.kappa = r * (3.0f - r * r) / (1.0f - r * r);
+        }
+        mixture_.set_lobe(k, l);
     }
 }
 

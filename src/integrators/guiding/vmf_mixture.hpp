@@ -46,12 +46,17 @@ public:
     // The untrained mixture: kLobes broad lobes, equal weights, means at the cube's corners.
     VmfMixture();
     float pdf(const Vec3f& d) const;  // per steradian, integrating to 1 over the sphere
+    // Each lobe's weighted density pi_k v(d; mu_k, kappa_k) (summing to pdf(d)).
+    std::array<float, kLobes> weighted_lobe_pdfs(const Vec3f& d) const;
     Vec3f sample(Vec2f u) const;      // a direction with density pdf() (r in [0, 1)^2)
     const std::array<VmfLobe, kLobes>& lobes() const { return lobes_; }
-    std::array<VmfLobe, kLobes>& lobes() { return lobes_; }
+    void set_lobe(int k, const VmfLobe& lobe);
 
 private:
     std::array<VmfLobe, kLobes> lobes_;
+    // Per lobe pi_k times v's normalisation, and the kappa of its exponent (0 for a uniform lobe):
+    // a density is then one exponential per lobe.
+    std::array<float, kLobes> scale_{}, kappa_{};
 };
 
 class VmfMixtureFit {

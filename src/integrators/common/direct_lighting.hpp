@@ -43,6 +43,57 @@ struct BsdfStrategyPdf {
     float operator()(const Vec3f&, float pdf_bsdf) const { return pdf_bsdf; }
 };
 
+// A guided path tracer's distribution of directions at a vertex (ppg): the continuation is drawn
+// from the one-sample mixture a p_scatter + (1 - a) p_guide (a Dirac lobe only from the BSDF
+// half, with probability a times its own), and light sampling is weighed against the mixture's
+// density. NoGuide, everyone else's: the BSDF or phase function alone (a = 1).
+//   bool guides() const;              whether the vertex is guided (else a = 1)
+//   float fraction() const;           a
+//   float pdf(const Vec3f& w) const;  p_guide of a world direction, per steradian
+//   Vec3f sample(Vec2f u) const;      a world direction drawn from p_guide
+//   float mixture(const Vec3f& w, float pdf_scatter) const;  the continuation's density of w
+//   float mis_pdf(const Vec3f& w, float pdf_scatter) const;  the density light sampling is weighed against
+struct NoGuide {
+    bool guides() const { return false; }
+    float fraction() const { return 1.0f; }
+    float pdf(const Vec3f&) const { return 0.0f; }
+    Vec3f sample(Vec2f) const { return Vec3f(0.0f, 0.0f, 1.0f); }
+    float mixture(const Vec3f&, float pdf_scatter) const { return pdf_scatter; }
+    float mis_pdf(const Vec3f&, float pdf_scatter) const { return pdf_scatter; }
+};
+
+// A continuation at a surface drawn from the BSDF, or (from_guide) from the guide with the BSDF
+// evaluated there: the sample, its value f, its world direction and the continuation's density
+// (guide.mixture; a Dirac lobe's a times its own). None where the BSDF has no sample, or is black
+// in the guide's direction.
+template <class Wl>
+struct GuidedBsdfSample {
+    BsdfSample s;
+    ColourAt<Wl> f;
+    Vec3f wo_world;
+    float pdf;
+};
+
+template <class Wl, class Guide>
+std::optional<GuidedBsdfSample<Wl>> sample_bsdf_or_guide(const ShadingPoint& sp, Vec2f u, bool from_guide, const Guide& guide, Wl& wl) {
+    std::optional<BsdfSample> s;
+    ColourAt<Wl> f(0.0f);
+    if (!from_guide) {
+        s = bsdf_sample(sp, u, wl);
+        if (!s) return std::nullopt;
+        f = bsdf_sample_colour(sp, *s, wl);
+    } else {
+        const Vec3f wo = sp.frame.to_local(guide.sample(u));
+        float pdf_bsdf = 0;
+        f = bsdf_eval(sp, wo, wl, pdf_bsdf);
+        if (is_black(f)) return std::nullopt;
+        s = BsdfSample{wo, Rgb(0.0f), pdf_bsdf, false, 0, 0};
+    }
+    const Vec3f wo_world = sp.frame.to_world(s->wo);
+    const float pdf = s->delta ? guide.fraction() * s->pdfW : guide.mixture(wo_world, s->pdfW);
+    return GuidedBsdfSample<Wl>{*s, f, wo_world, pdf};
+}
+
 // The light a light sample found, for estimators that learn from it (a guided path tracer): its
 // direction and the radiance arriving from it over the sample's density, MIS-weighted.
 template <class Wl>

@@ -21,23 +21,6 @@ struct ScatterVertex {
     int32_t medium = -1;  // the medium the path arrived in
 };
 
-// A guided path tracer's distribution of directions at a vertex (ppg in media): the continuation
-// is drawn from the one-sample mixture a p_scatter + (1 - a) p_guide (a Dirac lobe only from the
-// BSDF half, with probability a times its own), and light sampling is weighed against the
-// mixture's density. NoGuide, volpath's: the BSDF or phase function alone (a = 1).
-//   bool guides() const;              whether the vertex is guided (else a = 1)
-//   float fraction() const;           a
-//   float pdf(const Vec3f& w) const;  p_guide of a world direction, per steradian
-//   Vec3f sample(Vec2f u) const;      a world direction drawn from p_guide
-//   float mis_pdf(const Vec3f& w, float pdf_scatter) const;  the density light sampling is weighed against
-struct NoGuide {
-    bool guides() const { return false; }
-    float fraction() const { return 1.0f; }
-    float pdf(const Vec3f&) const { return 0.0f; }
-    Vec3f sample(Vec2f) const { return Vec3f(0.0f, 0.0f, 1.0f); }
-    float mis_pdf(const Vec3f&, float pdf_scatter) const { return pdf_scatter; }
-};
-
 // Next-event estimation at a vertex: pt-mis's estimate_light_sample (the same random numbers,
 // the same arithmetic at a surface), with the shadow ray's transmittance. With `seen`, the light
 // it found (its direction, and Le Tr times the MIS weight over the sample's density).
@@ -152,31 +135,18 @@ ScatterSample<T> sample_scatter(const Scene& scene, const ScatterVertex& v, Samp
     int light;
     const Vec2f u = sampler.next2d();
     const bool guided = guide.guides() && !(sampler.next1d() < guide.fraction());  // (NoGuide draws no choice)
-    // The continuation's density of a world direction w whose BSDF or phase density is pdf_scatter.
-    const auto mixture = [&](const Vec3f& w, float pdf_scatter) {
-        return guide.guides() ? guide.fraction() * pdf_scatter + (1.0f - guide.fraction()) * guide.pdf(w) : pdf_scatter;
-    };
     if (v.sp) {
         const ShadingPoint& sp = *v.sp;
         const MediumWalk& w = *v.hit;
-        std::optional<BsdfSample> s;
-        Colour f;
-        if (!guided) {
-            s = bsdf_sample(sp, u, wl);
-            if (!s) return n;
-            f = bsdf_sample_colour(sp, *s, wl);
-        } else {
-            const Vec3f wo = sp.frame.to_local(guide.sample(u));
-            float pdf_bsdf = 0;
-            f = bsdf_eval(sp, wo, wl, pdf_bsdf);
-            if (is_black(f)) return n;
-            s = BsdfSample{wo, Rgb(0.0f), pdf_bsdf, false, 0, 0};
-        }
-        const Vec3f wo_world = sp.frame.to_world(s->wo);
+        const auto g = sample_bsdf_or_guide(sp, u, guided, guide, wl);
+        if (!g) return n;
+        const BsdfSample* s = &g->s;
+        const Colour& f = g->f;
+        const Vec3f& wo_world = g->wo_world;
         n.sampled = true;
         n.lobe = s->lobe;
         n.pdf_scatter = s->pdfW;
-        n.pdf = s->delta ? guide.fraction() * s->pdfW : mixture(wo_world, s->pdfW);
+        n.pdf = g->pdf;
         if (guide.guides() && !(n.pdf > 0)) return ScatterSample<T>{};
         n.delta = s->delta;
         n.ray = sp.spawn(s->wo);
@@ -201,7 +171,7 @@ ScatterSample<T> sample_scatter(const Scene& scene, const ScatterVertex& v, Samp
         if (!(ps.pdfW > 0)) return n;
         n.sampled = true;
         n.pdf_scatter = ps.pdfW;
-        n.pdf = mixture(ps.wo, ps.pdfW);
+        n.pdf = guide.mixture(ps.wo, ps.pdfW);
         n.ray = Ray{v.p, ps.wo, kInf};
         n.medium = v.medium;
         n.next = walk_media(scene, n.ray, n.medium, st, n.next_seg);

@@ -203,11 +203,7 @@ ColourOf<T> PathGuiding<T>::walk(const Scene& scene, Intersection hit, Vec3f dir
         if (sp.material->is_black()) break;
         const GuidingLeaf* leaf = guided_ ? (next_leaf ? next_leaf : &tree_.leaf(sp.p)) : nullptr;
         const LeafGuide g = leaf_guide(leaf, (sp.material->lobes() & (kLobeDiffuse | kLobeGlossy)) != 0);
-        const bool guide = g.on;
-        const float a = g.a;
-        // The tree's solid-angle density of a direction (local), and the continuation's of one of BSDF density pdf_bsdf.
-        const auto tree_pdf = [&](const Vec3f& w) { return leaf->pdf(sp.frame.to_world(w)); };
-        const auto mixture_pdf = [&](const Vec3f& w, float pdf_bsdf) { return g.mixture(sp.frame.to_world(w), pdf_bsdf); };
+        // Light sampling weighed against the continuation's density (the light's direction is local here).
         const auto light_mis_pdf = [&](const Vec3f& w, float pdf_bsdf) { return g.mis_pdf(sp.frame.to_world(w), pdf_bsdf); };
         PathVertex* v = records && n < kRecordedVertices ? &vertices[n++] : nullptr;
         if (v) *v = {sp.p, Vec3f(0.0f), 0.0f, false, L, beta, L, beta};
@@ -217,30 +213,16 @@ ColourOf<T> PathGuiding<T>::walk(const Scene& scene, Intersection hit, Vec3f dir
 
         // The continuation: the BSDF's sample (always without guiding), or the tree's.
         const Vec2f u = sampler.next2d();
-        std::optional<BsdfSample> s;
-        Colour f(0.0f);
-        float pdf = 0;
-        if (!guide || sampler.next1d() < a) {
-            s = bsdf_sample(sp, u, wl);
-            if (s) {
-                f = bsdf_sample_colour(sp, *s, wl);
-                pdf = s->delta ? a * s->pdfW : mixture_pdf(s->wo, s->pdfW);
-            }
-        } else {
-            const Vec3f wo = sp.frame.to_local(leaf->sample(u));
-            float pdf_bsdf = 0;
-            f = bsdf_eval(sp, wo, wl, pdf_bsdf);
-            if (!is_black(f)) {
-                s = BsdfSample{wo, Rgb(0.0f), pdf_bsdf, false, 0, 0};
-                pdf = mixture_pdf(wo, pdf_bsdf);
-            }
-        }
-        if (!s || !(pdf > 0)) break;
+        const auto c = sample_bsdf_or_guide(sp, u, g.on && !(sampler.next1d() < g.a), g, wl);
+        if (!c || !(c->pdf > 0)) break;
+        const BsdfSample* s = &c->s;
+        const Colour& f = c->f;
+        const float pdf = c->pdf;
         const Colour step = f * (std::abs(s->wo.z) / pdf);
-        const Vec3f wo_world = sp.frame.to_world(s->wo);
+        const Vec3f wo_world = c->wo_world;
         if (v && !s->delta) {
             v->direction = wo_world, v->pdf = pdf, v->guided_record = true, v->L_before = L, v->beta_after = beta * step;
-            if (guide && learn_fraction) v->a = a, v->f_cos = mean_of(f) * std::abs(s->wo.z), v->pdf_bsdf = s->pdfW, v->pdf_tree = tree_pdf(s->wo);
+            if (g.on && learn_fraction) v->a = g.a, v->f_cos = mean_of(f) * std::abs(s->wo.z), v->pdf_bsdf = s->pdfW, v->pdf_tree = g.pdf(wo_world);
         }
         const EmitterHit found = trace_to_emitter(scene, sp.spawn(s->wo), sp.p, sp.frame.n);
         if (!is_black(found.Le)) {
@@ -329,10 +311,11 @@ ColourOf<T> PathGuiding<T>::trace_in_media(const Scene& scene, const Ray& camera
     int n = 0;
     const bool power = rules_.power_mis();
     const bool learn_fraction = records && options_.guiding_fraction == kLearnedGuidingFraction;
-    // Adjoint-driven roulette's estimate of the pixel: the radiance the first vertex's leaf sends back.
-    const float pixel = guided_ && options_.guiding_rr && !records && w.kind != MediumWalk::kLost
-                            ? tree_.leaf(w.kind == MediumWalk::kSurface ? w.isect.p : w.p).outgoing
-                            : 0.0f;
+    const auto leaf_at = [&](const MediumWalk& m) -> const GuidingLeaf& { return tree_.leaf(m.kind == MediumWalk::kSurface ? m.isect.p : m.p); };
+    // Adjoint-driven roulette's estimate of the pixel: the radiance the first vertex's leaf sends
+    // back; next_leaf: the leaf of w, when the roulette has looked it up.
+    const GuidingLeaf* next_leaf = guided_ && options_.guiding_rr && !records && w.kind != MediumWalk::kLost ? &leaf_at(w) : nullptr;
+    const float pixel = next_leaf ? next_leaf->outgoing : 0.0f;
     for (int bounces = 0; w.kind != MediumWalk::kLost && rules_.may_bounce(bounces); ++bounces) {
         ScatterVertex v;
         v.medium = w.medium;
@@ -348,7 +331,7 @@ ColourOf<T> PathGuiding<T>::trace_in_media(const Scene& scene, const Ray& camera
             v.wi = -w.dir / length(w.dir);
             v.phase = &medium_phase(scene.medium(w.medium));
         }
-        const LeafGuide g = leaf_guide(guided_ ? &tree_.leaf(v.p) : nullptr, guidable);
+        const LeafGuide g = leaf_guide(guided_ ? (next_leaf ? next_leaf : &tree_.leaf(v.p)) : nullptr, guidable);
         PathVertex* pv = records && n < kRecordedVertices ? &vertices[size_t(n++)] : nullptr;
         const Colour throughput = beta / st.density();
         if (pv) *pv = {v.p, Vec3f(0.0f), 0.0f, false, L, throughput, L, throughput};
@@ -370,7 +353,8 @@ ColourOf<T> PathGuiding<T>::trace_in_media(const Scene& scene, const Ray& camera
         w = s.next;
         // Adjoint-driven roulette on beta / density where the next vertex's leaf knows its
         // radiance (no splitting in media: a copy would need its own media state), else volpath's.
-        const float next = pixel > 0 ? tree_.leaf(w.kind == MediumWalk::kSurface ? w.isect.p : w.p).outgoing : 0.0f;
+        next_leaf = pixel > 0 ? &leaf_at(w) : nullptr;
+        const float next = next_leaf ? next_leaf->outgoing : 0.0f;
         Colour weight = beta / st.density();
         if (next > 0) {
             const float b = mean_of(weight), lower = weight_window(pixel, next).first;

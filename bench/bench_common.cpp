@@ -46,6 +46,7 @@ RenderResult run(const Scene& scene, const std::string& algorithm, int size, int
     r.sampler = sampler;
     // The scene's light sampler (the job refuses a shared scene built with another one).
     if (scene.light_sampler().kind() != LightSamplerKind::Power) r.light_sampler = scene.light_sampler().kind();
+    if (scene.light_sampler().kind() == LightSamplerKind::Bvh) r.light_split = scene.light_sampler().split();
     // The caller's scene, shared without ownership: its BVH is built once for many runs.
     RenderJob job(scene_choice_of(scene.description()), r, std::shared_ptr<const Scene>(std::shared_ptr<const Scene>(), &scene));
     job.settings.after_pass = std::move(after_pass);

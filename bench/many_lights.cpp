@@ -20,7 +20,18 @@
 namespace pathlab::bench {
 
 void many_lights_suite(const ManyLightsOptions& o) {
-    const LightSamplerKind kinds[] = {LightSamplerKind::Uniform, LightSamplerKind::Power, LightSamplerKind::Bvh, LightSamplerKind::Ris};
+    // The samplers compared: every kind, and bvh with adaptive splitting (--light-split).
+    struct Sampler {
+        std::string name;
+        LightSamplerKind kind;
+        float split;
+    };
+    const std::vector<Sampler> samplers = {{"uniform", LightSamplerKind::Uniform, 0},
+                                           {"power", LightSamplerKind::Power, 0},
+                                           {"bvh", LightSamplerKind::Bvh, 0},
+                                           {fmt::format("bvh split {:g}", o.split), LightSamplerKind::Bvh, o.split},
+                                           {"ris", LightSamplerKind::Ris, 0}};
+    const size_t kPower = 1, kBvh = 2;
     std::vector<std::pair<std::string, SceneDescription>> scenes;
     for (const std::string& f : o.scene_files) scenes.emplace_back(f, load_scene_file(std::string(PATHLAB_SOURCE_DIR) + "/scenes/" + f));
     for (const int i : o.scenes) scenes.emplace_back(fmt::format("{} {}", i, builtin_scene_choice(i).name), make_builtin_scene(i));
@@ -29,34 +40,35 @@ void many_lights_suite(const ManyLightsOptions& o) {
                "candidates)\n\n",
                o.size, o.size, o.seconds, o.repeats, o.ref_spp, kDefaultRisCandidates);
     std::string head = "| scene | lights | algorithm |", rule = "|---|---|---|";
-    for (const LightSamplerKind k : kinds) head += fmt::format(" MSE {} |", light_sampler_name(k)), rule += "---|";
-    for (const LightSamplerKind k : kinds)
-        if (k != LightSamplerKind::Power) head += fmt::format(" power/{} |", light_sampler_name(k)), rule += "---|";
-    for (const LightSamplerKind k : kinds) head += fmt::format(" spp {} |", light_sampler_name(k)), rule += "---|";
+    for (const Sampler& k : samplers) head += fmt::format(" MSE {} |", k.name), rule += "---|";
+    for (size_t k = 0; k < samplers.size(); ++k)
+        if (k != kPower) head += fmt::format(" power/{} |", samplers[k].name), rule += "---|";
+    for (const Sampler& k : samplers) head += fmt::format(" spp {} |", k.name), rule += "---|";
     fmt::print("{}\n{}\n", head, rule);
     for (auto& [name, desc] : scenes) {
-        std::map<LightSamplerKind, std::unique_ptr<Scene>> built;
-        for (const LightSamplerKind k : kinds) {
+        std::vector<std::unique_ptr<Scene>> built;
+        for (const Sampler& k : samplers) {
             SceneDescription d = desc;
-            d.light_sampler = k;
-            built[k] = Scene::build(d);
+            d.light_sampler = k.kind;
+            d.light_split = k.split;
+            built.push_back(Scene::build(d));
         }
         for (const std::string& algorithm : o.algorithms) {
-            const Reference ref = make_reference(*built[LightSamplerKind::Bvh], algorithm, o.size, o.ref_spp);
-            std::map<LightSamplerKind, std::vector<double>> mse, spp;
+            const Reference ref = make_reference(*built[kBvh], algorithm, o.size, o.ref_spp);
+            std::vector<std::vector<double>> mse(samplers.size()), spp(samplers.size());
             for (int round = 0; round < o.repeats; ++round)
-                for (const LightSamplerKind k : kinds) {
+                for (size_t k = 0; k < samplers.size(); ++k) {
                     const RenderResult r = run(*built[k], algorithm, o.size, 0, o.seconds, uint64_t(1000 + round));
                     const double e = rmse(r.film.mean(), ref);
                     mse[k].push_back(e * e);
                     spp[k].push_back(double(r.stats.spp));
                 }
-            std::string row = fmt::format("| {} | {} | {} |", name, built[LightSamplerKind::Power]->lights().size(), algorithm);
-            const double p = median(mse[LightSamplerKind::Power]);
-            for (const LightSamplerKind k : kinds) row += fmt::format(" {:.3g} |", median(mse[k]));
-            for (const LightSamplerKind k : kinds)
-                if (k != LightSamplerKind::Power) row += fmt::format(" {:.2f} |", p / median(mse[k]));
-            for (const LightSamplerKind k : kinds) row += fmt::format(" {:.0f} |", median(spp[k]));
+            std::string row = fmt::format("| {} | {} | {} |", name, built[kPower]->lights().size(), algorithm);
+            const double p = median(mse[kPower]);
+            for (size_t k = 0; k < samplers.size(); ++k) row += fmt::format(" {:.3g} |", median(mse[k]));
+            for (size_t k = 0; k < samplers.size(); ++k)
+                if (k != kPower) row += fmt::format(" {:.2f} |", p / median(mse[k]));
+            for (size_t k = 0; k < samplers.size(); ++k) row += fmt::format(" {:.0f} |", median(spp[k]));
             fmt::print("{}\n", row);
             std::fflush(stdout);
         }

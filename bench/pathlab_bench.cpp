@@ -12,7 +12,7 @@
 //   pathlab_bench pbgi-gather  pbgi's gather against a ray-traced truth per cutoff and micro-buffer
 //   pathlab_bench volumes  volpath: samples/s, equal-time RMSE with and without MIS, optical thickness
 //   pathlab_bench distributed  2 MPI ranks against 1 process, film reduction, checkpoints
-//   pathlab_bench many-lights   light samplers (uniform, power, bvh, ris) at equal time; the light BVH's build time and memory
+//   pathlab_bench many-lights   light samplers (uniform, power, bvh, bvh with splitting, ris) at equal time; the light BVH's build time and memory
 //   pathlab_bench lights   an environment map's cost per sample against the constant environment; spot and IES
 //   pathlab_bench textures textured against constant materials per sample; texture lookups
 //   pathlab_bench diff     a gradient's cost (path replay) relative to a primal render, its memory vs spp and depth
@@ -142,7 +142,7 @@ int main(int argc, char** argv) {
     lic->add_option("--scenes", lo.scenes, "Course scene indices with an environment")->delimiter(',')->capture_default_str();
     lic->add_option("--map-width", lo.map_width, "Width of the constant environment map")->capture_default_str();
     ManyLightsOptions mlo;
-    CLI::App* mlc = app.add_subcommand("many-lights", "Light samplers (uniform, power, bvh, ris) at equal time; the light BVH's build time and memory");
+    CLI::App* mlc = app.add_subcommand("many-lights", "Light samplers (uniform, power, bvh, bvh with splitting, ris) at equal time; the light BVH's build time and memory");
     mlc->add_option("--size", mlo.size, "Image width and height")->capture_default_str();
     mlc->add_option("--seconds", mlo.seconds, "Seconds per timed render")->capture_default_str();
     mlc->add_option("--repeats", mlo.repeats, "Interleaved rounds (medians reported)")->capture_default_str();
@@ -150,6 +150,7 @@ int main(int argc, char** argv) {
     mlc->add_option("--scene-files", mlo.scene_files, "Scene files of scenes/")->delimiter(',')->capture_default_str();
     mlc->add_option("--scenes", mlo.scenes, "Course scene indices")->delimiter(',')->capture_default_str();
     mlc->add_option("--algorithms", mlo.algorithms, "Integrators that sample lights")->delimiter(',')->capture_default_str();
+    mlc->add_option("--split", mlo.split, "The --light-split of the splitting bvh column")->capture_default_str();
     DistributedOptions dopt;
     CLI::App* dist = app.add_subcommand("distributed", "2 MPI ranks against 1 process, film reduction, checkpoint write and size");
     dist->add_option("--size", dopt.size, "Image width and height of the speedup renders")->capture_default_str();

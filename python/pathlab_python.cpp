@@ -324,6 +324,7 @@ OptionGroups command_options(const RenderJob& job, const JobRequest& r, bool alg
     if (r.rr_depth) option("--rr-depth", fmt::format("{}", *r.rr_depth));
     if (r.light_sampler) option("--light-sampler", light_sampler_name(*r.light_sampler));
     if (r.ris_candidates) option("--ris-candidates", fmt::format("{}", *r.ris_candidates));
+    if (r.light_split) option("--light-split", fmt::format("{}", *r.light_split));
     if (threads > 0) option("--threads", fmt::format("{}", threads));
     // The estimators' options by their command-line names (checked by apply_estimator_options).
     for (const auto& [key, value] : estimator_options) {
@@ -343,7 +344,7 @@ OptionGroups command_options(const RenderJob& job, const JobRequest& r, bool alg
 py::tuple py_render(const py::object& scene_obj, const py::object& algorithm, const py::object& spp_arg, const py::object& seed_arg,
                  const py::object& threads_arg, double time, const py::object& resolution, const py::object& max_depth_arg,
                  const py::object& sampler, bool spectral, const py::object& rr_depth_arg, const py::object& light_sampler,
-                 const py::object& ris_candidates_arg, const py::object& first_sample_arg, const py::object& checkpoint_arg,
+                 const py::object& ris_candidates_arg, const py::object& light_split_arg, const py::object& first_sample_arg, const py::object& checkpoint_arg,
                  double checkpoint_every, const py::object& resume_arg, const py::object& aovs_arg, const py::kwargs& estimator_options) {
     constexpr int kIntMax = std::numeric_limits<int>::max();
     // As the command line: sample indices from 2^62 on are refused (such a render never ends);
@@ -377,6 +378,12 @@ py::tuple py_render(const py::object& scene_obj, const py::object& algorithm, co
         if (!request.light_sampler) throw py::value_error(fmt::format("unknown light sampler '{}'; valid: {}", name, kLightSamplerNames));
     }
     request.ris_candidates = ris_candidates;
+    if (!light_split_arg.is_none()) {
+        const double split = light_split_arg.cast<double>();
+        if (!(split >= 0) || !(split <= kMaxLightSplit))
+            throw py::value_error(fmt::format("light_split must be between 0 (no splitting) and {}", kMaxLightSplit));
+        request.light_split = float(split);
+    }
     apply_estimator_options(request, estimator_options);
     if (!resolution.is_none()) {
         const auto size = py::isinstance<py::tuple>(resolution) || py::isinstance<py::list>(resolution)
@@ -704,15 +711,15 @@ PYBIND11_MODULE(pathlab, m) {
     m.def("render", &py_render, py::arg("scene"), py::arg("algorithm") = py::none(), py::arg("spp") = py::none(), py::arg("seed") = py::int_(1234),
           py::arg("threads") = py::int_(0), py::kw_only(), py::arg("time") = 0.0, py::arg("resolution") = py::none(), py::arg("max_depth") = py::none(),
           py::arg("sampler") = "independent", py::arg("spectral") = false, py::arg("rr_depth") = py::none(),
-          py::arg("light_sampler") = py::none(), py::arg("ris_candidates") = py::none(), py::arg("first_sample") = py::int_(0),
+          py::arg("light_sampler") = py::none(), py::arg("ris_candidates") = py::none(), py::arg("light_split") = py::none(), py::arg("first_sample") = py::int_(0),
           py::arg("checkpoint") = py::none(), py::arg("checkpoint_every") = kDefaultCheckpointEvery, py::arg("resume") = py::none(),
           py::arg("aovs") = py::none(),
           "Renders a scene (a pathlab.Scene, or what load() takes) and returns (image, standard_error), float32 arrays of shape\n"
           "(height, width, 3). As the command line: algorithm defaults to the scene file's integrator, else pt-mis; spp to the\n"
           "scene file's sample count, else 64 (unlimited with time=seconds); seed to 1234; threads=0 uses all cores. The same\n"
           "settings give the same bytes as `pathlab SCENE -a ALGORITHM --spp N --seed S -o out.exr`; spectral, rr_depth,\n"
-          "light_sampler ('uniform', 'power', 'bvh', 'ris') and ris_candidates are --spectral, --rr-depth, --light-sampler and\n"
-          "--ris-candidates. The estimators' own options go by their command-line names: mis='power', photons, radius, alpha,\n"
+          "light_sampler ('uniform', 'power', 'bvh', 'ris'), ris_candidates and light_split are --spectral, --rr-depth,\n"
+          "--light-sampler, --ris-candidates and --light-split. The estimators' own options go by their command-line names: mis='power', photons, radius, alpha,\n"
           "volume_estimate='points', no_merging=True, no_connections=True, ic_rays, ic_error, ic_no_gradients=True, pbgi_surfels,\n"
           "pbgi_cutoff, pbgi_bounces, pbgi_resolution, pbgi_direct_samples, pbgi_spacing, guiding_spp, guiding_rr=True, guiding_fraction (0.5 or 'learned'), guiding ('sd-tree' or 'vmm'), estimators, photon_beams, beam_radius (refused for another estimator),\n"
           "null_depth='skip' (--null-depth).\n"

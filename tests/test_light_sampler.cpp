@@ -40,9 +40,10 @@ SceneDescription mixed_lights(LightSamplerKind kind) {
     return d;
 }
 
-SceneDescription many_lights(LightSamplerKind kind) {
+SceneDescription many_lights(LightSamplerKind kind, float split = 0) {
     SceneDescription d = load_scene_file(std::string(PATHLAB_SOURCE_DIR) + "/scenes/many-lights.xml");
     d.light_sampler = kind;
+    d.light_split = split;
     return d;
 }
 
@@ -315,7 +316,7 @@ TEST(LightBvh, PrefersNearLightsAndRulesOutLightsFacingAway) {
 TEST(LightSamplerAgreement, EverySamplerConvergesToTheSameImage) {
     const AgreementOptions agreement{1e-3, 1e-4};
     for (const bool many : {false, true}) {
-        auto render_with = [&](LightSamplerKind kind, uint64_t seed) {
+        auto render_with = [&](LightSamplerKind kind, uint64_t seed, float split = 0) {
             JobRequest r;
             r.algorithm = "pt-mis";
             r.spp = many ? 256 : 2048;
@@ -323,6 +324,7 @@ TEST(LightSamplerAgreement, EverySamplerConvergesToTheSameImage) {
             r.seed = seed;
             r.max_depth = 3;
             r.light_sampler = kind;
+            if (split > 0) r.light_split = split;
             RenderJob job(many ? scene_choice_of(many_lights(kind)) : builtin_scene_choice(3), r);
             return job.run();
         };
@@ -332,33 +334,40 @@ TEST(LightSamplerAgreement, EverySamplerConvergesToTheSameImage) {
             const AgreementResult res = test_agreement(a.film.mean(), a.film.standard_error(), base.film.mean(), base.film.standard_error(), agreement);
             EXPECT_TRUE(res.agree) << light_sampler_name(kind) << " vs power, many=" << many << ": " << res.describe();
         }
+        // bvh with adaptive splitting (a threshold that splits the top levels on most of the hall's floor).
+        const RenderResult a = render_with(LightSamplerKind::Bvh, 3, 0.5f);
+        const AgreementResult res = test_agreement(a.film.mean(), a.film.standard_error(), base.film.mean(), base.film.standard_error(), agreement);
+        EXPECT_TRUE(res.agree) << "bvh with splitting vs power, many=" << many << ": " << res.describe();
     }
 }
 
 // The same bytes with 1 and 2 threads (the tree is read-only; every choice is a function of the
-// sample's own numbers).
+// sample's own numbers); bvh also with splitting.
 TEST(LightBvh, DeterministicAcrossThreadCounts) {
+    for (const float split : {0.0f, 0.5f})
     for (const LightSamplerKind kind : {LightSamplerKind::Bvh, LightSamplerKind::Ris}) {
-        SceneDescription d = many_lights(kind);
+        if (split > 0 && kind != LightSamplerKind::Bvh) continue;
+        SceneDescription d = many_lights(kind, split);
         JobRequest r;
         r.algorithm = "pt-mis";
         r.spp = 4;
         r.width = 32, r.height = 24;
         r.light_sampler = kind;
+        if (split > 0) r.light_split = split;
         auto run = [&](int threads) {
             tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
             RenderJob job(scene_choice_of(d), r);
             return job.run();
         };
         const RenderResult a = run(1), b = run(2);
-        EXPECT_TRUE(bit_identical(a.film.mean(), b.film.mean())) << light_sampler_name(kind);
+        EXPECT_TRUE(bit_identical(a.film.mean(), b.film.mean())) << light_sampler_name(kind) << " split " << split;
     }
 }
 
 // volpath's next-event estimation in a medium (the phase function as ris's target) and on
 // surfaces in fog: ris against power, per-pixel z-tests as above.
 TEST(LightSamplerAgreement, RisInFogConvergesToPowersImage) {
-    auto render_with = [&](LightSamplerKind kind, uint64_t seed) {
+    auto render_with = [&](LightSamplerKind kind, uint64_t seed, float split = 0) {
         JobRequest r;
         r.algorithm = "volpath";
         r.spp = 1024;
@@ -366,13 +375,18 @@ TEST(LightSamplerAgreement, RisInFogConvergesToPowersImage) {
         r.seed = seed;
         r.max_depth = 3;
         r.light_sampler = kind;
+        if (split > 0) r.light_split = split;
         RenderJob job(scene_choice_of(load_scene_file(std::string(PATHLAB_SOURCE_DIR) + "/scenes/fog-box.xml")), r);
         return job.run();
     };
-    const RenderResult a = render_with(LightSamplerKind::Ris, 2), base = render_with(LightSamplerKind::Power, 1);
-    const AgreementResult res = test_agreement(a.film.mean(), a.film.standard_error(), base.film.mean(), base.film.standard_error(),
-                                               AgreementOptions{1e-3, 1e-4});
-    EXPECT_TRUE(res.agree) << res.describe();
+    const RenderResult base = render_with(LightSamplerKind::Power, 1);
+    // ris, and bvh with a threshold low enough to split the fog box's light (two triangles) at most points.
+    for (const auto& [kind, split] : {std::pair{LightSamplerKind::Ris, 0.0f}, std::pair{LightSamplerKind::Bvh, 0.05f}}) {
+        const RenderResult a = render_with(kind, 2, split);
+        const AgreementResult res = test_agreement(a.film.mean(), a.film.standard_error(), base.film.mean(), base.film.standard_error(),
+                                                   AgreementOptions{1e-3, 1e-4});
+        EXPECT_TRUE(res.agree) << light_sampler_name(kind) << " split " << split << ": " << res.describe();
+    }
 }
 
 // Resampled importance sampling at a point (light_resampling.hpp): with g the unshadowed
@@ -436,6 +450,21 @@ TEST(LightSamplerOption, RefusedByIntegratorsThatDoNotChooseLightsAtShadingPoint
     EXPECT_NO_THROW(RenderJob(builtin_scene_choice(4), r));
 }
 
+TEST(LightSamplerOption, LightSplitOnlyWithBvhAndInRange) {
+    JobRequest r;
+    r.algorithm = "pt-mis";
+    r.light_split = 0.5f;
+    EXPECT_THROW(RenderJob(builtin_scene_choice(4), r), UsageError);
+    r.light_sampler = LightSamplerKind::Ris;
+    EXPECT_THROW(RenderJob(builtin_scene_choice(4), r), UsageError);
+    r.light_sampler = LightSamplerKind::Bvh;
+    EXPECT_NO_THROW(RenderJob(builtin_scene_choice(4), r));
+    for (const float bad : {-0.5f, kMaxLightSplit * 2, std::numeric_limits<float>::quiet_NaN()}) {
+        r.light_split = bad;
+        EXPECT_THROW(RenderJob(builtin_scene_choice(4), r), UsageError) << bad;
+    }
+}
+
 TEST(LightSamplerOption, RisCandidatesOnlyWithRisAndInRange) {
     JobRequest r;
     r.algorithm = "pt-mis";
@@ -472,6 +501,76 @@ TEST(LightBvh, LowersTheVarianceOfUnshadowedIrradianceOnTheManyLightFloor) {
         v_bvh -= sum * sum, v_power -= sum * sum;
         RecordProperty("variance_ratio", std::to_string(v_power / v_bvh));
         EXPECT_LT(v_bvh * 3, v_power) << "at (" << p.x << ", " << p.y << "): power " << v_power << ", bvh " << v_bvh;
+    }
+}
+
+// Adaptive splitting (--light-split): at points of the hall's floor and of the mixed-light
+// scene, every light choose_split returns carries the pmf pmf() gives it (bit for bit: the
+// BSDF-sampled half of MIS reads it), no light comes twice, and the sum over the returned lights
+// of E_i / pmf_i (E_i: light i's unshadowed irradiance at the point, or 1 for every light of
+// positive pmf) has the mean sum_i E_i (a z-test at a false-alarm rate of 1e-6 per point); on
+// the hall its variance is below the unsplit bvh's per choice.
+TEST(LightBvh, SplittingIsUnbiasedAndItsPmfIsWhatMisReads) {
+    struct Moments {
+        double sum = 0, sum2 = 0;
+        int n = 0;
+        void add(double x) { sum += x, sum2 += x * x, ++n; }
+        double mean() const { return sum / n; }
+        double variance() const { return std::max(0.0, sum2 / n - mean() * mean()); }
+        double standard_error() const { return std::sqrt(variance() / n); }
+    };
+    for (const bool many : {true, false}) {
+        SceneDescription d = many ? many_lights(LightSamplerKind::Bvh) : mixed_lights(LightSamplerKind::Bvh);
+        d.light_split = 0.5f;
+        const auto split = Scene::build(d);
+        d.light_split = 0;
+        const auto plain = Scene::build(d);
+        ASSERT_GT(split->light_sampler().split(), 0.0f);
+        const auto points = many ? std::vector<Vec3f>{Vec3f(0, 2, 0.01f), Vec3f(1, 12, 0.01f), Vec3f(-2, 22, 0.01f)}
+                                 : std::vector<Vec3f>{Vec3f(0.3f, -0.2f, 0.001f), Vec3f(-1.2f, 0.7f, 0.001f)};
+        const Vec3f n(0, 0, 1);
+        int split_points = 0;
+        for (const Vec3f& p : points) {
+            // E_i: the unshadowed irradiance of a light (its power over distance squared, times the
+            // receiver's cosine, for the tiles; 1 for the rest).
+            const auto E = [&](int i) -> double {
+                const auto* t = std::get_if<TriangleLight>(&split->lights()[size_t(i)]);
+                if (!t) return 1.0;
+                const Vec3f c = t->p0 + (t->e1 + t->e2) / 3.0f, dv = c - p;
+                const float d2 = dot(dv, dv);
+                const Vec3f w = dv / std::sqrt(d2);
+                return mean(t->radiance) * t->area * std::max(0.0f, -dot(t->normal, w)) * std::max(0.0f, dot(n, w)) / d2;
+            };
+            double expected_e = 0, expected_count = 0;
+            for (int i = 0; i < int(split->lights().size()); ++i)
+                if (split->light_pmf(p, n, i) > 0) expected_e += E(i), expected_count += 1;
+            Moments e_split, count_split, e_plain;
+            Sampler rng(23, 0, 0);
+            int most = 0;
+            for (int k = 0; k < 100000; ++k) {
+                LightChoice chosen[kMaxSplitLights];
+                const int m = split->light_sampler().choose_split(p, n, rng.next1d(), chosen);
+                ASSERT_LE(m, kMaxSplitLights);
+                most = std::max(most, m);
+                double e = 0, c = 0;
+                for (int j = 0; j < m; ++j) {
+                    ASSERT_EQ(chosen[j].pmf, split->light_pmf(p, n, chosen[j].index)) << "light " << chosen[j].index;
+                    for (int l = 0; l < j; ++l) ASSERT_NE(chosen[l].index, chosen[j].index);
+                    e += E(chosen[j].index) / chosen[j].pmf, c += 1 / chosen[j].pmf;
+                }
+                e_split.add(e), count_split.add(c);
+                const LightChoice one = plain->choose_light(p, n, rng.next1d());
+                e_plain.add(one.index >= 0 ? E(one.index) / one.pmf : 0.0);
+            }
+            split_points += most > 1;
+            for (const auto& [m, target, what] : {std::tuple{&e_split, expected_e, "irradiance"}, std::tuple{&count_split, expected_count, "count"}}) {
+                const double z = (m->mean() - target) / m->standard_error();
+                EXPECT_LT(std::abs(z), 4.9) << "many=" << many << " at (" << p.x << ", " << p.y << ") " << what << ": " << m->mean() << " +- "
+                                            << m->standard_error() << " against " << target;
+            }
+            if (many) EXPECT_LT(e_split.variance() * 2, e_plain.variance()) << "at (" << p.x << ", " << p.y << ")";
+        }
+        EXPECT_GT(split_points, 0) << "many=" << many << ": no point split";
     }
 }
 

@@ -116,6 +116,11 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
     app.add_option("--ris-candidates", o.ris_candidates,
                    fmt::format("--light-sampler ris: the light samples drawn to keep one (1 to {}; default {})", kMaxRisCandidates,
                                kDefaultRisCandidates));
+    app.add_option("--light-split", o.light_split,
+                   fmt::format("--light-sampler bvh: adaptive splitting (Conty Estevez and Kulla 2018): a node of the tree's top {} "
+                               "levels whose bounding sphere's radius over its distance to the shading point exceeds this "
+                               "gives a light sample for each of its children instead of choosing one (0: never; up to {}; default {})",
+                               kMaxSplitDepth, kMaxLightSplit, kDefaultLightSplit));
     app.add_option("--mis", o.mis, "bdpt, vcm, bpm, upbp, mmlt, pt-mis, pt-mis3, direct-mis, volpath: the MIS heuristic, balance or power (Mitsuba's path tracers')")->capture_default_str();
     app.add_option("--strategies", o.strategies_dir,
                    "bdpt: also write one image per strategy (s, t), weighted and unweighted, and montages, into this directory "
@@ -229,6 +234,7 @@ std::vector<RenderJob> make_jobs(const RenderCommandOptions& o, bool check_paths
             throw UsageError(fmt::format("unknown light sampler '{}'. Valid light samplers: {}", *o.light_sampler, kLightSamplerNames));
     }
     request.ris_candidates = o.ris_candidates;
+    request.light_split = o.light_split;
     if (o.null_depth) {
         if (*o.null_depth != "count" && *o.null_depth != "skip")
             throw UsageError(fmt::format("unknown --null-depth '{}'. Valid: count, skip", *o.null_depth));

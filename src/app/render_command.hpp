@@ -38,6 +38,7 @@ struct RenderCommandOptions {
     std::optional<std::string> light_sampler;
     std::optional<std::string> null_depth;  // --null-depth count|skip
     std::optional<int> ris_candidates;
+    std::optional<float> light_split;
     std::string strategies_dir;
     int strategies_depth = 4;
     std::optional<int64_t> photons;

@@ -67,9 +67,12 @@ public:
             const VertexBsdf* v = vb ? &*vb : nullptr;
 
             // Next-event estimation, as estimate_light_sample(mis = true).
-            const LightChoice choice = scene_.choose_light(sp.p, sp.frame.n, sampler.next1d());
+            // (With adaptive splitting, one light sample for each light choose_split returns.)
+            LightChoice chosen[kMaxSplitLights];
+            const int n_chosen = scene_.light_sampler().choose_split(sp.p, sp.frame.n, sampler.next1d(), chosen);
             const Vec2f u = sampler.next2d();
-            if (choice.index >= 0) {
+            for (int i = 0; i < n_chosen; ++i) {
+                const LightChoice choice = chosen[i];
                 const Light& light = scene_.lights()[size_t(choice.index)];
                 const auto ls = sample_light(light, sp.p, u);
                 if (ls && !is_black(ls->Le) && !(dot(ls->wi, sp.ng) <= 0 && !sp.material->transmits())) {

@@ -128,6 +128,7 @@ struct IntegratorOptions {
     // How next-event estimation chooses a light (--light-sampler); the scene is built with it.
     LightSamplerKind light_sampler = LightSamplerKind::Power;
     int ris_candidates = kDefaultRisCandidates;  // --ris-candidates: the light samples ris resamples
+    float light_split = 0;  // --light-split: bvh's adaptive splitting threshold (0: none)
 };
 
 // The processes that render one image together (MPI ranks), as prepare() may share its work

@@ -69,6 +69,7 @@ std::string options_text(const IntegratorOptions& o) {
            (o.spectral ? " mode=spectral" : "") + (o.volume_beam ? "" : " volume=points") + (o.skip_null_events ? " null_depth=skip" : "") +
            (o.light_sampler == LightSamplerKind::Power ? "" : fmt::format(" lights={}", light_sampler_name(o.light_sampler))) +
            (o.light_sampler == LightSamplerKind::Ris ? fmt::format(" ris={}", o.ris_candidates) : "") +
+           (o.light_split > 0 ? fmt::format(" split={}", hex_float(o.light_split)) : "") +
            (o.mlt_chains == defaults.mlt_chains && o.mlt_bootstrap == defaults.mlt_bootstrap && o.mlt_large_step == defaults.mlt_large_step &&
                     o.mlt_sigma == defaults.mlt_sigma
                 ? ""

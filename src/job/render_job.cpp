@@ -337,6 +337,11 @@ RenderJob::RenderJob(SceneChoice scene, const JobRequest& r) : choice_(std::move
     options_.ris_candidates = r.ris_candidates.value_or(kDefaultRisCandidates);
     if (options_.ris_candidates < 1 || options_.ris_candidates > kMaxRisCandidates)
         throw UsageError(fmt::format("--ris-candidates must be between 1 and {}, not {}", kMaxRisCandidates, options_.ris_candidates));
+    if (r.light_split && options_.light_sampler != LightSamplerKind::Bvh)
+        throw UsageError("--light-split is the light tree's adaptive splitting threshold; give --light-sampler bvh");
+    options_.light_split = r.light_split.value_or(options_.light_sampler == LightSamplerKind::Bvh ? kDefaultLightSplit : 0.0f);
+    if (!(options_.light_split >= 0) || !(options_.light_split <= kMaxLightSplit))
+        throw UsageError(fmt::format("--light-split must be between 0 (no splitting) and {}, not {}", kMaxLightSplit, options_.light_split));
     options_.spectral = r.spectral || d.spectral;
     if (options_.photons < 0) throw UsageError("--photons must be zero (the default count) or positive");
     if (!(options_.photon_radius >= 0) || !std::isfinite(options_.photon_radius))
@@ -394,6 +399,7 @@ const Scene& RenderJob::scene() {
         if (options_.spectral) check_spectral_materials(choice_.description);
         choice_.description.light_sampler = options_.light_sampler;
         choice_.description.ris_candidates = options_.ris_candidates;
+        choice_.description.light_split = options_.light_split;
         scene_ = Scene::build(choice_.description);
     }
     return *scene_;

@@ -70,6 +70,7 @@ struct JobRequest {
     std::optional<float> beam_radius;         // --beam-radius (upbp)
     std::optional<LightSamplerKind> light_sampler;  // --light-sampler (next-event estimation; default power)
     std::optional<int> ris_candidates;              // --ris-candidates (ris)
+    std::optional<float> light_split;               // --light-split (bvh)
     std::optional<int> mlt_chains;                  // --chains (pssmlt)
     std::optional<int> mlt_bootstrap;               // --bootstrap (pssmlt)
     std::optional<float> mlt_large_step;            // --large-step (pssmlt)
@@ -103,7 +104,8 @@ public:
     RenderJob(SceneChoice scene, const JobRequest& request, std::shared_ptr<const Scene> built)
         : RenderJob(std::move(scene), request) {
         if (built->light_sampler().kind() != options_.light_sampler ||
-            (options_.light_sampler == LightSamplerKind::Ris && built->light_sampler().candidates() != options_.ris_candidates))
+            (options_.light_sampler == LightSamplerKind::Ris && built->light_sampler().candidates() != options_.ris_candidates) ||
+            built->light_sampler().split() != options_.light_split)
             throw std::invalid_argument("RenderJob: the shared scene was built with another light sampler");
         scene_ = std::move(built);
     }

@@ -24,6 +24,11 @@ std::optional<LightSamplerKind> parse_light_sampler(const std::string& name) {
 
 namespace {
 
+template <class Node> void set_sphere(Node& node, const LightBounds& b) {
+    node.centre[0] = b.centre.x, node.centre[1] = b.centre.y, node.centre[2] = b.centre.z;
+    node.radius = b.radius;
+}
+
 // The solid angle a group's emission can reach, M_Omega of Conty Estevez and Kulla (the
 // orientation factor of the surface area orientation heuristic that splits the tree).
 float orientation_measure(const LightBounds& b) {
@@ -46,8 +51,9 @@ float split_cost(const LightBounds& b) {
 }  // namespace
 
 LightSampler::LightSampler(const std::vector<Light>& lights, const SceneSphere& sphere, LightSamplerKind kind, int candidates,
-                           const std::vector<int>& emitter_of)
-    : kind_(kind), count_(int(lights.size())), candidates_(kind == LightSamplerKind::Ris ? candidates : 1) {
+                           const std::vector<int>& emitter_of, float split)
+    : kind_(kind), count_(int(lights.size())), candidates_(kind == LightSamplerKind::Ris ? candidates : 1),
+      split_(kind == LightSamplerKind::Bvh ? split : 0.0f) {
     if (kind_ == LightSamplerKind::Power) power_ = LightDistribution(lights, sphere);
     if (kind_ == LightSamplerKind::Uniform) {
         // 1 / (the number of emitters) each, shared among an emitter's lights by their areas.
@@ -81,6 +87,7 @@ LightSampler::LightSampler(const std::vector<Light>& lights, const SceneSphere& 
         nodes_[0].bounds.set(0, binary[0].bounds);
         nodes_[0].child[0] = ~binary[0].light;
         trails_[size_t(binary[0].light)] = {0, 1};
+        set_sphere(nodes_[0], binary[0].bounds);
     } else {
         collapse(binary, 0, 0, 0);
     }
@@ -178,6 +185,7 @@ int LightSampler::collapse(const std::vector<BinaryNode>& binary, int b, int dep
     }
     const int index = int(nodes_.size());
     nodes_.emplace_back();
+    set_sphere(nodes_[size_t(index)], binary[size_t(b)].bounds);
     for (int k = 0; k < int(lanes.size()); ++k) {
         const BinaryNode& lane = binary[size_t(lanes[size_t(k)].node)];
         const uint64_t lane_trail = trail | (uint64_t(k) << (2 * depth));
@@ -208,6 +216,21 @@ float lane_importances(const LightBounds4& bounds, const Vec3f& p, const Vec3f& 
     return (importance[0] + importance[1]) + (importance[2] + importance[3]);
 }
 
+// The lane of a node whose share of [0, sum) holds u * sum (empty for a lane of importance 0;
+// counting the bounds below it takes no branch and no division, which would wait for the sum),
+// the last lane of positive importance where rounding leaves it past the sum; u is rescaled to
+// [0, 1) within the lane.
+int pick_lane(const float importance[4], float sum, float& u) {
+    constexpr float kBelowOne = 0x1.fffffep-1f;
+    const float c0 = importance[0], c1 = c0 + importance[1], c2 = c1 + importance[2];
+    const float x = u * sum;
+    int lane = int(x >= c0) + int(x >= c1) + int(x >= c2);
+    while (!(importance[lane] / sum > 0)) --lane;  // (a lane of positive importance, not so small its share rounds to 0)
+    const float below = lane == 0 ? 0.0f : lane == 1 ? c0 : lane == 2 ? c1 : c2;
+    u = std::min(std::max(0.0f, x - below) / importance[lane], kBelowOne);
+    return lane;
+}
+
 }  // namespace
 
 LightChoice LightSampler::choose(const Vec3f& p, const Vec3f& n, float u) const {
@@ -231,22 +254,58 @@ LightChoice LightSampler::choose(const Vec3f& p, const Vec3f& n, float u) const 
         const Node& at = nodes_[size_t(node)];
         float importance[4];
         const float sum = lane_importances(at.bounds, p, n, importance);
-        // The lane whose share of [0, sum) holds u * sum (empty for a lane of importance 0; counting
-        // the bounds below it takes no branch and no division, which would wait for the sum), the
-        // last lane of positive importance where rounding leaves it past the sum; u is rescaled
-        // to [0, 1) within the lane.
-        const float c0 = importance[0], c1 = c0 + importance[1], c2 = c1 + importance[2];
         if (!(sum > 0)) return {};
-        const float x = u * sum;
-        int lane = int(x >= c0) + int(x >= c1) + int(x >= c2);
-        while (!(importance[lane] / sum > 0)) --lane;  // (a lane of positive importance, not so small its share rounds to 0)
-        const float below = lane == 0 ? 0.0f : lane == 1 ? c0 : lane == 2 ? c1 : c2;
+        const int lane = pick_lane(importance, sum, u);
         pmf *= importance[lane] / sum;  // as pmf() multiplies it
-        u = std::min(std::max(0.0f, x - below) / importance[lane], kBelowOne);
         const int child = at.child[lane];
         if (child < 0) return {~child, pmf};
         node = child;
     }
+}
+
+int LightSampler::choose_split(const Vec3f& p, const Vec3f& n, float u, LightChoice* out) const {
+    if (!(split_ > 0) || nodes_.empty()) {
+        out[0] = choose(p, n, u);
+        return out[0].index >= 0 ? 1 : 0;
+    }
+    constexpr float kBelowOne = 0x1.fffffep-1f;
+    const float share = infinite_share();
+    if (u < share) {
+        out[0] = choose(p, n, u);
+        return 1;
+    }
+    u = std::min((u - share) / (1 - share), kBelowOne);
+    // Depth first, a split node's lanes in order; every descent gets u (rescaled by its own choices).
+    struct Open {
+        int node, depth;
+        float pmf, u;
+    };
+    Open stack[kMaxSplitLights];
+    int open = 0, count = 0;
+    stack[open++] = {0, 0, 1 - share, u};
+    while (open > 0) {
+        const Open o = stack[--open];
+        const Node& at = nodes_[size_t(o.node)];
+        float importance[4];
+        const float sum = lane_importances(at.bounds, p, n, importance);
+        if (!(sum > 0)) continue;
+        if (splits(at, o.depth, p)) {
+            for (int lane = 3; lane >= 0; --lane) {  // pushed last to first: taken first to last
+                if (!(importance[lane] > 0)) continue;
+                const int child = at.child[lane];
+                if (child < 0) out[count++] = {~child, o.pmf};  // a leaf lane: its light at once
+                else stack[open++] = {child, o.depth + 1, o.pmf, o.u};
+            }
+            continue;
+        }
+        float v = o.u;
+        const int lane = pick_lane(importance, sum, v);
+        const float pmf = o.pmf * (importance[lane] / sum);  // as pmf() multiplies it
+        const int child = at.child[lane];
+        if (child < 0) out[count++] = {~child, pmf};
+        else stack[open++] = {child, o.depth + 1, pmf, v};
+    }
+    return count;
 }
 
 float LightSampler::pmf(const Vec3f& p, const Vec3f& n, int light) const {
@@ -268,7 +327,11 @@ float LightSampler::pmf(const Vec3f& p, const Vec3f& n, int light) const {
         const float sum = lane_importances(at.bounds, p, n, importance);
         const int lane = int((trail.lanes >> (2 * level)) & 3);
         if (!(sum > 0)) return 0.0f;
-        pmf *= importance[lane] / sum;  // as choose() multiplies it
+        if (splits(at, level, p)) {  // every lane of positive importance is descended into
+            if (!(importance[lane] > 0)) return 0.0f;
+        } else {
+            pmf *= importance[lane] / sum;  // as choose() multiplies it
+        }
         node = at.child[lane];
     }
     return pmf;

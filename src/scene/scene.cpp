@@ -192,7 +192,7 @@ std::unique_ptr<Scene> Scene::build(const SceneDescription& desc) {
     }
 
     s->light_distribution_ = LightDistribution(s->lights_, s->scene_sphere());
-    s->light_sampler_ = LightSampler(s->lights_, s->scene_sphere(), desc.light_sampler, desc.ris_candidates, emitter_of);
+    s->light_sampler_ = LightSampler(s->lights_, s->scene_sphere(), desc.light_sampler, desc.ris_candidates, emitter_of, desc.light_split);
     if (s->has_media_) {
         // A point of each light on its emitting side (the middle of its emission sampling's domain).
         const float offset = 1e-4f * s->radius_;

@@ -74,6 +74,7 @@ struct SceneDescription {
     // How next-event estimation chooses a light (--light-sampler; not a scene-file setting).
     LightSamplerKind light_sampler = LightSamplerKind::Power;
     int ris_candidates = kDefaultRisCandidates;  // --ris-candidates (ris)
+    float light_split = 0;                        // --light-split (bvh; 0: no splitting)
     std::optional<bool> hide_emitters;            // paths of no bounce (emitters seen directly) left out
     std::optional<bool> skip_null_events;         // --null-depth skip (a Mitsuba <integrator type="volpath">)
     // The film: its reconstruction filter, the format of the default output (hdrfilm's

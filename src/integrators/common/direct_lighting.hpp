@@ -109,35 +109,43 @@ ColourAt<Wl> estimate_light_sample(const Scene& scene, const ShadingPoint& sp, S
     using Colour = ColourAt<Wl>;
     const bool dispersive = changes_wavelengths(*sp.material, wl);
     const bool transmits = sp.material->transmits();
-    const auto nee = sample_nee(scene, sp.p, sp.frame.n, sampler, nee_candidates(scene, &sp, wl),
-                                [&](const LightSample& c, int) { return surface_target(sp, c); });
-    if (!nee) return Colour(0.0f);
-    const LightChoice choice = nee->choice;
-    const LightSample* ls = &nee->ls;
-    // Lights behind the surface reach it only through a transmitting material (rough glass, a
-    // thin sheet).
-    if (dot(ls->wi, sp.ng) <= 0 && !transmits) return Colour(0.0f);
-    const Vec3f wo = sp.frame.to_local(ls->wi);
-    // The BSDF in RGB first (a shadow ray is traced only where it is not black), its colour once
-    // the light is known to be visible; a dispersive interface at once.
-    float pdf_bsdf;
-    Colour f(0.0f);
-    Rgb f_rgb(0.0f);
-    if (dispersive) [[unlikely]] {
-        f = bsdf_eval(sp, wo, wl, pdf_bsdf);
-        if (is_black(f)) return Colour(0.0f);
-    } else {
-        f_rgb = sp.material->eval_and_pdf(sp, sp.wi, wo, pdf_bsdf);
-        if (is_black(f_rgb)) return Colour(0.0f);
-    }
-    const Ray shadow = std::isinf(ls->distance) ? spawn_ray(sp.p, sp.ng, ls->wi)
-                                                : spawn_segment(sp.p, sp.ng, ls->point, ls->normal);
-    if (scene.occluded(shadow)) return Colour(0.0f);
-    if (!dispersive) f = bsdf_colour(sp, wo, f_rgb, wl);
-    const float weight = (mis && !ls->delta) ? mis_heuristic(power, nee->pdf_source, other_pdf(wo, pdf_bsdf)) : 1.0f;
-    const ColourAt<Wl> Le = light_colour(scene, choice.index, ls->Le, wl);
-    if (seen) *seen = {true, ls->wi, Le * (weight / nee->pdf)};
-    return f * Le * (std::abs(wo.z) * weight / nee->pdf);
+    Colour sum(0.0f);
+    float seen_y = -1;  // with splitting, `seen` gets the brightest of the samples
+    const auto one = [&](const NeeSample& nee) -> Colour {
+        const LightSample* ls = &nee.ls;
+        // Lights behind the surface reach it only through a transmitting material (rough glass, a
+        // thin sheet).
+        if (dot(ls->wi, sp.ng) <= 0 && !transmits) return Colour(0.0f);
+        const Vec3f wo = sp.frame.to_local(ls->wi);
+        // The BSDF in RGB first (a shadow ray is traced only where it is not black), its colour once
+        // the light is known to be visible; a dispersive interface at once.
+        float pdf_bsdf;
+        Colour f(0.0f);
+        Rgb f_rgb(0.0f);
+        if (dispersive) [[unlikely]] {
+            f = bsdf_eval(sp, wo, wl, pdf_bsdf);
+            if (is_black(f)) return Colour(0.0f);
+        } else {
+            f_rgb = sp.material->eval_and_pdf(sp, sp.wi, wo, pdf_bsdf);
+            if (is_black(f_rgb)) return Colour(0.0f);
+        }
+        const Ray shadow = std::isinf(ls->distance) ? spawn_ray(sp.p, sp.ng, ls->wi)
+                                                    : spawn_segment(sp.p, sp.ng, ls->point, ls->normal);
+        if (scene.occluded(shadow)) return Colour(0.0f);
+        if (!dispersive) f = bsdf_colour(sp, wo, f_rgb, wl);
+        const float weight = (mis && !ls->delta) ? mis_heuristic(power, nee.pdf_source, other_pdf(wo, pdf_bsdf)) : 1.0f;
+        const ColourAt<Wl> Le = light_colour(scene, nee.choice.index, ls->Le, wl);
+        if (seen) {
+            const ColourAt<Wl> Li = Le * (weight / nee.pdf);
+            const float y = max_component(f * Li);
+            if (y > seen_y) *seen = {true, ls->wi, Li}, seen_y = y;
+        }
+        return f * Le * (std::abs(wo.z) * weight / nee.pdf);
+    };
+    for_each_nee_sample(scene, sp.p, sp.frame.n, sampler, nee_candidates(scene, &sp, wl),
+                        [&](const LightSample& c, int) { return surface_target(sp, c); },
+                        [&](const NeeSample& nee) { sum += one(nee); });
+    return sum;
 }
 
 // The direct estimators' first hit: `L` becomes what the camera ray sees there (the emitter it

@@ -78,4 +78,25 @@ std::optional<NeeSample> sample_nee(const Scene& scene, const Vec3f& p, const Ve
     return NeeSample{kept, *ls, kept_t * float(m) / sum, kept.pmf * ls->pdfW};
 }
 
+// Next-event estimation's light samples at a point: sample_nee's one, or with adaptive splitting
+// (--light-split, light_sampler.hpp) one for each light choose_split returns, every one drawn
+// with the same random numbers as the single sample (a 1D choice, then a 2D point: each sample
+// is unbiased for its part of the lights, and their sum for all). f(const NeeSample&) for each.
+template <class Target, class F>
+void for_each_nee_sample(const Scene& scene, const Vec3f& p, const Vec3f& n, Sampler& sampler, int candidates, Target&& target, F&& f) {
+    if (candidates > 1 || !(scene.light_sampler().split() > 0)) {
+        if (const auto nee = sample_nee(scene, p, n, sampler, candidates, target)) f(*nee);
+        return;
+    }
+    LightChoice chosen[kMaxSplitLights];
+    const int count = scene.light_sampler().choose_split(p, n, sampler.next1d(), chosen);
+    const Vec2f u = sampler.next2d();
+    for (int i = 0; i < count; ++i) {
+        const auto ls = sample_light(scene.lights()[size_t(chosen[i].index)], p, u);
+        if (!ls || is_black(ls->Le)) continue;
+        const float pdf = chosen[i].pmf * ls->pdfW;
+        f(NeeSample{chosen[i], *ls, pdf, pdf});
+    }
+}
+
 }  // namespace pathlab

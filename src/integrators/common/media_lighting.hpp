@@ -28,48 +28,57 @@ template <class T, class Guide = NoGuide>
 ColourOf<T> estimate_light(const Scene& scene, const ScatterVertex& v, Sampler& sampler, MediumState<T>& st, bool mis,
                            WavelengthsOf<T>& wl, bool power = false, const Guide& guide = {}, LightSampleSeen<WavelengthsOf<T>>* seen = nullptr) {
     using Colour = ColourOf<T>;
-    const auto nee = sample_nee(scene, v.p, v.sp ? v.sp->frame.n : Vec3f(0.0f), sampler, nee_candidates(scene, v.sp, wl),
-                                [&](const LightSample& c, int) {
-                                    return v.sp ? surface_target(*v.sp, c) : phase_eval(*v.phase, v.wi, c.wi) * luminance(c.Le);
-                                });
-    if (!nee) return Colour(0.0f);
-    const LightChoice choice = nee->choice;
-    const LightSample* ls = &nee->ls;
-    Colour f;
-    float pdf_scatter, cosine;
-    Ray shadow;
-    int32_t medium = v.medium;
-    if (v.sp) {
-        const ShadingPoint& sp = *v.sp;
-        if (dot(ls->wi, sp.ng) <= 0 && !sp.material->transmits()) return Colour(0.0f);
-        const Vec3f wo = sp.frame.to_local(ls->wi);
-        f = bsdf_eval(sp, wo, wl, pdf_scatter);
-        if (is_black(f)) return Colour(0.0f);
-        cosine = std::abs(wo.z);
-        shadow = std::isinf(ls->distance) ? spawn_ray(sp.p, sp.ng, ls->wi) : spawn_segment(sp.p, sp.ng, ls->point, ls->normal);
-        medium = medium_after(v.hit->media, v.hit->isect.ng, ls->wi, medium);
-    } else {
-        const float p = phase_eval(*v.phase, v.wi, ls->wi);
-        if (!(p > 0)) return Colour(0.0f);
-        f = Colour(p);
-        pdf_scatter = phase_pdf(*v.phase, v.wi, ls->wi);
-        cosine = 1;
-        if (std::isinf(ls->distance)) {
-            shadow = Ray{v.p, ls->wi, kInf};
+    Colour sum(0.0f);
+    float seen_y = -1;  // with splitting, `seen` gets the brightest of the samples
+    const auto one = [&](const NeeSample& nee) -> Colour {
+        const LightChoice choice = nee.choice;
+        const LightSample* ls = &nee.ls;
+        Colour f;
+        float pdf_scatter, cosine;
+        Ray shadow;
+        int32_t medium = v.medium;
+        if (v.sp) {
+            const ShadingPoint& sp = *v.sp;
+            if (dot(ls->wi, sp.ng) <= 0 && !sp.material->transmits()) return Colour(0.0f);
+            const Vec3f wo = sp.frame.to_local(ls->wi);
+            f = bsdf_eval(sp, wo, wl, pdf_scatter);
+            if (is_black(f)) return Colour(0.0f);
+            cosine = std::abs(wo.z);
+            shadow = std::isinf(ls->distance) ? spawn_ray(sp.p, sp.ng, ls->wi) : spawn_segment(sp.p, sp.ng, ls->point, ls->normal);
+            medium = medium_after(v.hit->media, v.hit->isect.ng, ls->wi, medium);
         } else {
-            const Vec3f to = is_black(ls->normal) ? ls->point
-                                                  : offset_ray_origin(ls->point, dot(ls->point - v.p, ls->normal) <= 0 ? ls->normal : -ls->normal);
-            shadow = Ray{v.p, to - v.p, 1.0f - 1e-4f};
+            const float p = phase_eval(*v.phase, v.wi, ls->wi);
+            if (!(p > 0)) return Colour(0.0f);
+            f = Colour(p);
+            pdf_scatter = phase_pdf(*v.phase, v.wi, ls->wi);
+            cosine = 1;
+            if (std::isinf(ls->distance)) {
+                shadow = Ray{v.p, ls->wi, kInf};
+            } else {
+                const Vec3f to = is_black(ls->normal) ? ls->point
+                                                      : offset_ray_origin(ls->point, dot(ls->point - v.p, ls->normal) <= 0 ? ls->normal : -ls->normal);
+                shadow = Ray{v.p, to - v.p, 1.0f - 1e-4f};
+            }
         }
-    }
-    if (!st.pass_null && scene.media_separated(medium, scene.light_medium(choice.index))) return Colour(0.0f);  // blocked: no ray needed
-    const Colour Tr = shadow_transmittance(scene, shadow, medium, st);
-    if (is_black(Tr)) return Colour(0.0f);
-    const float weight = !ls->delta ? (mis ? mis_heuristic(power, nee->pdf_source, guide.mis_pdf(ls->wi, pdf_scatter)) : 1.0f) : 1.0f;
-    const Colour contribution = f * light_colour(scene, choice.index, ls->Le, wl) * (cosine * weight / nee->pdf);
-    const bool attenuated = scene.has_media() || st.pass_null;
-    if (seen) *seen = {true, ls->wi, light_colour(scene, choice.index, ls->Le, wl) * (attenuated ? Tr : Colour(1.0f)) * (weight / nee->pdf)};
-    return attenuated ? contribution * Tr : contribution;
+        if (!st.pass_null && scene.media_separated(medium, scene.light_medium(choice.index))) return Colour(0.0f);  // blocked: no ray needed
+        const Colour Tr = shadow_transmittance(scene, shadow, medium, st);
+        if (is_black(Tr)) return Colour(0.0f);
+        const float weight = !ls->delta ? (mis ? mis_heuristic(power, nee.pdf_source, guide.mis_pdf(ls->wi, pdf_scatter)) : 1.0f) : 1.0f;
+        const Colour contribution = f * light_colour(scene, choice.index, ls->Le, wl) * (cosine * weight / nee.pdf);
+        const bool attenuated = scene.has_media() || st.pass_null;
+        if (seen) {
+            const Colour Li = light_colour(scene, choice.index, ls->Le, wl) * (attenuated ? Tr : Colour(1.0f)) * (weight / nee.pdf);
+            const float y = max_component(f * Li);
+            if (y > seen_y) *seen = {true, ls->wi, Li}, seen_y = y;
+        }
+        return attenuated ? contribution * Tr : contribution;
+    };
+    for_each_nee_sample(scene, v.p, v.sp ? v.sp->frame.n : Vec3f(0.0f), sampler, nee_candidates(scene, v.sp, wl),
+                        [&](const LightSample& c, int) {
+                            return v.sp ? surface_target(*v.sp, c) : phase_eval(*v.phase, v.wi, c.wi) * luminance(c.Le);
+                        },
+                        [&](const NeeSample& nee) { sum += one(nee); });
+    return sum;
 }
 
 // The radiance a walk that ended on a surface or in the sky finds (Le towards the path, in RGB),

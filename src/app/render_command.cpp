@@ -117,10 +117,11 @@ void add_render_options(CLI::App& app, RenderCommandOptions& o) {
                    fmt::format("--light-sampler ris: the light samples drawn to keep one (1 to {}; default {})", kMaxRisCandidates,
                                kDefaultRisCandidates));
     app.add_option("--light-split", o.light_split,
-                   fmt::format("--light-sampler bvh: adaptive splitting (Conty Estevez and Kulla 2018): a node of the tree's top {} "
-                               "levels whose bounding sphere's radius over its distance to the shading point exceeds this "
-                               "gives a light sample for each of its children instead of choosing one (0: never; up to {}; default {})",
-                               kMaxSplitDepth, kMaxLightSplit, kDefaultLightSplit));
+                   fmt::format("--light-sampler bvh: adaptive splitting (Conty Estevez and Kulla 2018): where the light tree's root's "
+                               "bounding sphere's radius over its distance to the shading point exceeds this, next-event estimation "
+                               "takes a light sample from each of the root's children instead of choosing one (the path tracers: at "
+                               "their first vertex; 0: never; up to {}; default {})",
+                               kMaxLightSplit, kDefaultLightSplit));
     app.add_option("--mis", o.mis, "bdpt, vcm, bpm, upbp, mmlt, pt-mis, pt-mis3, direct-mis, volpath: the MIS heuristic, balance or power (Mitsuba's path tracers')")->capture_default_str();
     app.add_option("--strategies", o.strategies_dir,
                    "bdpt: also write one image per strategy (s, t), weighted and unweighted, and montages, into this directory "

@@ -67,9 +67,13 @@ public:
             const VertexBsdf* v = vb ? &*vb : nullptr;
 
             // Next-event estimation, as estimate_light_sample(mis = true).
-            // (With adaptive splitting, one light sample for each light choose_split returns.)
+            // (With adaptive splitting, at the first vertex, one light sample for each light choose_split returns.)
             LightChoice chosen[kMaxSplitLights];
-            const int n_chosen = scene_.light_sampler().choose_split(sp.p, sp.frame.n, sampler.next1d(), chosen);
+            const bool split = bounces == 0;
+            const float u_choice = sampler.next1d();
+            int n_chosen = 1;
+            if (split) n_chosen = scene_.light_sampler().choose_split(sp.p, sp.frame.n, u_choice, chosen);
+            else chosen[0] = scene_.choose_light(sp.p, sp.frame.n, u_choice), n_chosen = chosen[0].index >= 0 ? 1 : 0;
             const Vec2f u = sampler.next2d();
             for (int i = 0; i < n_chosen; ++i) {
                 const LightChoice choice = chosen[i];
@@ -98,7 +102,7 @@ public:
             const auto s = sp.material->sample(sp, sp.wi, sampler.next2d());
             EmitterHit found;
             if (s) {
-                found = trace_to_emitter(scene_, sp.spawn(s->wo), sp.p, sp.frame.n);
+                found = trace_to_emitter(scene_, sp.spawn(s->wo), sp.p, sp.frame.n, split);
                 if (!is_black(found.Le)) {
                     const float weight = s->delta ? 1.0f : balance_heuristic(s->pdfW, found.pdf_light);
                     const float k = std::abs(s->wo.z) * weight / s->pdfW;

@@ -308,7 +308,7 @@ int LightSampler::choose_split(const Vec3f& p, const Vec3f& n, float u, LightCho
     return count;
 }
 
-float LightSampler::pmf(const Vec3f& p, const Vec3f& n, int light) const {
+float LightSampler::pmf(const Vec3f& p, const Vec3f& n, int light, bool split) const {
     if (light < 0 || light >= count_) return 0.0f;
     switch (kind_) {
         case LightSamplerKind::Power: return power_.pmf(light);
@@ -327,7 +327,7 @@ float LightSampler::pmf(const Vec3f& p, const Vec3f& n, int light) const {
         const float sum = lane_importances(at.bounds, p, n, importance);
         const int lane = int((trail.lanes >> (2 * level)) & 3);
         if (!(sum > 0)) return 0.0f;
-        if (splits(at, level, p)) {  // every lane of positive importance is descended into
+        if (split && splits(at, level, p)) {  // every lane of positive importance is descended into
             if (!(importance[lane] > 0)) return 0.0f;
         } else {
             pmf *= importance[lane] / sum;  // as choose() multiplies it

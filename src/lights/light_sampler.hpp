@@ -68,7 +68,8 @@ public:
     // Next-event estimation's lights: with splitting, up to kMaxSplitLights into out (each with
     // its pmf), else choose's one; returns how many.
     int choose_split(const Vec3f& p, const Vec3f& n, float u, LightChoice* out) const;
-    float pmf(const Vec3f& p, const Vec3f& n, int light) const;
+    // `split`: of the choice choose_split makes (false: of choose's, at a vertex that does not split).
+    float pmf(const Vec3f& p, const Vec3f& n, int light, bool split = true) const;
 
     // The tree's size (bvh): nodes and bytes.
     size_t nodes() const { return nodes_.size(); }

@@ -103,7 +103,8 @@ public:
     // Next-event estimation's choice of a light for the point p with normal n (n = 0 in a
     // medium), by the description's light_sampler, and the probability of choosing light i there.
     LightChoice choose_light(const Vec3f& p, const Vec3f& n, float u) const { return light_sampler_.choose(p, n, u); }
-    float light_pmf(const Vec3f& p, const Vec3f& n, int index) const { return light_sampler_.pmf(p, n, index); }
+    // `split`: at a vertex where next-event estimation splits (light_sampler.hpp; the camera path's first).
+    float light_pmf(const Vec3f& p, const Vec3f& n, int index, bool split = true) const { return light_sampler_.pmf(p, n, index, split); }
     const LightSampler& light_sampler() const { return light_sampler_; }
     // Light paths' choice of the light they start on: in proportion to power (uniformly if all are 0).
     LightChoice choose_emitter(float u) const { return light_distribution_.choose(u); }

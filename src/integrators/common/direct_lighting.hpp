@@ -105,7 +105,7 @@ struct LightSampleSeen {
 
 template <class Wl, class OtherPdf = BsdfStrategyPdf>
 ColourAt<Wl> estimate_light_sample(const Scene& scene, const ShadingPoint& sp, Sampler& sampler, bool mis, Wl& wl, bool power = false,
-                                   const OtherPdf& other_pdf = {}, LightSampleSeen<Wl>* seen = nullptr) {
+                                   const OtherPdf& other_pdf = {}, LightSampleSeen<Wl>* seen = nullptr, bool split = true) {
     using Colour = ColourAt<Wl>;
     const bool dispersive = changes_wavelengths(*sp.material, wl);
     const bool transmits = sp.material->transmits();
@@ -144,7 +144,7 @@ ColourAt<Wl> estimate_light_sample(const Scene& scene, const ShadingPoint& sp, S
     };
     for_each_nee_sample(scene, sp.p, sp.frame.n, sampler, nee_candidates(scene, &sp, wl),
                         [&](const LightSample& c, int) { return surface_target(sp, c); },
-                        [&](const NeeSample& nee) { sum += one(nee); });
+                        [&](const NeeSample& nee) { sum += one(nee); }, split);
     return sum;
 }
 
@@ -167,8 +167,9 @@ std::optional<ShadingPoint> first_surface(const Scene& scene, const Ray& ray, bo
 // What a ray leaving a shading point finds: the surface it hits (if any), the radiance emitted
 // towards the shading point (a front-facing area light, or the environment if the ray
 // escapes), and the solid-angle density with which light sampling at `from` (a surface with
-// normal n) would have produced this direction, including the light's selection probability. The BSDF-sampled
-// half of MIS weighs its emission with this density.
+// normal n) would have produced this direction, including the light's selection probability (of
+// a splitting choice with `split`: for_each_nee_sample). The BSDF-sampled half of MIS weighs its
+// emission with this density.
 struct EmitterHit {
     bool hit = false;
     Intersection isect;
@@ -176,21 +177,21 @@ struct EmitterHit {
     float pdf_light = 0;
 };
 
-inline EmitterHit trace_to_emitter(const Scene& scene, const Ray& ray, const Vec3f& from, const Vec3f& n) {
+inline EmitterHit trace_to_emitter(const Scene& scene, const Ray& ray, const Vec3f& from, const Vec3f& n, bool split = true) {
     EmitterHit e;
     e.hit = scene.intersect(ray, e.isect);
     if (!e.hit) {
         const int env = scene.environment_light();
         if (env >= 0) {
             e.Le = scene.escaped_radiance(ray.d);
-            e.pdf_light = scene.light_pmf(from, n, env) * environment_pdf_li(scene.lights()[size_t(env)], ray.d);
+            e.pdf_light = scene.light_pmf(from, n, env, split) * environment_pdf_li(scene.lights()[size_t(env)], ray.d);
         }
         return e;
     }
     e.Le = emitted_radiance(scene, e.isect, -ray.d / length(ray.d));
     if (!is_black(e.Le)) {
         const Light& light = scene.lights()[size_t(e.isect.light)];
-        e.pdf_light = scene.light_pmf(from, n, e.isect.light) * surface_light_pdf_li(light, from, e.isect.p, e.isect.ng);
+        e.pdf_light = scene.light_pmf(from, n, e.isect.light, split) * surface_light_pdf_li(light, from, e.isect.p, e.isect.ng);
     }
     return e;
 }
@@ -202,8 +203,8 @@ inline EmitterHit trace_to_emitter(const Scene& scene, const Ray& ray, const Vec
 // continue from it.
 template <class Wl>
 ColourAt<Wl> estimate_bsdf_sample_mis(const Scene& scene, const ShadingPoint& sp, const BsdfSample& s, const ColourAt<Wl>& f,
-                                      EmitterHit& found, const Wl& wl, bool power = false) {
-    found = trace_to_emitter(scene, sp.spawn(s.wo), sp.p, sp.frame.n);
+                                      EmitterHit& found, const Wl& wl, bool power = false, bool split = true) {
+    found = trace_to_emitter(scene, sp.spawn(s.wo), sp.p, sp.frame.n, split);
     if (is_black(found.Le)) return ColourAt<Wl>(0.0f);
     const float weight = s.delta ? 1.0f : mis_heuristic(power, s.pdfW, found.pdf_light);
     const int light = found.hit ? found.isect.light : scene.environment_light();

@@ -82,9 +82,13 @@ std::optional<NeeSample> sample_nee(const Scene& scene, const Vec3f& p, const Ve
 // (--light-split, light_sampler.hpp) one for each light choose_split returns, every one drawn
 // with the same random numbers as the single sample (a 1D choice, then a 2D point: each sample
 // is unbiased for its part of the lights, and their sum for all). f(const NeeSample&) for each.
+// Splitting is for the camera path's first vertex (`split`; a path tracer's later vertices choose
+// one light: their extra shadow rays cost more than they gain, docs/lights.md); the MIS partner
+// at the vertex reads the pmf of the same choice (Scene::light_pmf's `split`).
 template <class Target, class F>
-void for_each_nee_sample(const Scene& scene, const Vec3f& p, const Vec3f& n, Sampler& sampler, int candidates, Target&& target, F&& f) {
-    if (candidates > 1 || !(scene.light_sampler().split() > 0)) {
+void for_each_nee_sample(const Scene& scene, const Vec3f& p, const Vec3f& n, Sampler& sampler, int candidates, Target&& target, F&& f,
+                         bool split = true) {
+    if (candidates > 1 || !split || !(scene.light_sampler().split() > 0)) {
         if (const auto nee = sample_nee(scene, p, n, sampler, candidates, target)) f(*nee);
         return;
     }

@@ -26,7 +26,8 @@ struct ScatterVertex {
 // it found (its direction, and Le Tr times the MIS weight over the sample's density).
 template <class T, class Guide = NoGuide>
 ColourOf<T> estimate_light(const Scene& scene, const ScatterVertex& v, Sampler& sampler, MediumState<T>& st, bool mis,
-                           WavelengthsOf<T>& wl, bool power = false, const Guide& guide = {}, LightSampleSeen<WavelengthsOf<T>>* seen = nullptr) {
+                           WavelengthsOf<T>& wl, bool power = false, const Guide& guide = {}, LightSampleSeen<WavelengthsOf<T>>* seen = nullptr,
+                           bool split = true) {
     using Colour = ColourOf<T>;
     Colour sum(0.0f);
     float seen_y = -1;  // with splitting, `seen` gets the brightest of the samples
@@ -77,14 +78,14 @@ ColourOf<T> estimate_light(const Scene& scene, const ScatterVertex& v, Sampler& 
                         [&](const LightSample& c, int) {
                             return v.sp ? surface_target(*v.sp, c) : phase_eval(*v.phase, v.wi, c.wi) * luminance(c.Le);
                         },
-                        [&](const NeeSample& nee) { sum += one(nee); });
+                        [&](const NeeSample& nee) { sum += one(nee); }, split);
     return sum;
 }
 
 // The radiance a walk that ended on a surface or in the sky finds (Le towards the path, in RGB),
 // the density with which light sampling at `from` would have chosen it (trace_to_emitter's), and
 // the light it belongs to.
-inline EmitterHit emission_found(const Scene& scene, const MediumWalk& w, const Vec3f& from, const Vec3f& n, int& light) {
+inline EmitterHit emission_found(const Scene& scene, const MediumWalk& w, const Vec3f& from, const Vec3f& n, int& light, bool split = true) {
     EmitterHit e;
     light = -1;
     if (w.kind == MediumWalk::kEscaped) {
@@ -92,14 +93,14 @@ inline EmitterHit emission_found(const Scene& scene, const MediumWalk& w, const 
         if (env >= 0) {
             light = env;
             e.Le = scene.escaped_radiance(w.dir);
-            e.pdf_light = scene.light_pmf(from, n, env) * environment_pdf_li(scene.lights()[size_t(env)], w.dir);
+            e.pdf_light = scene.light_pmf(from, n, env, split) * environment_pdf_li(scene.lights()[size_t(env)], w.dir);
         }
     } else if (w.kind == MediumWalk::kSurface) {
         e.Le = emitted_radiance(scene, w.isect, -w.dir / length(w.dir));
         if (!is_black(e.Le)) {
             light = w.isect.light;
             const Light& l = scene.lights()[size_t(w.isect.light)];
-            e.pdf_light = scene.light_pmf(from, n, w.isect.light) * surface_light_pdf_li(l, from, w.isect.p, w.isect.ng);
+            e.pdf_light = scene.light_pmf(from, n, w.isect.light, split) * surface_light_pdf_li(l, from, w.isect.p, w.isect.ng);
         }
     }
     return e;
@@ -112,6 +113,7 @@ struct MisOrigin {
     Vec3f p{}, n{};  // n: the shading normal at a surface, 0 in a medium
     float pdf = 0;   // the solid-angle density of the direction sampled there
     bool delta = true;
+    bool split = true;  // whether light sampling split there (for_each_nee_sample)
 };
 
 // A BSDF or phase sample at a vertex and the walk along it.
@@ -138,7 +140,8 @@ struct ScatterSample {
 // sample alone); its random numbers are u, then the choice of half, then the half's own.
 template <class T, class Guide = NoGuide>
 ScatterSample<T> sample_scatter(const Scene& scene, const ScatterVertex& v, Sampler& sampler, MediumState<T>& st, bool mis,
-                                WavelengthsOf<T>& wl, bool power = false, const MisOrigin* null_origin = nullptr, const Guide& guide = {}) {
+                                WavelengthsOf<T>& wl, bool power = false, const MisOrigin* null_origin = nullptr, const Guide& guide = {},
+                                bool split = true) {
     using Colour = ColourOf<T>;
     ScatterSample<T> n;
     int light;
@@ -163,9 +166,9 @@ ScatterSample<T> sample_scatter(const Scene& scene, const ScatterVertex& v, Samp
         n.next = walk_media(scene, n.ray, n.medium, st, n.next_seg);
         n.weight = f * (std::abs(s->wo.z) / n.pdf);
         const bool passed = null_origin && (s->lobe & kLobeNull);
-        const MisOrigin here{sp.p, sp.frame.n, n.pdf, s->delta};
+        const MisOrigin here{sp.p, sp.frame.n, n.pdf, s->delta, split};
         const MisOrigin& o = passed ? *null_origin : here;
-        const EmitterHit e = emission_found(scene, n.next, o.p, o.n, light);
+        const EmitterHit e = emission_found(scene, n.next, o.p, o.n, light, o.split);
         const float weight = o.delta ? 1.0f : (mis ? mis_heuristic(power, o.pdf, e.pdf_light) : 0.0f);
         if (!is_black(e.Le)) n.found = f * light_colour(scene, light, e.Le, wl) * (std::abs(s->wo.z) * weight / n.pdf);
     } else {
@@ -184,7 +187,7 @@ ScatterSample<T> sample_scatter(const Scene& scene, const ScatterVertex& v, Samp
         n.ray = Ray{v.p, ps.wo, kInf};
         n.medium = v.medium;
         n.next = walk_media(scene, n.ray, n.medium, st, n.next_seg);
-        const EmitterHit e = emission_found(scene, n.next, v.p, Vec3f(0.0f), light);
+        const EmitterHit e = emission_found(scene, n.next, v.p, Vec3f(0.0f), light, split);
         const float weight = mis ? mis_heuristic(power, n.pdf, e.pdf_light) : 0.0f;
         if (!is_black(e.Le)) n.found = Colour(ps.p) * light_colour(scene, light, e.Le, wl) * (weight / n.pdf);
         n.weight = Colour(ps.p / n.pdf);

@@ -208,7 +208,7 @@ ColourOf<T> PathGuiding<T>::walk(const Scene& scene, Intersection hit, Vec3f dir
         PathVertex* v = records && n < kRecordedVertices ? &vertices[n++] : nullptr;
         if (v) *v = {sp.p, Vec3f(0.0f), 0.0f, false, L, beta, L, beta};
         LightSampleSeen<Wl> light;
-        L += beta * estimate_light_sample(scene, sp, sampler, /*mis=*/true, wl, power, light_mis_pdf, records ? &light : nullptr);
+        L += beta * estimate_light_sample(scene, sp, sampler, /*mis=*/true, wl, power, light_mis_pdf, records ? &light : nullptr, bounces == 0);
         if (records && light.found) records->push_back({sp.p, light.wi, mean_of(light.Li), Record::kIncoming});
 
         // The continuation: the BSDF's sample (always without guiding), or the tree's.
@@ -224,7 +224,7 @@ ColourOf<T> PathGuiding<T>::walk(const Scene& scene, Intersection hit, Vec3f dir
             v->direction = wo_world, v->pdf = pdf, v->guided_record = true, v->L_before = L, v->beta_after = beta * step;
             if (g.on && learn_fraction) v->a = g.a, v->f_cos = mean_of(f) * std::abs(s->wo.z), v->pdf_bsdf = s->pdfW, v->pdf_tree = g.pdf(wo_world);
         }
-        const EmitterHit found = trace_to_emitter(scene, sp.spawn(s->wo), sp.p, sp.frame.n);
+        const EmitterHit found = trace_to_emitter(scene, sp.spawn(s->wo), sp.p, sp.frame.n, bounces == 0);
         if (!is_black(found.Le)) {
             const float weight = s->delta ? 1.0f : mis_heuristic(power, pdf, found.pdf_light);
             const int light_index = found.hit ? found.isect.light : scene.environment_light();
@@ -336,10 +336,10 @@ ColourOf<T> PathGuiding<T>::trace_in_media(const Scene& scene, const Ray& camera
         const Colour throughput = beta / st.density();
         if (pv) *pv = {v.p, Vec3f(0.0f), 0.0f, false, L, throughput, L, throughput};
         LightSampleSeen<Wl> light;
-        L += beta * estimate_light(scene, v, sampler, st, /*mis=*/true, wl, power, g, records ? &light : nullptr) / st.density();
+        L += beta * estimate_light(scene, v, sampler, st, /*mis=*/true, wl, power, g, records ? &light : nullptr, bounces == 0) / st.density();
         if (records && light.found) records->push_back({v.p, light.wi, mean_of(light.Li), Record::kIncoming});
         const Colour L_before = L;
-        const ScatterSample<T> s = sample_scatter(scene, v, sampler, st, /*mis=*/true, wl, power, nullptr, g);
+        const ScatterSample<T> s = sample_scatter(scene, v, sampler, st, /*mis=*/true, wl, power, nullptr, g, bounces == 0);
         if (!s.sampled) break;
         L += beta * s.next_seg * s.found / st.density();
         const Colour beta_next = beta * s.next_seg * s.weight;

@@ -34,7 +34,8 @@ ColourAt<Wl> pt_mis_from_hit(const Scene& scene, Intersection hit, Vec3f dir, in
         if (sp.material->is_black()) break;
         // Paths of bounces + 1 bounces ending on a light: the MIS pair.
         if (may_scatter) {
-            const Colour direct = estimate_light_sample(scene, sp, sampler, /*mis=*/true, wl, rules.power_mis());
+            const Colour direct = estimate_light_sample(scene, sp, sampler, /*mis=*/true, wl, rules.power_mis(), BsdfStrategyPdf{},
+                                                        static_cast<LightSampleSeen<Wl>*>(nullptr), /*split=*/bounces == 0);
             if (counts(bounces + 1)) L += beta * direct;
         }
         const auto s = bsdf_sample(sp, sampler.next2d(), wl);
@@ -42,7 +43,7 @@ ColourAt<Wl> pt_mis_from_hit(const Scene& scene, Intersection hit, Vec3f dir, in
         Colour f(0.0f);  // the continuation's BSDF value
         if (s) {
             f = bsdf_sample_colour(sp, *s, wl);
-            const Colour found_emission = estimate_bsdf_sample_mis(scene, sp, *s, f, found, wl, rules.power_mis());
+            const Colour found_emission = estimate_bsdf_sample_mis(scene, sp, *s, f, found, wl, rules.power_mis(), /*split=*/bounces == 0);
             const bool bounce = rules.is_bounce(s->lobe);
             if ((may_scatter || !bounce) && counts(bounces + (bounce ? 1 : 0))) L += beta * found_emission;
         }

@@ -84,14 +84,15 @@ public:
             }
             // The MIS pair: a light sample, and a BSDF or phase sample whose walk may find emission.
             if (may_scatter) {
-                const Colour direct = estimate_light(scene, v, sampler, st, mis, wl, rules_.power_mis());
+                const Colour direct = estimate_light(scene, v, sampler, st, mis, wl, rules_.power_mis(), {}, nullptr, /*split=*/bounces == 0);
                 L += beta * direct / st.density();
             }
 
-            const ScatterSample<T> n = sample_scatter(scene, v, sampler, st, mis, wl, rules_.power_mis(), st.pass_null ? &origin : nullptr);
+            const ScatterSample<T> n = sample_scatter(scene, v, sampler, st, mis, wl, rules_.power_mis(), st.pass_null ? &origin : nullptr, {},
+                                                      /*split=*/bounces == 0);
             if (!n.sampled) break;  // pt-mis: no BSDF sample, nothing found, and the path ends
             const bool bounce = rules_.is_bounce(n.lobe);
-            if (bounce) origin = MisOrigin{v.p, v.sp ? v.sp->frame.n : Vec3f(0.0f), n.pdf, n.delta};
+            if (bounce) origin = MisOrigin{v.p, v.sp ? v.sp->frame.n : Vec3f(0.0f), n.pdf, n.delta, bounces == 0};
             if (!may_scatter && bounce) break;  // a scattering past the depth limit
             if (!(rules_.hides_emitters() && bounces == 0 && !bounce)) L += beta * n.next_seg * n.found / st.density();
             const MediumWalk& next = n.next;

@@ -61,6 +61,16 @@ std::vector<std::pair<Vec3f, Vec3f>> shading_points(const Scene& scene, int coun
     return out;
 }
 
+// The running mean, variance and standard error of a sample of estimates.
+struct Moments {
+    double sum = 0, sum2 = 0;
+    int n = 0;
+    void add(double x) { sum += x, sum2 += x * x, ++n; }
+    double mean() const { return sum / n; }
+    double variance() const { return std::max(0.0, sum2 / n - mean() * mean()); }
+    double standard_error() const { return std::sqrt(variance() / n); }
+};
+
 class LightSamplers : public ::testing::TestWithParam<LightSamplerKind> {};
 
 TEST_P(LightSamplers, PmfSumsToOneAndIsWhatChooseReturns) {
@@ -396,14 +406,6 @@ TEST(LightSamplerAgreement, RisInFogConvergesToPowersImage) {
 // positive where g is); with t = g its variance per sample is a fraction of bvh's. Every kind of
 // light (delta, infinite, area) and the many-light floor.
 TEST(LightRis, ResampledEstimateIsUnbiasedAndLowersVariance) {
-    struct Moments {
-        double sum = 0, sum2 = 0;
-        int n = 0;
-        void add(double x) { sum += x, sum2 += x * x, ++n; }
-        double mean() const { return sum / n; }
-        double variance() const { return std::max(0.0, sum2 / n - mean() * mean()); }
-        double standard_error() const { return std::sqrt(variance() / n); }
-    };
     for (const bool many : {false, true}) {
         const auto scene = Scene::build(many ? many_lights(LightSamplerKind::Ris) : mixed_lights(LightSamplerKind::Ris));
         ASSERT_EQ(scene->light_sampler().candidates(), kDefaultRisCandidates);
@@ -511,14 +513,6 @@ TEST(LightBvh, LowersTheVarianceOfUnshadowedIrradianceOnTheManyLightFloor) {
 // positive pmf) has the mean sum_i E_i (a z-test at a false-alarm rate of 1e-6 per point); on
 // the hall its variance is below the unsplit bvh's per choice.
 TEST(LightBvh, SplittingIsUnbiasedAndItsPmfIsWhatMisReads) {
-    struct Moments {
-        double sum = 0, sum2 = 0;
-        int n = 0;
-        void add(double x) { sum += x, sum2 += x * x, ++n; }
-        double mean() const { return sum / n; }
-        double variance() const { return std::max(0.0, sum2 / n - mean() * mean()); }
-        double standard_error() const { return std::sqrt(variance() / n); }
-    };
     for (const bool many : {true, false}) {
         SceneDescription d = many ? many_lights(LightSamplerKind::Bvh) : mixed_lights(LightSamplerKind::Bvh);
         d.light_split = 0.5f;

@@ -417,14 +417,16 @@ TEST(LightRis, ResampledEstimateIsUnbiasedAndLowersVariance) {
             auto other = [&](const LightSample& ls, int i) { return g(ls, i) * (0.2f + ls.wi.x * ls.wi.x); };
             Moments plain;
             Sampler rng(17, 0, 0);
-            for (int k = 0; k < 400000; ++k)
-                if (const auto s = sample_nee(*scene, p, n, rng, 1, g)) plain.add(g(s->ls, 0) / s->pdf);
-                else plain.add(0);
+            for (int k = 0; k < 400000; ++k) {
+                double sum = 0;
+                for_each_nee_sample(*scene, p, n, rng, 1, g, [&](const NeeSample& s) { sum += g(s.ls, 0) / s.pdf; });
+                plain.add(sum);
+            }
             for (const bool exact : {true, false}) {
                 Moments ris;
                 for (int k = 0; k < 50000; ++k) {
-                    const auto s = exact ? sample_nee(*scene, p, n, rng, kDefaultRisCandidates, g)
-                                         : sample_nee(*scene, p, n, rng, kDefaultRisCandidates, other);
+                    const auto s = exact ? resample_nee(*scene, p, n, rng, kDefaultRisCandidates, g)
+                                         : resample_nee(*scene, p, n, rng, kDefaultRisCandidates, other);
                     ris.add(s ? g(s->ls, 0) / s->pdf : 0.0);
                 }
                 const double z = (ris.mean() - plain.mean()) / std::hypot(ris.standard_error(), plain.standard_error());

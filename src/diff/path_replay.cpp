@@ -70,10 +70,7 @@ public:
             // (With adaptive splitting, at the first vertex, one light sample for each light choose_split returns.)
             LightChoice chosen[kMaxSplitLights];
             const bool split = bounces == 0;
-            const float u_choice = sampler.next1d();
-            int n_chosen = 1;
-            if (split) n_chosen = scene_.light_sampler().choose_split(sp.p, sp.frame.n, u_choice, chosen);
-            else chosen[0] = scene_.choose_light(sp.p, sp.frame.n, u_choice), n_chosen = chosen[0].index >= 0 ? 1 : 0;
+            const int n_chosen = scene_.light_sampler().choose_split(sp.p, sp.frame.n, sampler.next1d(), chosen, split);
             const Vec2f u = sampler.next2d();
             for (int i = 0; i < n_chosen; ++i) {
                 const LightChoice choice = chosen[i];

@@ -263,8 +263,8 @@ LightChoice LightSampler::choose(const Vec3f& p, const Vec3f& n, float u) const 
     }
 }
 
-int LightSampler::choose_split(const Vec3f& p, const Vec3f& n, float u, LightChoice* out) const {
-    if (!(split_ > 0) || nodes_.empty()) {
+int LightSampler::choose_split(const Vec3f& p, const Vec3f& n, float u, LightChoice* out, bool split) const {
+    if (!split || !(split_ > 0) || nodes_.empty()) {
         out[0] = choose(p, n, u);
         return out[0].index >= 0 ? 1 : 0;
     }

@@ -65,9 +65,9 @@ public:
     // A light for the point p with normal n (n = 0 in a medium), and its probability (without
     // splitting: ris's candidates and light paths draw one light).
     LightChoice choose(const Vec3f& p, const Vec3f& n, float u) const;
-    // Next-event estimation's lights: with splitting, up to kMaxSplitLights into out (each with
-    // its pmf), else choose's one; returns how many.
-    int choose_split(const Vec3f& p, const Vec3f& n, float u, LightChoice* out) const;
+    // Next-event estimation's lights: with splitting (and `split`: a vertex that splits), up to
+    // kMaxSplitLights into out (each with its pmf), else choose's one; returns how many.
+    int choose_split(const Vec3f& p, const Vec3f& n, float u, LightChoice* out, bool split = true) const;
     // `split`: of the choice choose_split makes (false: of choose's, at a vertex that does not split).
     float pmf(const Vec3f& p, const Vec3f& n, int light, bool split = true) const;
 

@@ -32,20 +32,11 @@ struct NeeSample {
     float pdf_source = 0;  // pmf * pdfW: the density MIS weighs with
 };
 
-// `target(ls, light)` is t for a candidate. With candidates <= 1 this is the light sampler's own
-// sample (the same random numbers as ever: a 1D choice, then a 2D point).
+// `target(ls, light)` is t for a candidate; `candidates` >= 2 (one is the light sampler's own
+// sample: for_each_nee_sample).
 template <class Target>
-std::optional<NeeSample> sample_nee(const Scene& scene, const Vec3f& p, const Vec3f& n, Sampler& sampler, int candidates,
-                                    Target&& target) {
-    if (candidates <= 1) {
-        const LightChoice choice = scene.choose_light(p, n, sampler.next1d());
-        const Vec2f u = sampler.next2d();
-        if (choice.index < 0) return std::nullopt;
-        const auto ls = sample_light(scene.lights()[size_t(choice.index)], p, u);
-        if (!ls || is_black(ls->Le)) return std::nullopt;
-        const float pdf = choice.pmf * ls->pdfW;
-        return NeeSample{choice, *ls, pdf, pdf};
-    }
+std::optional<NeeSample> resample_nee(const Scene& scene, const Vec3f& p, const Vec3f& n, Sampler& sampler, int candidates,
+                                      Target&& target) {
     // A weighted reservoir of one (Chao's algorithm): candidate i replaces the kept one with
     // probability w_i / (w_1 + ... + w_i), decided by one uniform number that each decision
     // rescales to a fresh uniform number (in double: 8 candidates use a few of its 53 bits).
@@ -78,22 +69,23 @@ std::optional<NeeSample> sample_nee(const Scene& scene, const Vec3f& p, const Ve
     return NeeSample{kept, *ls, kept_t * float(m) / sum, kept.pmf * ls->pdfW};
 }
 
-// Next-event estimation's light samples at a point: sample_nee's one, or with adaptive splitting
-// (--light-split, light_sampler.hpp) one for each light choose_split returns, every one drawn
-// with the same random numbers as the single sample (a 1D choice, then a 2D point: each sample
-// is unbiased for its part of the lights, and their sum for all). f(const NeeSample&) for each.
-// Splitting is for the camera path's first vertex (`split`; a path tracer's later vertices choose
-// one light: their extra shadow rays cost more than they gain, docs/lights.md); the MIS partner
-// at the vertex reads the pmf of the same choice (Scene::light_pmf's `split`).
+// Next-event estimation's light samples at a point: ris's one (candidates > 1), else the light
+// sampler's: one light, or with adaptive splitting (--light-split, light_sampler.hpp) each light
+// choose_split returns, every one drawn with the same random numbers (a 1D choice, then a 2D
+// point: each sample is unbiased for its part of the lights, and their sum for all).
+// f(const NeeSample&) for each. Splitting is for the camera path's first vertex (`split`; a path
+// tracer's later vertices choose one light: their extra shadow rays cost more than they gain,
+// docs/lights.md); the MIS partner at the vertex reads the pmf of the same choice
+// (Scene::light_pmf's `split`).
 template <class Target, class F>
 void for_each_nee_sample(const Scene& scene, const Vec3f& p, const Vec3f& n, Sampler& sampler, int candidates, Target&& target, F&& f,
                          bool split = true) {
-    if (candidates > 1 || !split || !(scene.light_sampler().split() > 0)) {
-        if (const auto nee = sample_nee(scene, p, n, sampler, candidates, target)) f(*nee);
+    if (candidates > 1) {
+        if (const auto nee = resample_nee(scene, p, n, sampler, candidates, target)) f(*nee);
         return;
     }
     LightChoice chosen[kMaxSplitLights];
-    const int count = scene.light_sampler().choose_split(p, n, sampler.next1d(), chosen);
+    const int count = scene.light_sampler().choose_split(p, n, sampler.next1d(), chosen, split);
     const Vec2f u = sampler.next2d();
     for (int i = 0; i < count; ++i) {
         const auto ls = sample_light(scene.lights()[size_t(chosen[i].index)], p, u);

@@ -488,10 +488,16 @@ public:
         }
         return p;
     }
+    // What the weights are made of: the strategies' densities, but for a light seen directly
+    // (a path of one edge), where s = 1's counts (1 - T) times (Bdpt::seen_directly_weight).
+    double weighed_density(const MediumPath& f, int s) const {
+        if (k(f) != 1 || s != 1) return strategy_density(f, s);
+        return (1 - std::exp(-kSigma * length(f.p[1] - f.p[0]))) * strategy_density(f, s);
+    }
     double expected_weight(const MediumPath& f, int s) const {
         double sum = 0;
-        for (int i = 0; i <= k(f); ++i) sum += strategy_density(f, i);  // (every strategy can make these paths)
-        return strategy_density(f, s) / sum;
+        for (int i = 0; i <= k(f); ++i) sum += weighed_density(f, i);  // (every strategy can make these paths)
+        return weighed_density(f, s) / sum;
     }
 
     // The vertex bdpt's walk would have made of x_j on the camera side (reached from x_{j-1}) or the light side.
@@ -556,8 +562,8 @@ public:
         std::vector<PathVertex<RgbTransport>> light, camera;
         subpaths(f, s, light, camera, vm);
         const int n = k(f), t = n + 1 - s;
-        PathVertex<RgbTransport> sampled = s == 1 ? vertex(f, n, false) : vertex(f, 0, true);
-        if (s == 1) sampled.pdf_fwd = float(light_origin());
+        PathVertex<RgbTransport> sampled = s == 1 && t > 1 ? vertex(f, n, false) : vertex(f, 0, true);
+        if (s == 1 && t > 1) sampled.pdf_fwd = float(light_origin());
         EdgeDensities known;
         if (s >= 1) known.T = float(std::exp(-kSigma * length(f.p[size_t(t)] - f.p[size_t(t - 1)])));
         return bdpt_.mis_weight(ctx_, light, s, camera, t, sampled, known, vm);
@@ -625,7 +631,10 @@ public:
     std::vector<MediumPath> paths() const {
         const Vec3f m1(0.3f, -1.0f, 1.2f), m2(-0.4f, 0.2f, 1.8f), floor(0.2f, 0.4f, 0.0f), on_light(0.1f, 0.45f, 2.5f);
         const Vec3f c = camera_.position();
-        return {{"camera-medium-light", {c, m1, on_light}, {false, true, false}},
+        // (camera-light: the light seen through the medium, by the camera's ray (s = 0) and by
+        // the emitter's point connected to the camera (s = t = 1), which a scene with media has.)
+        return {{"camera-light", {c, on_light}, {false, false}},
+                {"camera-medium-light", {c, m1, on_light}, {false, true, false}},
                 {"camera-medium-floor-light", {c, m1, floor, on_light}, {false, true, false, false}},
                 {"camera-floor-medium-light", {c, floor, m2, on_light}, {false, false, true, false}},
                 {"camera-medium-medium-light", {c, m1, m2, on_light}, {false, true, true, false}},
@@ -686,7 +695,7 @@ bool merge_weights_match(const MediumMis& h, VcmFaults faults, std::string& repo
         exact.eta_volume = 1000 * 4.0 / 3.0 * M_PI * r * r * r;
         for (const MediumPath& f : h.paths()) {
             double total = 0;
-            for (int s = 0; s <= h.k(f); ++s) total += h.strategy_density(f, s);
+            for (int s = 0; s <= h.k(f); ++s) total += h.weighed_density(f, s);
             for (int j = 1; j < h.k(f); ++j) total += h.merge_density(f, j, exact);
             double sum = 0;
             const auto check = [&](const std::string& what, double got, double expected) {
@@ -697,7 +706,7 @@ bool merge_weights_match(const MediumMis& h, VcmFaults faults, std::string& repo
                               std::to_string(expected) + "\n";
                 }
             };
-            for (int s = 0; s <= h.k(f); ++s) check("s=" + std::to_string(s), h.bdpt_weight(f, s, &vm), h.strategy_density(f, s) / total);
+            for (int s = 0; s <= h.k(f); ++s) check("s=" + std::to_string(s), h.bdpt_weight(f, s, &vm), h.weighed_density(f, s) / total);
             for (int j = 1; j < h.k(f); ++j) {
                 const auto [running, walk] = h.merge_weights(vcm, f, j, vm);
                 if (std::abs(running - walk) > 1e-5 * walk + 1e-12) {
@@ -744,7 +753,7 @@ bool upbp_weights_match(const MediumMis& h, const std::string& estimators, std::
             const auto base = [&](int j) { return h.strategy_density(f, h.k(f) - j) * h.light_density(f, j); };
             double total = 0;
             for (int s = 0; s <= h.k(f); ++s)
-                if (s == 0 || e.bpt) total += h.strategy_density(f, s);
+                if (s == 0 || e.bpt) total += h.weighed_density(f, s);
             for (int j = 1; j < h.k(f); ++j) {
                 if (!f.in_medium[size_t(j)]) total += e.surf ? base(j) * disc : 0.0;
                 else
@@ -768,7 +777,7 @@ bool upbp_weights_match(const MediumMis& h, const std::string& estimators, std::
                 }
             };
             for (int s = 0; s <= h.k(f); ++s)
-                if (s == 0 || e.bpt) check("s=" + std::to_string(s), h.bdpt_weight(f, s, &vm), h.strategy_density(f, s) / total);
+                if (s == 0 || e.bpt) check("s=" + std::to_string(s), h.bdpt_weight(f, s, &vm), h.weighed_density(f, s) / total);
             for (int j = 1; j < h.k(f); ++j) {
                 const bool medium = f.in_medium[size_t(j)];
                 if (medium ? e.pp3d : e.surf) {

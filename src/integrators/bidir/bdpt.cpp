@@ -313,13 +313,25 @@ ConnectionDensities Bdpt<T>::connection_densities(const RenderContext& ctx, cons
 }
 
 template <class T>
+float Bdpt<T>::seen_directly_weight(const RenderContext& ctx, SubpathView light, int s, SubpathView camera, const Vertex& sampled,
+                                    const EdgeDensities& known, const MergeMis* vm) const {
+    const Vertex& end = s == 0 ? camera[1] : light[0];
+    if ((vm && !vm->connections) || !both_strategies_see(ctx.scene, end)) return 1.0f;
+    // T: the edge's MIS transmittance, the same function of the segment on both sides.
+    if (s == 0) return seen_directly_weight(0, end.pdf_fwd, pdf_light_origin(ctx.scene, end, camera[0]), end.T_in, options_.mis_power);
+    // The camera's density of y_0 across the new edge (as connection_densities' light_end).
+    const float p0 = pdf_next(ctx.scene, ctx.camera, nullptr, sampled, end) * end.distance_factor(known.T);
+    return seen_directly_weight(1, p0, end.pdf_fwd, known.T, options_.mis_power);
+}
+
+template <class T>
 float Bdpt<T>::mis_weight(const RenderContext& ctx, SubpathView light, int s, SubpathView camera, int t, const Vertex& sampled,
                           const EdgeDensities& known, const MergeMis* vm) const {
-    if (s + t == 2) return 1.0f;
+    if (s + t == 2) return seen_directly_weight(ctx, light, s, camera, sampled, known, vm);
     if (faults_.any()) return mis_weight_oracle(ctx, light, s, camera, t, sampled, known, vm);
-    // The strategy's own vertices: the sampled endpoint (y_0 for s = 1, z_0 for t = 1), and the
-    // densities across the new edge; the rest from the running quantities (path_vertex.hpp).
-    const Vertex* const ys = s == 1 ? &sampled : light.data();
+    // The strategy's own vertices: the sampled endpoint (y_0 for s = 1 and t > 1, z_0 for t = 1),
+    // and the densities across the new edge; the rest from the running quantities (path_vertex.hpp).
+    const Vertex* const ys = s == 1 && t > 1 ? &sampled : light.data();
     const Vertex* const zs = t == 1 ? &sampled : camera.data();
     const ConnectionDensities d = connection_densities(ctx, ys, s, zs, t, known);
     const MisRules rules(options_.mis_power, vm);
@@ -333,11 +345,11 @@ float Bdpt<T>::mis_weight(const RenderContext& ctx, SubpathView light, int s, Su
 template <class T>
 float Bdpt<T>::mis_weight_oracle(const RenderContext& ctx, SubpathView light_view, int s, SubpathView camera_view, int t,
                                  const Vertex& sampled, const EdgeDensities& known, const MergeMis* vm) const {
-    if (s + t == 2) return 1.0f;
+    if (s + t == 2) return seen_directly_weight(ctx, light_view, s, camera_view, sampled, known, vm);
     // The connection's densities written onto copies of the vertices for the walk.
     Subpath light(light_view.begin(), light_view.end()), camera(camera_view.begin(), camera_view.end());
     Vertex end = sampled;
-    Vertex* const ys = s == 1 ? &end : light.data();
+    Vertex* const ys = s == 1 && t > 1 ? &end : light.data();
     Vertex* const zs = t == 1 ? &end : camera.data();
     const ConnectionDensities d = connection_densities(ctx, ys, s, zs, t, known);
     Vertex* qs = s > 0 ? &ys[s - 1] : nullptr;
@@ -410,7 +422,9 @@ StrategyResult<T> Bdpt<T>::connect(const RenderContext& ctx, SubpathView light, 
         }
     } else if (t == 1) {
         const Vertex& qs = light[size_t(s - 1)];
-        if (!qs.connectible() || qs.kind == VertexKind::Light) return r;
+        // The emitter's own point (s = 1) where a light seen directly has two strategies.
+        const bool emitter = qs.kind == VertexKind::Light;
+        if (!qs.connectible() || (emitter && !both_strategies_see(scene, qs))) return r;
         const auto k = ctx.camera.connect(qs.p);
         if (!k) return r;
         sampled.kind = VertexKind::Camera;
@@ -418,10 +432,20 @@ StrategyResult<T> Bdpt<T>::connect(const RenderContext& ctx, SubpathView light, 
         sampled.medium = scene.camera_medium();
         sampled.beta = Colour(k->We / k->pdfW);
         if (separated(qs, sampled, k->wi)) return r;
-        r.L = qs.beta * bsdf_towards(scene, qs, k->wi, known.qs_to_pt, wl) * sampled.beta * cos_at(qs, k->wi);
+        if (emitter) {
+            // (Through no medium, T = 1, the weight is 0: seen_directly_weight.)
+            // Le towards the camera (area emitters are Lambertian: y_0's beta is Le), over the
+            // density of y_0 (pdf_fwd: the emitter's pmf times its position's area density).
+            const float cos_light = dot(qs.emitter_n, k->wi);
+            if (!(cos_light > 0)) return r;
+            r.L = qs.beta * (cos_light / qs.pdf_fwd) * sampled.beta;
+        } else {
+            r.L = qs.beta * bsdf_towards(scene, qs, k->wi, known.qs_to_pt, wl) * sampled.beta * cos_at(qs, k->wi);
+        }
         if (is_black(r.L)) return StrategyResult<T>{};
         const Colour Tr = transmittance(qs, sampled, k->wi);
         if (is_black(Tr)) return StrategyResult<T>{};
+        if (emitter && !(known.T < 1)) return StrategyResult<T>{};  // through no medium: weight 0 (seen_directly_weight)
         if (media) r.L *= Tr;
         r.splat = true;
         r.raster = k->raster;

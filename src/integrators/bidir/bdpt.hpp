@@ -155,7 +155,36 @@ public:
     // MIS weight (vcm).
     StrategyResult<T> connect(const RenderContext& ctx, SubpathView light, int s, SubpathView camera, int t, Sampler& sampler,
                               const Wavelengths& wl, const MergeMis* vm = nullptr) const;
-    // The MIS weight of strategy (s, t); `sampled` replaces y_0 (s = 1) or z_0 (t = 1). From the
+    // Whether a light seen directly has two strategies: the camera's ray finding it (s = 0) and
+    // the emitter's own point connected to the camera (s = t = 1, as light tracing does). Only in
+    // scenes with media: in a vacuum s = 0 alone is exact up to the pixel's sample position;
+    // through a medium its free-flight sampling reaches the light with probability T, a coin
+    // flip per sample, where the connection carries T as a factor.
+    static bool connects_emitters_to_camera(const Scene& scene) { return scene.has_media(); }
+    // Whether the path of no bounce (s + t = 2) whose camera vertex z_1 (s = 0) or light vertex
+    // y_0 (s = 1) is `end` has both strategies (else its one strategy has weight 1).
+    static bool both_strategies_see(const Scene& scene, const Vertex& end) {
+        return connects_emitters_to_camera(scene) && !end.infinite && !end.delta_light && end.light >= 0 && end.has_normal();
+    }
+    // The weight of strategy s (0 or 1) of such a path: p0 the camera's density of the emitter
+    // point (per unit area, times the segment's MIS transmittance T), p1 the light's (its pmf
+    // times the area density). Not the balance heuristic of p0 and p1: s = 0's estimate is
+    // exact but for free-flight sampling's coin flip, whose variance is the factor 1 - T of the
+    // estimate's, so p0 counts as p0 / (1 - T) (variance-aware MIS, Grittmann et al. 2019, weighs
+    // each technique by its density over its variance): s = 0 alone through a vacuum (T = 1, the
+    // image of a scene without media), the balance (or power) heuristic in dense media (T -> 0).
+    // Any weights that sum to 1 over the path's strategies keep the estimate unbiased.
+    static float seen_directly_weight(int s, double p0, double p1, double transmittance, bool power) {
+        const double a0 = p0, a1 = std::max(0.0, 1 - transmittance) * p1;
+        const double h0 = power ? a0 * a0 : a0, h1 = power ? a1 * a1 : a1;
+        if (!(h0 + h1 > 0)) return s == 0 ? 1.0f : 0.0f;
+        return float((s == 0 ? h0 : h1) / (h0 + h1));
+    }
+    // That weight for strategy (s, t) with s + t = 2, from the subpaths (as mis_weight's
+    // arguments; without connections, vm->connections off, s = 0 is the only strategy).
+    float seen_directly_weight(const RenderContext& ctx, SubpathView light, int s, SubpathView camera, const Vertex& sampled,
+                               const EdgeDensities& known, const MergeMis* vm) const;
+    // The MIS weight of strategy (s, t); `sampled` replaces y_0 (s = 1, t > 1) or z_0 (t = 1). From the
     // subpaths' running quantities (made with the same `vm`) in O(1).
     float mis_weight(const RenderContext& ctx, SubpathView light, int s, SubpathView camera, int t, const Vertex& sampled,
                      const EdgeDensities& known = {}, const MergeMis* vm = nullptr) const;
@@ -181,7 +210,7 @@ public:
             const int s_max = !vm || vm->connections ? std::max(1, int(light.size())) : 0;
             for (int s = 0; s <= s_max; ++s) {
                 const int depth = s + t - 2;
-                if ((s == 1 && t == 1) || depth < 0 || depth > max_bounces_) continue;
+                if ((s == 1 && t == 1 && !connects_emitters_to_camera(ctx.scene)) || depth < 0 || depth > max_bounces_) continue;
                 if (options_.only_length >= 0 && depth != options_.only_length) continue;
                 if (options_.hide_emitters && depth == 0) continue;
                 const StrategyResult<T> r = connect(ctx, light, s, camera, t, sampler, wl, vm);

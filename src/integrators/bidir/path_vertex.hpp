@@ -205,7 +205,8 @@ double mis_ratio_sum(const LightAt& light, int s, const CameraAt& camera, int t,
 // this strategy (see Bdpt::mis_weight); vertices are left unchanged.
 template <class Vertex>
 float mis_weight_ratio_walk(const Vertex* light, int s, const Vertex* camera, int t, bool power, const MergeMis* vm = nullptr) {
-    if (s + t == 2) return 1.0f;  // a light seen directly: only s = 0 samples it (s = t = 1 is not used)
+    // (A light seen directly, s + t = 2: the caller decides whether s = t = 1 is a strategy; a
+    // path with s = 0 alone has weight 1 without the walk.)
     const double sum = mis_ratio_sum([light](int i) { return mis_vertex(light[i]); }, s, [camera](int i) { return mis_vertex(camera[i]); },
                                      t, power, vm);
     return float(1 / (1 + sum));

@@ -4,8 +4,8 @@
 // position over the whole image, the wavelengths in spectral mode, the hero channel in media,
 // the walk), the light subpath's and the connection's (next-event estimation's light point,
 // transmittance estimates). The first number picks one of bdpt's n_d strategies (s, t) with
-// s + t = d + 2 uniformly (n_d = d + 2: s = 0 .. d + 1, t >= 1; at d = 0 only s = 0, t = 2,
-// as bdpt has it); the camera subpath is traced to t vertices, the light subpath to s, and
+// s + t = d + 2 uniformly (n_d = d + 2: s = 0 .. d + 1, t >= 1; at d = 0 s = 0, t = 2, and in
+// scenes with media s = t = 1 too, as bdpt has it); the camera subpath is traced to t vertices, the light subpath to s, and
 // the strategy's contribution is bdpt's connection times its MIS weight times n_d. So the
 // contribution a chain follows is the part of the path that this strategy samples well: the
 // chain moves between strategies as it moves between paths, and a path that only one strategy
@@ -46,7 +46,7 @@ template <class T>
 ChainSample Mmlt<T>::evaluate(const RenderContext& ctx, PrimarySamples& state, int chain) {
     Sampler camera_numbers(state, 0), light_numbers(state, 1), connection_numbers(state, 2);
     const int d = first_length_ + int(state.label());
-    const int strategies = d == 0 ? 1 : d + 2;
+    const int strategies = d == 0 ? (Bdpt<T>::connects_emitters_to_camera(ctx.scene) ? 2 : 1) : d + 2;
     const int s = std::min(int(camera_numbers.next1d() * float(strategies)), strategies - 1), t = d + 2 - s;
     const Vec2f raster = raster_anywhere(ctx, camera_numbers.next2d());
     const WavelengthsOf<T> wl = T::camera_wavelengths(camera_numbers);
@@ -58,7 +58,7 @@ ChainSample Mmlt<T>::evaluate(const RenderContext& ctx, PrimarySamples& state, i
     bdpt_.camera_subpath_at(ctx, raster, camera_numbers, wl, camera, t, nullptr, hero);
     if (int(camera.size()) < t) return p;
     light.clear();
-    if (s >= 2) {  // (s = 1 samples its light point in the connection; s = 0 has none)
+    if (s >= 2 || t == 1) {  // (s = 1, t > 1 samples its light point in the connection; s = 0 has none)
         bdpt_.light_subpath(ctx, light_numbers, wl, light, nullptr, hero, s);
         if (int(light.size()) < s) return p;
     }

@@ -421,6 +421,7 @@ StrategyResult<T> Bdpt<T>::connect(const RenderContext& ctx, SubpathView light, 
             if (dot(pt.emitter_n, w) > 0) r.L = pt.beta * light_colour(scene, pt.light, surface_radiance(scene.lights()[size_t(pt.light)], pt.sp.uv), wl);
         }
     } else if (t == 1) {
+        if (s > int(light.size())) return r;  // (s = 1 with no light subpath: an emission sample that failed)
         const Vertex& qs = light[size_t(s - 1)];
         // The emitter's own point (s = 1) where a light seen directly has two strategies.
         const bool emitter = qs.kind == VertexKind::Light;
@@ -433,7 +434,6 @@ StrategyResult<T> Bdpt<T>::connect(const RenderContext& ctx, SubpathView light, 
         sampled.beta = Colour(k->We / k->pdfW);
         if (separated(qs, sampled, k->wi)) return r;
         if (emitter) {
-            // (Through no medium, T = 1, the weight is 0: seen_directly_weight.)
             // Le towards the camera (area emitters are Lambertian: y_0's beta is Le), over the
             // density of y_0 (pdf_fwd: the emitter's pmf times its position's area density).
             const float cos_light = dot(qs.emitter_n, k->wi);

@@ -5,6 +5,7 @@
 
 #include <tbb/info.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <map>
@@ -62,7 +63,8 @@ void bidir_efficiency_suite(const BidirEfficiencyOptions& o) {
         const double ref_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         fmt::print("\n## scenes/{} (reference: {:.0f} s)\n", key, ref_seconds);
         // Pixels whose first surface is a Dirac one: lt's image is incomplete there.
-        const size_t dirac_pixels = count_marked(specular_first_vertex_mask(*scene, o.size, o.size, 4, /*dilate=*/false));
+        const bool any_lt = std::any_of(o.algorithms.begin(), o.algorithms.end(), sees_no_dirac_surface_first);
+        const size_t dirac_pixels = any_lt ? count_marked(specular_first_vertex_mask(*scene, o.size, o.size, 4, /*dilate=*/false)) : 0;
         if (key == o.scenes.front() && !o.judge.empty()) judge_images(o.judge, ref);
         for (const std::string& sampler_name : o.samplers) {
             const SamplerKind sampler = sampler_name == "sobol" ? SamplerKind::Sobol : SamplerKind::Independent;

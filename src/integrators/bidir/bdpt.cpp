@@ -317,10 +317,13 @@ float Bdpt<T>::seen_directly_weight(const RenderContext& ctx, SubpathView light,
                                     const EdgeDensities& known, const MergeMis* vm) const {
     const Vertex& end = s == 0 ? camera[1] : light[0];
     if ((vm && !vm->connections) || !both_strategies_see(ctx.scene, end)) return 1.0f;
-    // T: the edge's MIS transmittance, the same function of the segment on both sides.
-    if (s == 0) return seen_directly_weight(0, end.pdf_fwd, pdf_light_origin(ctx.scene, end, camera[0]), end.T_in, options_.mis_power);
-    // The camera's density of y_0 across the new edge (as connection_densities' light_end).
-    const float p0 = pdf_next(ctx.scene, ctx.camera, nullptr, sampled, end) * end.distance_factor(known.T);
+    // The other strategy's density of the shared vertex across the edge, as for any connection;
+    // T, the edge's MIS transmittance, is the same function of the segment on both sides.
+    if (s == 0) {
+        const float p1 = connection_densities(ctx, light.data(), 0, camera.data(), 2, known).camera_end;
+        return seen_directly_weight(0, end.pdf_fwd, p1, end.T_in, options_.mis_power);
+    }
+    const float p0 = connection_densities(ctx, light.data(), 1, &sampled, 1, known).light_end;
     return seen_directly_weight(1, p0, end.pdf_fwd, known.T, options_.mis_power);
 }
 

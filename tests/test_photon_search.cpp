@@ -45,10 +45,15 @@ TEST(PhotonSearch, GridAndKdTreeFindExactlyThePhotonsWithinTheRadius) {
     const std::vector<Photon<RgbTransport>> photons = random_photons(rng, 6000);
     size_t grand_total = 0;
     for (const float build_radius : {0.01f, 0.08f, 0.5f}) {
-        PhotonGrid grid;
+        PhotonGrid grid, placed;
         PhotonKdTree tree;
         grid.build(photons, build_radius);
         tree.build(photons, build_radius);
+        // build_placed: the items stored in its cell order by the caller; item_at[slot] is the item.
+        const std::vector<uint32_t>& place = placed.build_placed(Positions::of(photons), build_radius);
+        std::vector<uint32_t> item_at(photons.size(), uint32_t(-1));
+        for (size_t i = 0; i < photons.size(); ++i) item_at[place[i]] = uint32_t(i);
+        ASSERT_EQ(std::count(item_at.begin(), item_at.end(), uint32_t(-1)), 0) << "place must be a permutation";
         size_t total = 0;
         for (int k = 0; k < 600; ++k) {
             // Queries in and around the photons' box, some at photons, radii up to the build radius.
@@ -59,6 +64,11 @@ TEST(PhotonSearch, GridAndKdTreeFindExactlyThePhotonsWithinTheRadius) {
             total += expected.size();
             ASSERT_EQ(found(grid, photons, q, r), expected) << "grid, r=" << r << ", query " << k;
             ASSERT_EQ(found(tree, photons, q, r), expected) << "k-d tree, r=" << r << ", query " << k;
+            // The placed grid visits the same items in the same order as the plain one.
+            std::vector<uint32_t> plain, slots;
+            grid.for_each_within(q, r, [&](uint32_t i) { plain.push_back(i); });
+            placed.for_each_within(q, r, [&](uint32_t slot) { slots.push_back(item_at[slot]); });
+            ASSERT_EQ(slots, plain) << "placed grid, r=" << r << ", query " << k;
         }
         EXPECT_GT(total, 150u) << "the queries at photons must find them";
         grand_total += total;
@@ -92,7 +102,12 @@ TEST(PhotonSearch, PrefetchingSearchCallsBackInTheSameOrder) {
     Pcg32 rng(56, 78);
     std::vector<Photon<RgbTransport>> photons = random_photons(rng, 6000);
     PhotonGrid grid;
-    grid.build_sorted(photons, 0.3f);
+    {
+        const std::vector<uint32_t>& place = grid.build_placed(Positions::of(photons), 0.3f);
+        std::vector<Photon<RgbTransport>> in_cell_order(photons.size());
+        for (size_t i = 0; i < photons.size(); ++i) in_cell_order[place[i]] = photons[i];
+        photons = std::move(in_cell_order);
+    }
     size_t longest = 0;
     for (int k = 0; k < 200; ++k) {
         const Vec3f q = k % 2 == 0 ? photons[size_t(rng.next_u32() % photons.size())].p

@@ -25,6 +25,9 @@ struct Positions {
     template <class P> static Positions of(const std::vector<P>& items) {
         return {items.empty() ? nullptr : reinterpret_cast<const char*>(&items.front().p), sizeof(P), items.size()};
     }
+    static Positions of(const std::vector<Vec3f>& points) {
+        return {points.empty() ? nullptr : reinterpret_cast<const char*>(points.data()), sizeof(Vec3f), points.size()};
+    }
     const Vec3f& operator[](size_t i) const { return *reinterpret_cast<const Vec3f*>(first + i * stride); }
     size_t size() const { return count; }
     bool empty() const { return count == 0; }
@@ -43,13 +46,13 @@ public:
     // grid is searched.
     template <class P> void build(const std::vector<P>& items, float radius) { build(Positions::of(items), radius); }
     void build(Positions positions, float radius);
-    // The same, with the items themselves moved into the grid's cell order (stable: by index
-    // within a cell), in place, and their positions copied into a dense array in that order: a
-    // query's distance tests then read one contiguous run of 12-byte positions per cell (not one
-    // item's cache line per candidate), and visit the items in the order build() would. f(i)
-    // gets indices into the reordered items. `companion`, unless empty, is an array of as many
-    // values that belong to the items (one each) and is reordered with them.
-    template <class P, class Q = char> void build_sorted(std::vector<P>& items, float radius, std::vector<Q>* companion = nullptr);
+    // For items that the caller stores in the grid's cell order itself (vcm writes each merge
+    // vertex once, at its place, instead of moving a million of them after the build): returns
+    // place, where place[i] is the slot in that order of the item at positions[i] (stable: by
+    // index within a cell). The grid keeps a dense copy of the positions in that order, so a
+    // query's distance tests read one contiguous run of 12-byte positions per cell, and f(k) gets
+    // slots. `positions` need not outlive the call. Parallel; the same result on any number of threads.
+    const std::vector<uint32_t>& build_placed(Positions positions, float radius);
     template <typename F> void for_each_within(const Vec3f& q, float r, F&& f) const { for_each_within(q, r, f, [](uint32_t) {}); }
     // The same, calling prefetch(i) for the items found ahead of f(i): they are gathered in
     // batches, all of a batch's prefetches issued before its first f, so that the reads of their
@@ -57,7 +60,7 @@ public:
     // each waiting for f to finish the one before. f still sees the items in the same order.
     template <typename F, typename Prefetch> void for_each_within(const Vec3f& q, float r, F&& f, Prefetch&& prefetch) const;
     size_t memory_bytes() const {
-        return cell_ends_.capacity() * sizeof(uint32_t) + order_.capacity() * sizeof(uint32_t) + cell_of_.capacity() * sizeof(uint32_t) +
+        return cell_ends_.capacity() * sizeof(uint32_t) + order_.capacity() * sizeof(uint32_t) + place_.capacity() * sizeof(uint32_t) +
                sorted_p_.capacity() * sizeof(Vec3f);
     }
 
@@ -69,39 +72,13 @@ private:
     Vec3f lo_{0.0f};
     float cell_size_ = 1, inv_cell_ = 1;
     std::vector<uint32_t> cell_ends_;  // photons of cell c: order_[cell_ends_[c-1] .. cell_ends_[c])
-    std::vector<uint32_t> order_;      // photon indices sorted by cell (stable: by index within a cell)
-    std::vector<uint32_t> cell_of_;    // build's scratch: each photon's cell
-    bool sorted_ = false;              // the items are in cell order (build_sorted): order_ is unused
-    std::vector<Vec3f> sorted_p_;      // build_sorted: the items' positions, in cell order
+    std::vector<uint32_t> order_;      // build: photon indices sorted by cell (stable: by index within a cell)
+    std::vector<uint32_t> place_;      // each photon's slot in that order (order_'s inverse)
+    bool sorted_ = false;              // build_placed: positions_ is sorted_p_, in cell order; order_ is unused
+    std::vector<Vec3f> sorted_p_;      // build_placed: the items' positions, in cell order
+    // Both builds: the cells' runs (cell_ends_) and each item's slot (place_).
+    void sort_into_cells(Positions positions, float radius);
 };
-
-template <class P, class Q> void PhotonGrid::build_sorted(std::vector<P>& items, float radius, std::vector<Q>* companion) {
-    build(Positions::of(items), radius);
-    const bool with = companion && !companion->empty();
-    // Gather items[k] = old items[order_[k]] by following the permutation's cycles; a visited
-    // slot is marked by order_[k] = k.
-    for (size_t start = 0; start < items.size(); ++start) {
-        if (order_[start] == start) continue;
-        P held = std::move(items[start]);
-        Q held_companion{};
-        if (with) held_companion = std::move((*companion)[start]);
-        size_t k = start;
-        while (order_[k] != start) {
-            const size_t from = order_[k];
-            items[k] = std::move(items[from]);
-            if (with) (*companion)[k] = std::move((*companion)[from]);
-            order_[k] = uint32_t(k);
-            k = from;
-        }
-        items[k] = std::move(held);
-        if (with) (*companion)[k] = std::move(held_companion);
-        order_[k] = uint32_t(k);
-    }
-    sorted_p_.resize(items.size());
-    for (size_t k = 0; k < items.size(); ++k) sorted_p_[k] = items[k].p;
-    positions_ = {reinterpret_cast<const char*>(sorted_p_.data()), sizeof(Vec3f), sorted_p_.size()};
-    sorted_ = true;
-}
 
 template <typename F, typename Prefetch> void PhotonGrid::for_each_within(const Vec3f& q, float r, F&& f, Prefetch&& prefetch) const {
     if (positions_.empty()) return;

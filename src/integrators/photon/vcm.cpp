@@ -152,7 +152,7 @@ MergeVertex<T> Vcm<T>::merge_vertex(const Vertex* y, int j) {
 }
 
 template <class T>
-uint64_t Vcm<T>::trace_light_paths(const RenderContext& ctx, uint64_t pass, const Wavelengths& wl, const MergeMis& vm, int hero) {
+uint64_t Vcm<T>::trace_light_paths(const RenderContext& ctx, uint64_t pass, const Wavelengths& wl, const MergeMis& vm, int hero, float r) {
     const size_t paths = ctx.pixel_count(), per_chunk = Bdpt<T>::chunk_size(paths), chunks = (paths + per_chunk - 1) / per_chunk;
     chunk_vertices_.resize(chunks);
     chunk_photons_.resize(chunks + 1);
@@ -202,21 +202,35 @@ uint64_t Vcm<T>::trace_light_paths(const RenderContext& ctx, uint64_t pass, cons
     photon_r_.resize(vm.merging && media ? photons_.size() : 0);
     light_beams_.clear();
     for (const std::vector<LightBeam>& beams : chunk_beams_) light_beams_.insert(light_beams_.end(), beams.begin(), beams.end());
-    if (vm.merging) {
+    if (vm.merging) place_photons(paths, media, r);
+    return rays.load();
+}
+
+template <class T>
+void Vcm<T>::place_photons(size_t paths, bool media, float r) {
+    const int max_bounces = bdpt_.max_bounces();
+    const size_t per_chunk = light_per_chunk_, chunks = chunk_vertices_.size();
+    // Calls f(k, y, v) for every merge vertex y[v] of the iteration, k its index in path order.
+    const auto for_each_photon = [&](auto&& f) {
         tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
             size_t k = chunk_photons_[c];
             const std::vector<Vertex>& vertices = chunk_vertices_[c];
             for (size_t j = c * per_chunk; j < std::min(paths, (c + 1) * per_chunk); ++j) {
                 const Vertex* y = vertices.data() + path_begin_[j];
                 for (size_t v = 1; v < path_length_[j]; ++v)
-                    if (is_photon(y[v], v, max_bounces, estimators_)) {
-                        if (media) photon_r_[k] = y[v].r;
-                        photons_[k++] = merge_vertex(y, int(v));
-                    }
+                    if (is_photon(y[v], v, max_bounces, estimators_)) f(k++, y, int(v));
             }
         });
-    }
-    return rays.load();
+    };
+    // Their positions first, the grid on them, and then each merge vertex made once, in its slot
+    // of the grid's cell order.
+    photon_positions_.resize(photons_.size());
+    for_each_photon([&](size_t k, const Vertex* y, int v) { photon_positions_[k] = y[v].p; });
+    const std::vector<uint32_t>& place = grid_.build_placed(Positions::of(photon_positions_), r);
+    for_each_photon([&](size_t k, const Vertex* y, int v) {
+        if (media) photon_r_[place[k]] = y[v].r;
+        photons_[place[k]] = merge_vertex(y, v);
+    });
 }
 
 template <class T>
@@ -333,7 +347,7 @@ void Vcm<T>::build_volume_tree(float r) {
     volume_position_.clear();
     for (size_t k = 0; k < photons_.size(); ++k)
         if (photons_[k].in_medium()) volume_index_.push_back(uint32_t(k)), volume_position_.push_back(photons_[k].p);
-    const Positions centres{reinterpret_cast<const char*>(volume_position_.data()), sizeof(Vec3f), volume_position_.size()};
+    const Positions centres = Positions::of(volume_position_);
     volume_tree_.build(centres, std::vector<float>(volume_position_.size(), r));
 }
 
@@ -527,8 +541,7 @@ PassCounters Vcm<T>::render_passes(const RenderContext& ctx, Film& film, uint64_
         const MergeMis vm = merge_mis(pixels, r, r_beam);
         // In media, one hero channel for every subpath of the iteration (see vcm.hpp).
         const int hero = Bdpt<T>::sample_hero(ctx, pixels, pass, wl);
-        rays += trace_light_paths(ctx, pass, wl, vm, hero);
-        if (vm.merging) grid_.build_sorted(photons_, r, &photon_r_);
+        rays += trace_light_paths(ctx, pass, wl, vm, hero, r);
         if (vm.eta_beam2d > 0) build_volume_tree(r_beam);
         if (vm.eta_beam1d > 0) {
             std::vector<BeamTree::Segment> segments(light_beams_.size());

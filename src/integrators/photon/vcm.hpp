@@ -16,7 +16,7 @@
 // of x, times eta = N pi r_i^2 (path_vertex.hpp, MergeMis). Every weight, a merged photon's too,
 // costs O(1): the subpaths carry running quantities, and a photon is a compact MergeVertex that
 // holds its subpath's (no merge reads the subpath it came from). The photons are sorted into the
-// grid's cell order in place (PhotonGrid::build_sorted).
+// grid's cell order as they are made (PhotonGrid::build_placed).
 //
 // The radius shrinks as in sppm (Knaus and Zwicker: r_i^2 = r_1^2 prod (k + alpha) / (k + 1),
 // progressive_radius.hpp; --radius, --alpha), so iterations are independent given their index
@@ -130,9 +130,9 @@ public:
                                const PassProgress& progress) override;
 
     // The light subpaths and photons of iteration `pass` at its wavelengths (kept until the next),
-    // with the running MIS quantities of the strategies in `vm` and the hero channel of media;
-    // returns the rays traced.
-    uint64_t trace_light_paths(const RenderContext& ctx, uint64_t pass, const Wavelengths& wl, const MergeMis& vm, int hero = -1);
+    // with the running MIS quantities of the strategies in `vm` and the hero channel of media, the
+    // photons in a grid for radius r; returns the rays traced.
+    uint64_t trace_light_paths(const RenderContext& ctx, uint64_t pass, const Wavelengths& wl, const MergeMis& vm, int hero, float r);
     // The merging estimate at camera vertex z_{t-1} (t >= 2, on a surface or in a medium) with the
     // current photons, radius r, MIS-weighted against every strategy in `vm` (times the camera throughput).
     Colour merge(const Scene& scene, const std::vector<Vertex>& camera, int t, float r, const MergeMis& vm, const Wavelengths& wl) const;
@@ -201,6 +201,9 @@ private:
     MergeVertex<T> photon_on_beam(const Scene& scene, const Vertex* y, const SubpathBeam<T>& b, float along, float mis_running,
                                   Vertex& x) const;
     const Vertex* light_path(uint32_t j) const;
+    // The merge vertices of the traced light subpaths (of `paths` pixels), each made in its slot of
+    // the grid's cell order (with its distance densities in media), and the grid for radius r.
+    void place_photons(size_t paths, bool media, float r);
     // The merge vertex that stands for a photon on a camera beam (pb2d) at distance `along`.
     void place_on_beam(const Scene& scene, const SubpathBeam<T>& beam, float along, const Vertex& from, Vertex& x) const;
 
@@ -211,10 +214,11 @@ private:
     // One iteration's light subpaths (for the connections of their own pixels), per chunk of
     // light paths, and where each path starts; its merge vertices, in one array.
     std::vector<std::vector<Vertex>> chunk_vertices_;
-    std::vector<size_t> chunk_photons_;   // where chunk c writes its merge vertices (before the grid sorts them)
+    std::vector<size_t> chunk_photons_;   // chunk c's merge vertices are these in path order
+    std::vector<Vec3f> photon_positions_;  // the merge vertices' positions in path order (the grid's input)
     std::vector<uint32_t> path_begin_;    // light path j: its chunk's vertices from here
     std::vector<uint16_t> path_length_;   // ... this many
-    std::vector<MergeVertex<T>> photons_;  // made in path order, then sorted into the grid's cells
+    std::vector<MergeVertex<T>> photons_;  // in the grid's cell order
     std::vector<Colour> photon_r_;         // in media: each photon's subpath's distance densities (PathVertex::r), in the same order
     PhotonGrid grid_;
     BallTree volume_tree_;                  // pb2d: the medium photons (indices into photons_ in volume_index_)

@@ -8,7 +8,7 @@
 // For a delta sample (conductor, plastic's coating) the derivative is that of the sample's
 // coefficient f (bsdf_sample.hpp), for other samples that of eval(wi, wo).
 //
-// Formulas (directions local, both above the surface):
+// Formulas (directions local, both above the surface but for roughdielectric):
 //   Phong:           df/drho_d = 1/pi,  df/drho_s = (n + 2) c^n / (2 pi),
 //                    df/dn = rho_s c^n (1 + (n + 2) ln c) / (2 pi)     (c = cos alpha > 0)
 //   roughconductor:  df/dR = F D G2 / (4 cos_i cos_o),  df/dalpha = R F (D' G2 + D G2') / (4 cos_i cos_o),
@@ -16,6 +16,8 @@
 //                    D' = D (-2/alpha + 4 s / (alpha^3 t)), t = s / alpha^2 + hz^2, s = hx^2 + hy^2,
 //                    Lambda' = a2 / (2 alpha sqrt(1 + a2)), a2 = alpha^2 tan^2;
 //                    for Beckmann D' = D (2 s / (alpha^3 hz^2) - 2/alpha), Lambda' = exp(-c^2) / (2 sqrt(pi) c alpha), c = 1/sqrt(a2)
+//   roughdielectric: df/dalpha = f (D'/D + G2'/G2) for reflection and refraction (wi on either side;
+//                    only D(h) and G2 depend on alpha, h the lobe's half vector)
 //   conductor (delta), plastic's coating (delta): df/dR = F / cos
 //   plastic, roughplastic base: df/drho = T_i T_o / (pi eta^2) d(rho')/drho, rho' = rho / (1 - Fdr)
 //                    (or rho / (1 - rho Fdr): derivative 1 / (1 - rho Fdr)^2)
@@ -86,6 +88,26 @@ float coating_fdr(const CoatedDiffuse& c, Compute&& compute) {
 template <typename Add>
 void bsdf_jacobian(const Material& m, const MaterialBinding& b, const Vec3f& wi, const Vec3f& wo, bool delta, Add&& add) {
     using namespace bsdf_derivative_detail;
+    if (const auto* r = std::get_if<RoughDielectricMaterial>(&m.model)) {
+        // Reflection and refraction alike: f = D(h) G2(wi, wo) times factors free of alpha (the
+        // Fresnel term at h, the refraction's Jacobian), h the half vector of the lobe, so
+        // df/dalpha = f (D'/D + G2'/G2), in the frame where wi is above (as eval: D and Lambda
+        // are even in z).
+        if (delta || b.alpha < 0 || wi.z == 0 || wo.z == 0) return;
+        const Rgb f = r->eval(wi, wo);
+        if (is_black(f)) return;
+        const bool outside = wi.z > 0;
+        const Vec3f i(wi.x, wi.y, std::abs(wi.z)), o(wo.x, wo.y, outside ? wo.z : -wo.z);
+        const float eta_i = outside ? r->ext_ior : r->int_ior, eta_o = outside ? r->int_ior : r->ext_ior;
+        Vec3f h = normalize(o.z > 0 ? i + o : i * eta_i + o * eta_o);
+        if (h.z < 0) h = -h;
+        const MicrofacetDistribution& d = r->distribution;
+        const float D = d.D(h);
+        if (!(D > 0)) return;
+        const float dlog_G = -(d.G1(i) * dlambda_dalpha(d, i) + d.G1(o) * dlambda_dalpha(d, o));
+        add(b.alpha, f * (dD_dalpha(d, h) / D + dlog_G));
+        return;
+    }
     if (wi.z <= 0 || wo.z <= 0) return;
     if (const auto* p = std::get_if<PhongMaterial>(&m.model)) {
         if (delta) return;

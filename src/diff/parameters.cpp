@@ -30,11 +30,13 @@ std::optional<ParamField> textured_field(const MaterialModel& m, int slot) {
     if (std::holds_alternative<PlasticMaterial>(m))
         return slot == CoatedDiffuse::kSlotDiffuse ? ParamField::PlasticDiffuse : ParamField::PlasticSpecular;
     if (std::holds_alternative<RoughPlasticMaterial>(m) && slot == CoatedDiffuse::kSlotDiffuse) return ParamField::RoughPlasticDiffuse;
+    if (std::holds_alternative<RoughDielectricMaterial>(m)) return ParamField::RoughDielectricAlpha;  // its only textured parameter
     return std::nullopt;
 }
 
 // The rgb reflectances (the fields whose texels are differentiable).
-bool is_reflectance(ParamField f) { return f != ParamField::PhongExponent && f != ParamField::RoughConductorAlpha && f < ParamField::Texels; }
+bool is_roughness(ParamField f) { return f == ParamField::RoughConductorAlpha || f == ParamField::RoughDielectricAlpha; }
+bool is_reflectance(ParamField f) { return f != ParamField::PhongExponent && !is_roughness(f) && f < ParamField::Texels; }
 
 const BitmapTexture* bitmap_of(const TextureBinding& b) {
     return b.scalar || !b.texture ? nullptr : std::get_if<BitmapTexture>(&b.texture->model());
@@ -69,7 +71,8 @@ bool is_diffuse_field(ParamField f) {
 std::string SceneParameter::range() const {
     switch (field) {
         case ParamField::PhongExponent: return "[0, 10000]";
-        case ParamField::RoughConductorAlpha: return "[0.001, 10]";
+        case ParamField::RoughConductorAlpha:
+        case ParamField::RoughDielectricAlpha: return "[0.001, 10]";
         case ParamField::MeshRadiance:
         case ParamField::SphereRadiance:
         case ParamField::PointIntensity:
@@ -122,6 +125,8 @@ std::vector<SceneParameter> scene_parameters(const SceneDescription& d) {
             add("specular_reflectance.value", ParamField::PlasticSpecular, 3);
         } else if (std::holds_alternative<RoughPlasticMaterial>(m.model)) {
             add("diffuse_reflectance.value", ParamField::RoughPlasticDiffuse, 3);
+        } else if (const auto* r = std::get_if<RoughDielectricMaterial>(&m.model)) {
+            if (!r->distribution.is_anisotropic()) add("alpha", ParamField::RoughDielectricAlpha, 1);
         }
     }
     for (size_t i = 0; i < d.meshes.size(); ++i)  // (a textured emitter's radiance is its texture: not a value)
@@ -175,6 +180,7 @@ std::vector<float> parameter_value(const SceneDescription& d, const SceneParamet
         case ParamField::ConductorSpecular: return rgb(std::get<ConductorMaterial>(m).specular_reflectance);
         case ParamField::RoughConductorSpecular: return rgb(std::get<RoughConductorMaterial>(m).specular_reflectance);
         case ParamField::RoughConductorAlpha: return {std::get<RoughConductorMaterial>(m).distribution.alpha_u};
+        case ParamField::RoughDielectricAlpha: return {std::get<RoughDielectricMaterial>(m).distribution.alpha_u};
         case ParamField::PlasticDiffuse: return rgb(std::get<PlasticMaterial>(m).coat.diffuse_reflectance);
         case ParamField::PlasticSpecular: return rgb(std::get<PlasticMaterial>(m).coat.specular_reflectance);
         default: return rgb(std::get<RoughPlasticMaterial>(m).coat.diffuse_reflectance);
@@ -248,8 +254,10 @@ void set_parameter_value(SceneDescription& d, const SceneParameter& p, const std
         case ParamField::PhongExponent: std::get<PhongMaterial>(m).exponent = v[0]; return;
         case ParamField::ConductorSpecular: std::get<ConductorMaterial>(m).specular_reflectance = rgb(v); return;
         case ParamField::RoughConductorSpecular: std::get<RoughConductorMaterial>(m).specular_reflectance = rgb(v); return;
-        case ParamField::RoughConductorAlpha: {
-            MicrofacetDistribution& dist = std::get<RoughConductorMaterial>(m).distribution;
+        case ParamField::RoughConductorAlpha:
+        case ParamField::RoughDielectricAlpha: {
+            MicrofacetDistribution& dist = p.field == ParamField::RoughConductorAlpha ? std::get<RoughConductorMaterial>(m).distribution
+                                                                                    : std::get<RoughDielectricMaterial>(m).distribution;
             dist = MicrofacetDistribution(dist.type, v[0], v[0]);
             return;
         }
@@ -275,7 +283,8 @@ void clamp_parameter_value(const SceneParameter& p, std::vector<float>& v) {
     float lo = 0, hi = 1;
     switch (p.field) {
         case ParamField::PhongExponent: hi = 1e4f; break;
-        case ParamField::RoughConductorAlpha: lo = 1e-3f, hi = 10; break;
+        case ParamField::RoughConductorAlpha:
+        case ParamField::RoughDielectricAlpha: lo = 1e-3f, hi = 10; break;
         case ParamField::MeshRadiance:
         case ParamField::SphereRadiance:
         case ParamField::PointIntensity:
@@ -322,7 +331,8 @@ ParameterSet ParameterSet::choose(const SceneDescription& d, const std::vector<s
             case ParamField::RoughConductorSpecular:
             case ParamField::PlasticSpecular: mb->specular = off; break;
             case ParamField::PhongExponent: mb->exponent = off; break;
-            case ParamField::RoughConductorAlpha: mb->alpha = off; break;
+            case ParamField::RoughConductorAlpha:
+            case ParamField::RoughDielectricAlpha: mb->alpha = off; break;
             case ParamField::MeshRadiance: mesh[p.index] = off; break;
             case ParamField::SphereRadiance: sphere[p.index] = off; break;
             default: free_light[p.index] = off; break;

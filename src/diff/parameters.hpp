@@ -3,7 +3,7 @@
 //   <bsdf id>.diffuse_reflectance.value     phong, plastic, roughplastic: rho_d, rgb
 //   <bsdf id>.specular_reflectance.value    phong (rho_s), conductor, roughconductor, plastic: rgb
 //   <bsdf id>.exponent                      phong: n, float
-//   <bsdf id>.alpha                         roughconductor (isotropic): roughness, float
+//   <bsdf id>.alpha                         roughconductor, roughdielectric (isotropic): roughness, float
 //   <shape id>.emitter.radiance.value       area emitter on a shape: radiance, rgb
 //   <emitter id>.intensity.value            point light: intensity, rgb
 //   <emitter id>.radiance.value             constant environment: radiance, rgb
@@ -11,7 +11,7 @@
 //                                           reflectances above (e.g. reflectance.data): width *
 //                                           height * 3 linear values, row-major, top row first
 // A twosided wrapper is transparent (its id names the BSDF inside). Materials without an id,
-// pure emitters' black BSDFs (paths end there) and the other models (dielectrics: only an
+// pure emitters' black BSDFs (paths end there) and the other models (smooth dielectrics: only an
 // index of refraction, which moves refracted directions; blendbsdf, mask) have none; geometric
 // parameters (vertex positions, transforms) are out of scope (docs/differentiable.md).
 //
@@ -36,6 +36,7 @@ enum class ParamField {
     PlasticDiffuse,
     PlasticSpecular,
     RoughPlasticDiffuse,
+    RoughDielectricAlpha,
     Texels,          // a bitmap texture's texels; SceneParameter::texels_of says which reflectance
     MeshRadiance,    // index: the mesh
     SphereRadiance,  // index: the sphere

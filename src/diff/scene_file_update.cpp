@@ -27,7 +27,8 @@ std::vector<std::string> xml_names(const SceneParameter& p, const std::string& b
         case ParamField::PlasticDiffuse:
         case ParamField::RoughPlasticDiffuse: return {"diffuse_reflectance", "diffuseReflectance"};
         case ParamField::PhongExponent: return {"exponent"};
-        case ParamField::RoughConductorAlpha: return {"alpha"};
+        case ParamField::RoughConductorAlpha:
+        case ParamField::RoughDielectricAlpha: return {"alpha"};
         case ParamField::MeshRadiance:
         case ParamField::SphereRadiance:
         case ParamField::ConstantRadiance: return {"radiance"};

@@ -19,6 +19,7 @@
 //   roughdielectric: df/dalpha = f (D'/D + G2'/G2) for reflection and refraction (wi on either side;
 //                    only D(h) and G2 depend on alpha, h the lobe's half vector)
 //   conductor (delta), plastic's coating (delta): df/dR = F / cos
+//   roughplastic's coating: df/drho_s = F(wi.h) D G2 / (4 cos_i cos_o)
 //   plastic, roughplastic base: df/drho = T_i T_o / (pi eta^2) d(rho')/drho, rho' = rho / (1 - Fdr)
 //                    (or rho / (1 - rho Fdr): derivative 1 / (1 - rho Fdr)^2)
 #pragma once
@@ -164,10 +165,19 @@ void bsdf_jacobian(const Material& m, const MaterialBinding& b, const Vec3f& wi,
         return;
     }
     if (const auto* r = std::get_if<RoughPlasticMaterial>(&m.model)) {
-        if (delta || b.diffuse < 0) return;
-        const Rgb d = coated_base_derivative(r->coat, coating_fdr(r->coat, [&] { return r->coat.fdr; })) *
-                      (r->T(wi.z) * r->T(wo.z) * kInvPi / (r->coat.eta * r->coat.eta));
-        for (int ch = 0; ch < 3; ++ch) add(b.diffuse + ch, channel(ch, (&d.x)[ch]));
+        if (delta) return;
+        if (b.diffuse >= 0) {
+            const Rgb d = coated_base_derivative(r->coat, coating_fdr(r->coat, [&] { return r->coat.fdr; })) *
+                          (r->T(wi.z) * r->T(wo.z) * kInvPi / (r->coat.eta * r->coat.eta));
+            for (int ch = 0; ch < 3; ++ch) add(b.diffuse + ch, channel(ch, (&d.x)[ch]));
+        }
+        if (b.specular >= 0) {  // the coating's lobe, linear in its reflectance
+            const Vec3f h = normalize(wi + wo);
+            const float c = dot(wi, h), D = r->distribution.D(h);
+            if (!(c > 0) || !(D > 0)) return;
+            const float s = r->coat.fresnel(c) * D * r->distribution.G2(wi, wo) / (4 * wi.z * wo.z);
+            for (int ch = 0; ch < 3; ++ch) add(b.specular + ch, channel(ch, s));
+        }
     }
 }
 

@@ -29,7 +29,8 @@ std::optional<ParamField> textured_field(const MaterialModel& m, int slot) {
         return slot == RoughConductorMaterial::kSlotSpecularReflectance ? ParamField::RoughConductorSpecular : ParamField::RoughConductorAlpha;
     if (std::holds_alternative<PlasticMaterial>(m))
         return slot == CoatedDiffuse::kSlotDiffuse ? ParamField::PlasticDiffuse : ParamField::PlasticSpecular;
-    if (std::holds_alternative<RoughPlasticMaterial>(m) && slot == CoatedDiffuse::kSlotDiffuse) return ParamField::RoughPlasticDiffuse;
+    if (std::holds_alternative<RoughPlasticMaterial>(m))
+        return slot == CoatedDiffuse::kSlotDiffuse ? ParamField::RoughPlasticDiffuse : ParamField::RoughPlasticSpecular;
     if (std::holds_alternative<RoughDielectricMaterial>(m)) return ParamField::RoughDielectricAlpha;  // its only textured parameter
     return std::nullopt;
 }
@@ -125,6 +126,7 @@ std::vector<SceneParameter> scene_parameters(const SceneDescription& d) {
             add("specular_reflectance.value", ParamField::PlasticSpecular, 3);
         } else if (std::holds_alternative<RoughPlasticMaterial>(m.model)) {
             add("diffuse_reflectance.value", ParamField::RoughPlasticDiffuse, 3);
+            add("specular_reflectance.value", ParamField::RoughPlasticSpecular, 3);
         } else if (const auto* r = std::get_if<RoughDielectricMaterial>(&m.model)) {
             if (!r->distribution.is_anisotropic()) add("alpha", ParamField::RoughDielectricAlpha, 1);
         }
@@ -181,6 +183,7 @@ std::vector<float> parameter_value(const SceneDescription& d, const SceneParamet
         case ParamField::RoughConductorSpecular: return rgb(std::get<RoughConductorMaterial>(m).specular_reflectance);
         case ParamField::RoughConductorAlpha: return {std::get<RoughConductorMaterial>(m).distribution.alpha_u};
         case ParamField::RoughDielectricAlpha: return {std::get<RoughDielectricMaterial>(m).distribution.alpha_u};
+        case ParamField::RoughPlasticSpecular: return rgb(std::get<RoughPlasticMaterial>(m).coat.specular_reflectance);
         case ParamField::PlasticDiffuse: return rgb(std::get<PlasticMaterial>(m).coat.diffuse_reflectance);
         case ParamField::PlasticSpecular: return rgb(std::get<PlasticMaterial>(m).coat.specular_reflectance);
         default: return rgb(std::get<RoughPlasticMaterial>(m).coat.diffuse_reflectance);
@@ -272,8 +275,10 @@ void set_parameter_value(SceneDescription& d, const SceneParameter& p, const std
             return;
         }
         default: {
-            RoughPlasticMaterial& r = std::get<RoughPlasticMaterial>(m);
-            r = RoughPlasticMaterial(r.distribution, recoat(r.coat, rgb(v), r.coat.specular_reflectance));
+            // The reflectances only: the rough coating's tables and Fdr (of eta and the roughness) stay.
+            CoatedDiffuse& c = std::get<RoughPlasticMaterial>(m).coat;
+            (p.field == ParamField::RoughPlasticSpecular ? c.specular_reflectance : c.diffuse_reflectance) = rgb(v);
+            c.update();
             return;
         }
     }
@@ -329,7 +334,8 @@ ParameterSet ParameterSet::choose(const SceneDescription& d, const std::vector<s
             case ParamField::PhongSpecular:
             case ParamField::ConductorSpecular:
             case ParamField::RoughConductorSpecular:
-            case ParamField::PlasticSpecular: mb->specular = off; break;
+            case ParamField::PlasticSpecular:
+            case ParamField::RoughPlasticSpecular: mb->specular = off; break;
             case ParamField::PhongExponent: mb->exponent = off; break;
             case ParamField::RoughConductorAlpha:
             case ParamField::RoughDielectricAlpha: mb->alpha = off; break;

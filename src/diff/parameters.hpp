@@ -1,7 +1,7 @@
 // Differentiable scene parameters by name, as Mitsuba 3's traverse() names them:
 //   <bsdf id>.reflectance.value             diffuse (Phong without a glossy lobe): rho, rgb
 //   <bsdf id>.diffuse_reflectance.value     phong, plastic, roughplastic: rho_d, rgb
-//   <bsdf id>.specular_reflectance.value    phong (rho_s), conductor, roughconductor, plastic: rgb
+//   <bsdf id>.specular_reflectance.value    phong (rho_s), conductor, roughconductor, plastic, roughplastic: rgb
 //   <bsdf id>.exponent                      phong: n, float
 //   <bsdf id>.alpha                         roughconductor, roughdielectric (isotropic): roughness, float
 //   <shape id>.emitter.radiance.value       area emitter on a shape: radiance, rgb
@@ -36,6 +36,7 @@ enum class ParamField {
     PlasticDiffuse,
     PlasticSpecular,
     RoughPlasticDiffuse,
+    RoughPlasticSpecular,
     RoughDielectricAlpha,
     Texels,          // a bitmap texture's texels; SceneParameter::texels_of says which reflectance
     MeshRadiance,    // index: the mesh

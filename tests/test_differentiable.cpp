@@ -196,6 +196,21 @@ TEST(DiffParameters, CourseScenesNameTheirMaterialsAndLights) {
     }
 }
 
+// The path replay does not see media: a scene with one is refused (issue: no silent wrong
+// answer), naming the medium; a medium declared and never used changes nothing.
+TEST(DiffParameters, ScenesWithMediaAreRefused) {
+    const SceneDescription fog = load_scene_file(std::string(PATHLAB_SOURCE_DIR) + "/scenes/fog-box.xml");
+    try {
+        ParameterSet::choose(fog, {"floor.reflectance.value"});
+        ADD_FAILURE() << "a scene with fog must be refused";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("'fog'"), std::string::npos) << e.what();
+    }
+    SceneDescription unused = course(2);
+    unused.media = fog.media;  // declared, on no shape
+    EXPECT_NO_THROW(ParameterSet::choose(unused, {"red.reflectance.value"}));
+}
+
 TEST(DiffParameters, SetGetClampAndUnknownNames) {
     SceneDescription d = metals();
     const ParameterSet set = ParameterSet::choose(d, {"red.reflectance.value", "blue.alpha", "light.emitter.radiance.value"});

@@ -7,6 +7,8 @@
 
 #include <fmt/format.h>
 
+#include "scene/medium_in_use.hpp"
+
 namespace pathlab {
 namespace {
 
@@ -300,6 +302,12 @@ void clamp_parameter_value(const SceneParameter& p, std::vector<float>& v) {
 }
 
 ParameterSet ParameterSet::choose(const SceneDescription& d, const std::vector<std::string>& names) {
+    if (const std::string medium = medium_in_use(d); !medium.empty())
+        throw std::invalid_argument(fmt::format(
+            "this scene has the {}: the path replay (pt-mis's estimator, which `gradient` and `optimize` differentiate) does not "
+            "see participating media and would differentiate the scene as if the medium were not there; remove the medium "
+            "(docs/differentiable.md: media are not differentiable yet)",
+            medium));
     const std::vector<SceneParameter> all = scene_parameters(d);
     ParameterSet s;
     s.materials.assign(d.materials.size(), MaterialBinding{});

@@ -110,7 +110,8 @@ struct ParameterSet {
     std::vector<int> lights;
 
     // Chooses `names` of the description's parameters (std::invalid_argument for an unknown
-    // or repeated name, listing the valid ones).
+    // or repeated name, listing the valid ones, and for a scene with a participating medium,
+    // which the path replay does not see).
     static ParameterSet choose(const SceneDescription& d, const std::vector<std::string>& names);
 
     std::vector<float> values(const SceneDescription& d) const;

@@ -17,7 +17,9 @@
 //                    Lambda' = a2 / (2 alpha sqrt(1 + a2)), a2 = alpha^2 tan^2;
 //                    for Beckmann D' = D (2 s / (alpha^3 hz^2) - 2/alpha), Lambda' = exp(-c^2) / (2 sqrt(pi) c alpha), c = 1/sqrt(a2)
 //   roughdielectric: df/dalpha = f (D'/D + G2'/G2) for reflection and refraction (wi on either side;
-//                    only D(h) and G2 depend on alpha, h the lobe's half vector)
+//                    only D(h) and G2 depend on alpha, h the lobe's half vector); df/deta by forward-mode
+//                    dual numbers through eval's formulas (eta reaches the refraction lobe's half vector,
+//                    D(h), the Fresnel term and the Jacobian)
 //   conductor (delta), plastic's coating (delta): df/dR = F / cos
 //   roughplastic's coating: df/drho_s = F(wi.h) D G2 / (4 cos_i cos_o)
 //   plastic, roughplastic base: df/drho = T_i T_o / (pi eta^2) d(rho')/drho, rho' = rho / (1 - Fdr)
@@ -63,6 +65,80 @@ inline float dD_dalpha(const MicrofacetDistribution& d, const Vec3f& h) {
     return D * (2 * s / (alpha * alpha * alpha * z2) - 2 / alpha);
 }
 
+// A value and its derivative with respect to one parameter (forward mode): for a rough
+// dielectric's eta, which reaches its refraction lobe through the half vector.
+struct Dual {
+    float v = 0, d = 0;
+};
+inline Dual operator+(Dual a, Dual b) { return {a.v + b.v, a.d + b.d}; }
+inline Dual operator-(Dual a, Dual b) { return {a.v - b.v, a.d - b.d}; }
+inline Dual operator-(Dual a) { return {-a.v, -a.d}; }
+inline Dual operator*(Dual a, Dual b) { return {a.v * b.v, a.d * b.v + a.v * b.d}; }
+inline Dual operator/(Dual a, Dual b) { return {a.v / b.v, (a.d * b.v - a.v * b.d) / (b.v * b.v)}; }
+inline Dual constant(float v) { return {v, 0}; }
+inline Dual sqrt(Dual a) {
+    const float s = std::sqrt(a.v);
+    return {s, s > 0 ? a.d / (2 * s) : 0.0f};
+}
+inline Dual exp(Dual a) {
+    const float e = std::exp(a.v);
+    return {e, e * a.d};
+}
+
+// fresnel_dielectric (fresnel.hpp) with its derivative.
+inline Dual fresnel_dielectric(Dual cos_i, Dual eta) {
+    const Dual sin2_t = (constant(1) - cos_i * cos_i) / (eta * eta);
+    if (sin2_t.v >= 1) return constant(1);
+    const Dual ct = sqrt(constant(1) - sin2_t);
+    const Dual rs = (cos_i - eta * ct) / (cos_i + eta * ct), rp = (eta * cos_i - ct) / (eta * cos_i + ct);
+    return constant(0.5f) * (rs * rs + rp * rp);
+}
+
+// MicrofacetDistribution::D (isotropic) at a normal h with its derivative.
+inline Dual distribution_D(const MicrofacetDistribution& d, Dual hx, Dual hy, Dual hz) {
+    if (hz.v <= 0) return constant(0);
+    const float a = d.alpha_u;
+    const Dual s = (hx * hx + hy * hy) / constant(a * a), z2 = hz * hz;
+    if (d.type == MicrofacetType::GGX) {
+        const Dual t = s + z2;
+        return constant(1 / (kPi * a * a)) / (t * t);
+    }
+    return exp(-(s / z2)) / (constant(kPi * a * a) * z2 * z2);
+}
+
+// The rough dielectric's f(wi, wo) (roughdielectric.hpp's eval) with its derivative with respect
+// to eta = int_ior / ext_ior.
+inline Dual roughdielectric_f_eta(const RoughDielectricMaterial& r, Vec3f wi, Vec3f wo) {
+    const bool outside = wi.z > 0;
+    if (!outside) wi.z = -wi.z, wo.z = -wo.z;
+    // int_ior = eta ext_ior: d(int_ior)/d(eta) = ext_ior.
+    const Dual n_int{r.int_ior, r.ext_ior}, n_ext = constant(r.ext_ior);
+    const Dual eta_i = outside ? n_ext : n_int, eta_o = outside ? n_int : n_ext, eta = eta_o / eta_i;
+    const MicrofacetDistribution& d = r.distribution;
+    if (wo.z > 0) {  // reflection: only F depends on eta
+        const Vec3f h = normalize(wi + wo);
+        const float c = dot(wi, h), D = d.D(h);
+        if (!(c > 0) || !(D > 0)) return {};
+        return fresnel_dielectric(constant(c), eta) * constant(D * d.G2(wi, wo) / (4 * wi.z * wo.z));
+    }
+    Dual hx = eta_i * constant(wi.x) + eta_o * constant(wo.x), hy = eta_i * constant(wi.y) + eta_o * constant(wo.y),
+         hz = eta_i * constant(wi.z) + eta_o * constant(wo.z);
+    const Dual len = sqrt(hx * hx + hy * hy + hz * hz);
+    if (!(len.v > 0)) return {};
+    hx = hx / len, hy = hy / len, hz = hz / len;
+    if (hz.v < 0) hx = -hx, hy = -hy, hz = -hz;
+    const Dual ci = constant(wi.x) * hx + constant(wi.y) * hy + constant(wi.z) * hz,
+               co = constant(wo.x) * hx + constant(wo.y) * hy + constant(wo.z) * hz;
+    if (!(ci.v > 0) || !(co.v < 0)) return {};
+    const Dual D = distribution_D(d, hx, hy, hz);
+    if (!(D.v > 0)) return {};
+    const Dual F = eta.v >= 1 ? fresnel_dielectric(ci, eta) : fresnel_dielectric(-co, constant(1) / eta);
+    const Dual den = eta_i * ci + eta_o * co;
+    if (!(den.v * den.v > 0)) return {};
+    return (constant(1) - F) * D * constant(d.G2(wi, wo)) * ci * (-co) * eta_i * eta_i /
+           (constant(wi.z * -wo.z) * den * den);
+}
+
 // d(rho')/drho of a coated base, per channel (rho' = rho / (1 - Fdr) or rho / (1 - rho Fdr)).
 inline Rgb coated_base_derivative(const CoatedDiffuse& c, float fdr) {
     if (!c.nonlinear) return Rgb(1 / (1 - fdr));
@@ -94,7 +170,9 @@ void bsdf_jacobian(const Material& m, const MaterialBinding& b, const Vec3f& wi,
         // Fresnel term at h, the refraction's Jacobian), h the half vector of the lobe, so
         // df/dalpha = f (D'/D + G2'/G2), in the frame where wi is above (as eval: D and Lambda
         // are even in z).
-        if (delta || b.alpha < 0 || wi.z == 0 || wo.z == 0) return;
+        if (delta || wi.z == 0 || wo.z == 0) return;
+        if (b.eta >= 0) add(b.eta, Rgb(roughdielectric_f_eta(*r, wi, wo).d));
+        if (b.alpha < 0) return;
         const Rgb f = r->eval(wi, wo);
         if (is_black(f)) return;
         const bool outside = wi.z > 0;

@@ -39,7 +39,9 @@ std::optional<ParamField> textured_field(const MaterialModel& m, int slot) {
 
 // The rgb reflectances (the fields whose texels are differentiable).
 bool is_roughness(ParamField f) { return f == ParamField::RoughConductorAlpha || f == ParamField::RoughDielectricAlpha; }
-bool is_reflectance(ParamField f) { return f != ParamField::PhongExponent && !is_roughness(f) && f < ParamField::Texels; }
+bool is_reflectance(ParamField f) {
+    return f != ParamField::PhongExponent && !is_roughness(f) && f != ParamField::RoughDielectricEta && f < ParamField::Texels;
+}
 
 const BitmapTexture* bitmap_of(const TextureBinding& b) {
     return b.scalar || !b.texture ? nullptr : std::get_if<BitmapTexture>(&b.texture->model());
@@ -76,6 +78,7 @@ std::string SceneParameter::range() const {
         case ParamField::PhongExponent: return "[0, 10000]";
         case ParamField::RoughConductorAlpha:
         case ParamField::RoughDielectricAlpha: return "[0.001, 10]";
+        case ParamField::RoughDielectricEta: return "[0.2, 5]";
         case ParamField::MeshRadiance:
         case ParamField::SphereRadiance:
         case ParamField::PointIntensity:
@@ -131,6 +134,7 @@ std::vector<SceneParameter> scene_parameters(const SceneDescription& d) {
             add("specular_reflectance.value", ParamField::RoughPlasticSpecular, 3);
         } else if (const auto* r = std::get_if<RoughDielectricMaterial>(&m.model)) {
             if (!r->distribution.is_anisotropic()) add("alpha", ParamField::RoughDielectricAlpha, 1);
+            if (!r->dispersion) add("eta", ParamField::RoughDielectricEta, 1);
         }
     }
     for (size_t i = 0; i < d.meshes.size(); ++i)  // (a textured emitter's radiance is its texture: not a value)
@@ -185,6 +189,10 @@ std::vector<float> parameter_value(const SceneDescription& d, const SceneParamet
         case ParamField::RoughConductorSpecular: return rgb(std::get<RoughConductorMaterial>(m).specular_reflectance);
         case ParamField::RoughConductorAlpha: return {std::get<RoughConductorMaterial>(m).distribution.alpha_u};
         case ParamField::RoughDielectricAlpha: return {std::get<RoughDielectricMaterial>(m).distribution.alpha_u};
+        case ParamField::RoughDielectricEta: {
+            const RoughDielectricMaterial& r = std::get<RoughDielectricMaterial>(m);
+            return {r.int_ior / r.ext_ior};
+        }
         case ParamField::RoughPlasticSpecular: return rgb(std::get<RoughPlasticMaterial>(m).coat.specular_reflectance);
         case ParamField::PlasticDiffuse: return rgb(std::get<PlasticMaterial>(m).coat.diffuse_reflectance);
         case ParamField::PlasticSpecular: return rgb(std::get<PlasticMaterial>(m).coat.specular_reflectance);
@@ -266,6 +274,11 @@ void set_parameter_value(SceneDescription& d, const SceneParameter& p, const std
             dist = MicrofacetDistribution(dist.type, v[0], v[0]);
             return;
         }
+        case ParamField::RoughDielectricEta: {
+            RoughDielectricMaterial& r = std::get<RoughDielectricMaterial>(m);
+            r.int_ior = v[0] * r.ext_ior;
+            return;
+        }
         case ParamField::PlasticDiffuse: {
             CoatedDiffuse& c = std::get<PlasticMaterial>(m).coat;
             c = recoat(c, rgb(v), c.specular_reflectance);
@@ -292,6 +305,7 @@ void clamp_parameter_value(const SceneParameter& p, std::vector<float>& v) {
         case ParamField::PhongExponent: hi = 1e4f; break;
         case ParamField::RoughConductorAlpha:
         case ParamField::RoughDielectricAlpha: lo = 1e-3f, hi = 10; break;
+        case ParamField::RoughDielectricEta: lo = 0.2f, hi = 5; break;
         case ParamField::MeshRadiance:
         case ParamField::SphereRadiance:
         case ParamField::PointIntensity:
@@ -347,6 +361,7 @@ ParameterSet ParameterSet::choose(const SceneDescription& d, const std::vector<s
             case ParamField::PhongExponent: mb->exponent = off; break;
             case ParamField::RoughConductorAlpha:
             case ParamField::RoughDielectricAlpha: mb->alpha = off; break;
+            case ParamField::RoughDielectricEta: mb->eta = off; break;
             case ParamField::MeshRadiance: mesh[p.index] = off; break;
             case ParamField::SphereRadiance: sphere[p.index] = off; break;
             default: free_light[p.index] = off; break;

@@ -4,6 +4,7 @@
 //   <bsdf id>.specular_reflectance.value    phong (rho_s), conductor, roughconductor, plastic, roughplastic: rgb
 //   <bsdf id>.exponent                      phong: n, float
 //   <bsdf id>.alpha                         roughconductor, roughdielectric (isotropic): roughness, float
+//   <bsdf id>.eta                           roughdielectric (not dispersive): int_ior / ext_ior, float
 //   <shape id>.emitter.radiance.value       area emitter on a shape: radiance, rgb
 //   <emitter id>.intensity.value            point light: intensity, rgb
 //   <emitter id>.radiance.value             constant environment: radiance, rgb
@@ -38,6 +39,7 @@ enum class ParamField {
     RoughPlasticDiffuse,
     RoughPlasticSpecular,
     RoughDielectricAlpha,
+    RoughDielectricEta,
     Texels,          // a bitmap texture's texels; SceneParameter::texels_of says which reflectance
     MeshRadiance,    // index: the mesh
     SphereRadiance,  // index: the sphere
@@ -94,10 +96,10 @@ struct TexelBinding {
     bool bound() const { return offset >= 0; }
 };
 struct MaterialBinding {
-    int diffuse = -1, specular = -1, exponent = -1, alpha = -1;
+    int diffuse = -1, specular = -1, exponent = -1, alpha = -1, eta = -1;
     TexelBinding diffuse_texels, specular_texels;  // in place of diffuse, specular
     bool texels() const { return diffuse_texels.bound() || specular_texels.bound(); }
-    bool any() const { return diffuse >= 0 || specular >= 0 || exponent >= 0 || alpha >= 0 || texels(); }
+    bool any() const { return diffuse >= 0 || specular >= 0 || exponent >= 0 || alpha >= 0 || eta >= 0 || texels(); }
 };
 struct ParameterSet {
     std::vector<SceneParameter> params;

@@ -116,6 +116,11 @@ std::string scene_file_with_values(const std::string& scene_file, const Paramete
             set_filename(texture, file->second);
             continue;
         }
+        if (p.field == ParamField::RoughDielectricEta) {  // only the ratio matters: int_ior = eta, ext_ior = 1
+            set_value(element, {"int_ior", "intIOR"}, v);
+            set_value(element, {"ext_ior", "extIOR"}, {1.0f});
+            continue;
+        }
         set_value(element, xml_names(p, bsdf_type), v);
     }
     // Files the scene names are found from the original folder.

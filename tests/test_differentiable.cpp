@@ -548,6 +548,15 @@ TEST(DiffCli, ParamsNamesAreAcceptedByOptimize) {
     EXPECT_EQ(bad.code, 2);
     EXPECT_TRUE(test::contains(bad.err, "unknown parameter 'red.albedo'")) << bad.err;
     EXPECT_TRUE(test::contains(bad.err, "green.reflectance.value")) << bad.err;
+    // A scene with fog: refused by both (exit 2, naming the medium), not differentiated as if empty.
+    const std::string fog = std::string(PATHLAB_SOURCE_DIR) + "/scenes/fog-box.xml";
+    for (const std::string command : {"gradient", "optimize"}) {
+        std::vector<std::string> a = {command, "--scene", fog, "--params", "floor.reflectance.value", "--spp", "1", "--out", out};
+        if (command == "optimize") a.insert(a.end(), {"--target", target, "--iterations", "1", "-q"});
+        const test::CliResult refused = test::run(a);
+        EXPECT_EQ(refused.code, 2) << command;
+        EXPECT_TRUE(test::contains(refused.err, "medium 'fog'")) << command << ": " << refused.err;
+    }
     // --out naming the folder of a file they read (optimize's scene.xml was written over the
     // scene, final.exr over a target of that name) is refused, and the file is left as it was.
     // (opt/scene.xml is the scene optimize wrote above: a scene file like any other.)

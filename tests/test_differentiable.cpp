@@ -558,8 +558,12 @@ TEST(DiffCli, ParamsNamesAreAcceptedByOptimize) {
     EXPECT_EQ(bad.code, 2);
     EXPECT_TRUE(test::contains(bad.err, "unknown parameter 'red.albedo'")) << bad.err;
     EXPECT_TRUE(test::contains(bad.err, "green.reflectance.value")) << bad.err;
-    // A scene with fog: refused by both (exit 2, naming the medium), not differentiated as if empty.
+    // A scene with fog: refused by both (exit 2, naming the medium), not differentiated as if
+    // empty; params lists its parameters and says so.
     const std::string fog = std::string(PATHLAB_SOURCE_DIR) + "/scenes/fog-box.xml";
+    const test::CliResult listed = test::run({"params", fog});
+    EXPECT_EQ(listed.code, 0) << listed.err;
+    EXPECT_TRUE(test::contains(listed.out, "gradient and optimize refuse it")) << listed.out;
     for (const std::string command : {"gradient", "optimize"}) {
         std::vector<std::string> a = {command, "--scene", fog, "--params", "floor.reflectance.value", "--spp", "1", "--out", out};
         if (command == "optimize") a.insert(a.end(), {"--target", target, "--iterations", "1", "-q"});

@@ -25,6 +25,7 @@
 #include "job/usage_error.hpp"
 #include "judge/false_colour.hpp"
 #include "judge/svg_plot.hpp"
+#include "scene/medium_in_use.hpp"
 #include "scenefile/scene_file.hpp"
 
 namespace pathlab {
@@ -270,6 +271,8 @@ int run_params_command(const ParamsOptions& o) {
         fmt::print("{:<{}}  {:<7}  {:<34}  {:>4}  {}\n", p.name, width, p.kind(), value_text(p, parameter_value(scene.description, p)),
                    p.size, p.range());
     if (params.empty()) fmt::print("(none: differentiable parameters need ids on the scene's <bsdf>, <shape> and <emitter> elements)\n");
+    if (const std::string medium = medium_in_use(scene.description); !medium.empty())
+        fmt::print("(this scene has the {}: gradient and optimize refuse it, as their path replay does not see participating media)\n", medium);
     return 0;
 }
 

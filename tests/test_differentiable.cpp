@@ -277,13 +277,23 @@ TEST(DiffBsdf, JacobianMatchesDifferencesOfEval) {
         }
 }
 
+namespace {
+
+// Frosted glass: the left sphere of metals() a rough dielectric, seen, lit and looked through.
+SceneDescription frosted(float alpha, MicrofacetType type = MicrofacetType::GGX) {
+    SceneDescription d = metals();
+    d.materials[6] = make_rough_dielectric(MicrofacetDistribution(type, alpha, alpha), 1.5f);  // yellow
+    return d;
+}
+
+}  // namespace
+
 // A rough dielectric's alpha and eta: wi and wo on either side (reflection and refraction, from outside
 // and from inside), GGX and Beckmann, against central differences of eval.
 TEST(DiffBsdf, RoughDielectricAlphaAndEtaMatchDifferencesOfEval) {
     for (const std::string name : {"yellow.alpha", "yellow.eta"})
     for (const MicrofacetType type : {MicrofacetType::GGX, MicrofacetType::Beckmann}) {
-        SceneDescription d = metals();
-        d.materials[6] = make_rough_dielectric(MicrofacetDistribution(type, 0.3f, 0.3f), 1.5f);  // yellow
+        SceneDescription d = frosted(0.3f, type);
         d.meshes.clear(), d.spheres.clear(), d.lights.clear();
         const ParameterSet set = ParameterSet::choose(d, {name});
         const std::vector<float> theta = set.values(d);
@@ -370,13 +380,6 @@ TEST(DiffGradients, RoughConductorAndPlasticAgreeWithFiniteDifferences) {
 }
 
 namespace {
-
-// Frosted glass: the left sphere a rough dielectric, seen, lit and looked through.
-SceneDescription frosted(float alpha) {
-    SceneDescription d = metals();
-    d.materials[6] = make_rough_dielectric(MicrofacetDistribution(MicrofacetType::GGX, alpha, alpha), 1.5f);  // yellow
-    return d;
-}
 
 // Scene 2 with its floor frosted glass (GGX, alpha 0.2) of index ratio eta, over nothing: what
 // the camera sees of it is its reflection, which grows with eta (the Fresnel term); the light it

@@ -43,7 +43,6 @@ std::optional<double> environment_cap(const char* name) {
     return v;
 }
 
-
 // PATHLAB_SPP_CAP, PATHLAB_TIME_CAP and PATHLAB_RESOLUTION_CAP (see the header).
 void apply_environment_caps(RenderSettings& s, const SceneDescription& d) {
     if (const auto cap = environment_cap("PATHLAB_RESOLUTION_CAP")) {

@@ -71,7 +71,7 @@ private:
     Positions positions_;
     Vec3f lo_{0.0f};
     float cell_size_ = 1, inv_cell_ = 1;
-    std::vector<uint32_t> cell_ends_;  // photons of cell c: order_[cell_ends_[c-1] .. cell_ends_[c])
+    std::vector<uint32_t> cell_ends_;  // cell c: slots cell_ends_[c-1] .. cell_ends_[c] of the cell order
     std::vector<uint32_t> order_;      // build: photon indices sorted by cell (stable: by index within a cell)
     std::vector<uint32_t> place_;      // each photon's slot in that order (order_'s inverse)
     bool sorted_ = false;              // build_placed: positions_ is sorted_p_, in cell order; order_ is unused

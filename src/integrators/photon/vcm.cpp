@@ -152,7 +152,7 @@ MergeVertex<T> Vcm<T>::merge_vertex(const Vertex* y, int j) {
 }
 
 template <class T>
-uint64_t Vcm<T>::trace_light_paths(const RenderContext& ctx, uint64_t pass, const Wavelengths& wl, const MergeMis& vm, int hero, float r) {
+uint64_t Vcm<T>::trace_light_paths(const RenderContext& ctx, uint64_t pass, const Wavelengths& wl, const MergeMis& vm, int hero) {
     const size_t paths = ctx.pixel_count(), per_chunk = Bdpt<T>::chunk_size(paths), chunks = (paths + per_chunk - 1) / per_chunk;
     chunk_vertices_.resize(chunks);
     chunk_photons_.resize(chunks + 1);
@@ -202,7 +202,6 @@ uint64_t Vcm<T>::trace_light_paths(const RenderContext& ctx, uint64_t pass, cons
     photon_r_.resize(vm.merging && media ? photons_.size() : 0);
     light_beams_.clear();
     for (const std::vector<LightBeam>& beams : chunk_beams_) light_beams_.insert(light_beams_.end(), beams.begin(), beams.end());
-    if (vm.merging) place_photons(paths, media, r);
     return rays.load();
 }
 
@@ -541,7 +540,8 @@ PassCounters Vcm<T>::render_passes(const RenderContext& ctx, Film& film, uint64_
         const MergeMis vm = merge_mis(pixels, r, r_beam);
         // In media, one hero channel for every subpath of the iteration (see vcm.hpp).
         const int hero = Bdpt<T>::sample_hero(ctx, pixels, pass, wl);
-        rays += trace_light_paths(ctx, pass, wl, vm, hero, r);
+        rays += trace_light_paths(ctx, pass, wl, vm, hero);
+        if (vm.merging) place_photons(pixels, ctx.scene.has_media(), r);
         if (vm.eta_beam2d > 0) build_volume_tree(r_beam);
         if (vm.eta_beam1d > 0) {
             std::vector<BeamTree::Segment> segments(light_beams_.size());

@@ -130,9 +130,9 @@ public:
                                const PassProgress& progress) override;
 
     // The light subpaths and photons of iteration `pass` at its wavelengths (kept until the next),
-    // with the running MIS quantities of the strategies in `vm` and the hero channel of media, the
-    // photons in a grid for radius r; returns the rays traced.
-    uint64_t trace_light_paths(const RenderContext& ctx, uint64_t pass, const Wavelengths& wl, const MergeMis& vm, int hero, float r);
+    // with the running MIS quantities of the strategies in `vm` and the hero channel of media;
+    // returns the rays traced. The photons are made by place_photons.
+    uint64_t trace_light_paths(const RenderContext& ctx, uint64_t pass, const Wavelengths& wl, const MergeMis& vm, int hero = -1);
     // The merging estimate at camera vertex z_{t-1} (t >= 2, on a surface or in a medium) with the
     // current photons, radius r, MIS-weighted against every strategy in `vm` (times the camera throughput).
     Colour merge(const Scene& scene, const std::vector<Vertex>& camera, int t, float r, const MergeMis& vm, const Wavelengths& wl) const;

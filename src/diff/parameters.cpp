@@ -15,6 +15,13 @@ namespace {
 std::vector<float> rgb(const Rgb& c) { return {c.x, c.y, c.z}; }
 Rgb rgb(const std::vector<float>& v) { return Rgb(v.at(0), v.at(1), v.at(2)); }
 
+// The microfacet distribution of an anisotropic parameter's model (roughconductor or roughdielectric).
+template <class Model>
+auto& distribution_of(Model& m) {
+    if (auto* r = std::get_if<RoughConductorMaterial>(&m)) return r->distribution;
+    return std::get<RoughDielectricMaterial>(m).distribution;
+}
+
 const std::string& id_at(const std::vector<std::string>& ids, size_t i) {
     static const std::string none;
     return i < ids.size() ? ids[i] : none;
@@ -27,18 +34,24 @@ std::optional<ParamField> textured_field(const MaterialModel& m, int slot) {
                : slot == PhongMaterial::kSlotSpecular ? ParamField::PhongSpecular
                                                       : ParamField::PhongExponent;
     if (std::holds_alternative<ConductorMaterial>(m)) return ParamField::ConductorSpecular;
+    const auto roughness = [&](ParamField isotropic) {
+        return slot == MicrofacetDistribution::kSlotAlphaU ? ParamField::AlphaU : slot == MicrofacetDistribution::kSlotAlphaV ? ParamField::AlphaV : isotropic;
+    };
     if (std::holds_alternative<RoughConductorMaterial>(m))
-        return slot == RoughConductorMaterial::kSlotSpecularReflectance ? ParamField::RoughConductorSpecular : ParamField::RoughConductorAlpha;
+        return slot == RoughConductorMaterial::kSlotSpecularReflectance ? ParamField::RoughConductorSpecular : roughness(ParamField::RoughConductorAlpha);
     if (std::holds_alternative<PlasticMaterial>(m))
         return slot == CoatedDiffuse::kSlotDiffuse ? ParamField::PlasticDiffuse : ParamField::PlasticSpecular;
     if (std::holds_alternative<RoughPlasticMaterial>(m))
         return slot == CoatedDiffuse::kSlotDiffuse ? ParamField::RoughPlasticDiffuse : ParamField::RoughPlasticSpecular;
-    if (std::holds_alternative<RoughDielectricMaterial>(m)) return ParamField::RoughDielectricAlpha;  // its only textured parameter
+    if (std::holds_alternative<RoughDielectricMaterial>(m)) return roughness(ParamField::RoughDielectricAlpha);  // its only textured parameter
     return std::nullopt;
 }
 
 // The rgb reflectances (the fields whose texels are differentiable).
-bool is_roughness(ParamField f) { return f == ParamField::RoughConductorAlpha || f == ParamField::RoughDielectricAlpha; }
+bool is_roughness(ParamField f) {
+    return f == ParamField::RoughConductorAlpha || f == ParamField::RoughDielectricAlpha || f == ParamField::RoughPlasticAlpha ||
+           f == ParamField::AlphaU || f == ParamField::AlphaV;
+}
 bool is_reflectance(ParamField f) {
     return f != ParamField::PhongExponent && !is_roughness(f) && f != ParamField::RoughDielectricEta && f < ParamField::Texels;
 }
@@ -77,7 +90,10 @@ std::string SceneParameter::range() const {
     switch (field) {
         case ParamField::PhongExponent: return "[0, 10000]";
         case ParamField::RoughConductorAlpha:
-        case ParamField::RoughDielectricAlpha: return "[0.001, 10]";
+        case ParamField::RoughDielectricAlpha:
+        case ParamField::RoughPlasticAlpha:
+        case ParamField::AlphaU:
+        case ParamField::AlphaV: return "[0.001, 10]";
         case ParamField::RoughDielectricEta: return "[0.2, 5]";
         case ParamField::MeshRadiance:
         case ParamField::SphereRadiance:
@@ -113,6 +129,12 @@ std::vector<SceneParameter> scene_parameters(const SceneDescription& d) {
             }
             out.push_back({id + "." + what, f, k, size});
         };
+        // alpha, or alpha_u and alpha_v (Mitsuba's names; a scene file's alpha_u = alpha_v is one alpha).
+        const auto add_roughness = [&](const MicrofacetDistribution& dist, ParamField isotropic) {
+            if (!dist.is_anisotropic()) return add("alpha", isotropic, 1);
+            add("alpha_u", ParamField::AlphaU, 1);
+            add("alpha_v", ParamField::AlphaV, 1);
+        };
         if (const auto* p = std::get_if<PhongMaterial>(&m.model)) {
             if (is_black(p->specular)) {
                 add("reflectance.value", ParamField::PhongDiffuse, 3);
@@ -124,7 +146,7 @@ std::vector<SceneParameter> scene_parameters(const SceneDescription& d) {
         } else if (std::holds_alternative<ConductorMaterial>(m.model)) {
             add("specular_reflectance.value", ParamField::ConductorSpecular, 3);
         } else if (const auto* r = std::get_if<RoughConductorMaterial>(&m.model)) {
-            if (!r->distribution.is_anisotropic()) add("alpha", ParamField::RoughConductorAlpha, 1);
+            add_roughness(r->distribution, ParamField::RoughConductorAlpha);
             add("specular_reflectance.value", ParamField::RoughConductorSpecular, 3);
         } else if (std::holds_alternative<PlasticMaterial>(m.model)) {
             add("diffuse_reflectance.value", ParamField::PlasticDiffuse, 3);
@@ -132,8 +154,9 @@ std::vector<SceneParameter> scene_parameters(const SceneDescription& d) {
         } else if (std::holds_alternative<RoughPlasticMaterial>(m.model)) {
             add("diffuse_reflectance.value", ParamField::RoughPlasticDiffuse, 3);
             add("specular_reflectance.value", ParamField::RoughPlasticSpecular, 3);
+            add("alpha", ParamField::RoughPlasticAlpha, 1);  // (always isotropic)
         } else if (const auto* r = std::get_if<RoughDielectricMaterial>(&m.model)) {
-            if (!r->distribution.is_anisotropic()) add("alpha", ParamField::RoughDielectricAlpha, 1);
+            add_roughness(r->distribution, ParamField::RoughDielectricAlpha);
             if (!r->dispersion) add("eta", ParamField::RoughDielectricEta, 1);
         }
     }
@@ -189,6 +212,9 @@ std::vector<float> parameter_value(const SceneDescription& d, const SceneParamet
         case ParamField::RoughConductorSpecular: return rgb(std::get<RoughConductorMaterial>(m).specular_reflectance);
         case ParamField::RoughConductorAlpha: return {std::get<RoughConductorMaterial>(m).distribution.alpha_u};
         case ParamField::RoughDielectricAlpha: return {std::get<RoughDielectricMaterial>(m).distribution.alpha_u};
+        case ParamField::RoughPlasticAlpha: return {std::get<RoughPlasticMaterial>(m).distribution.alpha_u};
+        case ParamField::AlphaU: return {distribution_of(m).alpha_u};
+        case ParamField::AlphaV: return {distribution_of(m).alpha_v};
         case ParamField::RoughDielectricEta: {
             const RoughDielectricMaterial& r = std::get<RoughDielectricMaterial>(m);
             return {r.int_ior / r.ext_ior};
@@ -274,6 +300,19 @@ void set_parameter_value(SceneDescription& d, const SceneParameter& p, const std
             dist = MicrofacetDistribution(dist.type, v[0], v[0]);
             return;
         }
+        case ParamField::RoughPlasticAlpha: {
+            // The coating's tables and Fdr depend on the roughness: built again.
+            RoughPlasticMaterial& r = std::get<RoughPlasticMaterial>(m);
+            r = RoughPlasticMaterial(MicrofacetDistribution(r.distribution.type, v[0], v[0]), r.coat);
+            return;
+        }
+        case ParamField::AlphaU:
+        case ParamField::AlphaV: {
+            MicrofacetDistribution& dist = distribution_of(m);
+            dist = p.field == ParamField::AlphaU ? MicrofacetDistribution(dist.type, v[0], dist.alpha_v)
+                                                 : MicrofacetDistribution(dist.type, dist.alpha_u, v[0]);
+            return;
+        }
         case ParamField::RoughDielectricEta: {
             RoughDielectricMaterial& r = std::get<RoughDielectricMaterial>(m);
             r.int_ior = v[0] * r.ext_ior;
@@ -304,7 +343,10 @@ void clamp_parameter_value(const SceneParameter& p, std::vector<float>& v) {
     switch (p.field) {
         case ParamField::PhongExponent: hi = 1e4f; break;
         case ParamField::RoughConductorAlpha:
-        case ParamField::RoughDielectricAlpha: lo = 1e-3f, hi = 10; break;
+        case ParamField::RoughDielectricAlpha:
+        case ParamField::RoughPlasticAlpha:
+        case ParamField::AlphaU:
+        case ParamField::AlphaV: lo = 1e-3f, hi = 10; break;
         case ParamField::RoughDielectricEta: lo = 0.2f, hi = 5; break;
         case ParamField::MeshRadiance:
         case ParamField::SphereRadiance:
@@ -360,7 +402,10 @@ ParameterSet ParameterSet::choose(const SceneDescription& d, const std::vector<s
             case ParamField::RoughPlasticSpecular: mb->specular = off; break;
             case ParamField::PhongExponent: mb->exponent = off; break;
             case ParamField::RoughConductorAlpha:
-            case ParamField::RoughDielectricAlpha: mb->alpha = off; break;
+            case ParamField::RoughDielectricAlpha:
+            case ParamField::RoughPlasticAlpha: mb->alpha = off; break;
+            case ParamField::AlphaU: mb->alpha_u = off; break;
+            case ParamField::AlphaV: mb->alpha_v = off; break;
             case ParamField::RoughDielectricEta: mb->eta = off; break;
             case ParamField::MeshRadiance: mesh[p.index] = off; break;
             case ParamField::SphereRadiance: sphere[p.index] = off; break;

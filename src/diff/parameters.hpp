@@ -3,7 +3,8 @@
 //   <bsdf id>.diffuse_reflectance.value     phong, plastic, roughplastic: rho_d, rgb
 //   <bsdf id>.specular_reflectance.value    phong (rho_s), conductor, roughconductor, plastic, roughplastic: rgb
 //   <bsdf id>.exponent                      phong: n, float
-//   <bsdf id>.alpha                         roughconductor, roughdielectric (isotropic): roughness, float
+//   <bsdf id>.alpha                         roughconductor, roughdielectric (isotropic), roughplastic: roughness, float
+//   <bsdf id>.alpha_u, <bsdf id>.alpha_v    roughconductor, roughdielectric (anisotropic): roughness along u, v, float
 //   <bsdf id>.eta                           roughdielectric (not dispersive): int_ior / ext_ior, float
 //   <shape id>.emitter.radiance.value       area emitter on a shape: radiance, rgb
 //   <emitter id>.intensity.value            point light: intensity, rgb
@@ -40,6 +41,9 @@ enum class ParamField {
     RoughPlasticSpecular,
     RoughDielectricAlpha,
     RoughDielectricEta,
+    RoughPlasticAlpha,
+    AlphaU,  // an anisotropic roughconductor's or roughdielectric's alpha_u
+    AlphaV,  // and alpha_v
     Texels,          // a bitmap texture's texels; SceneParameter::texels_of says which reflectance
     MeshRadiance,    // index: the mesh
     SphereRadiance,  // index: the sphere
@@ -96,10 +100,12 @@ struct TexelBinding {
     bool bound() const { return offset >= 0; }
 };
 struct MaterialBinding {
-    int diffuse = -1, specular = -1, exponent = -1, alpha = -1, eta = -1;
+    int diffuse = -1, specular = -1, exponent = -1, alpha = -1, alpha_u = -1, alpha_v = -1, eta = -1;
     TexelBinding diffuse_texels, specular_texels;  // in place of diffuse, specular
     bool texels() const { return diffuse_texels.bound() || specular_texels.bound(); }
-    bool any() const { return diffuse >= 0 || specular >= 0 || exponent >= 0 || alpha >= 0 || eta >= 0 || texels(); }
+    bool any() const {
+        return diffuse >= 0 || specular >= 0 || exponent >= 0 || alpha >= 0 || alpha_u >= 0 || alpha_v >= 0 || eta >= 0 || texels();
+    }
 };
 struct ParameterSet {
     std::vector<SceneParameter> params;

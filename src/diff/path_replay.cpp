@@ -6,6 +6,10 @@
 
 #include <algorithm>
 #include <array>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <tuple>
 #include <optional>
 
 #include "diff/bsdf_derivatives.hpp"
@@ -36,10 +40,36 @@ IntegratorOptions path_options(const DiffSettings& s) {
     return o;
 }
 
+// RoughCoatingDerivative of a roughplastic, kept for the last few (distribution, alpha, eta):
+// building it costs two table builds (0.1-0.5 s), and the gradients of one scene, pass after
+// pass, ask for the same.
+std::shared_ptr<const RoughCoatingDerivative> coating_derivative(const RoughPlasticMaterial& r) {
+    using Key = std::tuple<int, float, float>;
+    static std::mutex mutex;
+    static std::deque<std::pair<Key, std::shared_ptr<const RoughCoatingDerivative>>> recent;
+    const Key key{int(r.distribution.type), r.distribution.alpha_u, r.coat.eta};
+    {
+        const std::lock_guard lock(mutex);
+        for (const auto& [k, d] : recent)
+            if (k == key) return d;
+    }
+    auto d = std::make_shared<const RoughCoatingDerivative>(r);
+    const std::lock_guard lock(mutex);
+    recent.emplace_front(key, d);
+    if (recent.size() > 16) recent.pop_back();
+    return d;
+}
+
 class PathReplay {
 public:
     PathReplay(const Scene& scene, const ParameterSet& set, const DiffSettings& s)
-        : scene_(scene), set_(set), rules_(path_options(s)), hide_(s.hide_emitters), faults_(s.faults) {}
+        : scene_(scene), set_(set), rules_(path_options(s)), hide_(s.hide_emitters), faults_(s.faults) {
+        // A roughplastic's alpha also moves its coating's tables: their derivative, once per material.
+        coatings_.resize(set.materials.size());
+        for (size_t i = 0; i < set.materials.size(); ++i)
+            if (const auto* r = std::get_if<RoughPlasticMaterial>(&scene.material(uint32_t(i)).model); r && set.materials[i].alpha >= 0)
+                coatings_[i] = coating_derivative(*r);
+    }
 
     template <Mode M>
     Rgb trace(const Ray& camera_ray, Sampler& sampler, Carry& c) const {
@@ -150,6 +180,7 @@ private:
         MaterialBinding binding;
         std::array<TexelFootprint, 2> footprint{};  // diffuse, specular
         std::array<int, 2> texel_offset{-1, -1};
+        std::shared_ptr<const RoughCoatingDerivative> coating;
         const Material& m() const { return at_uv ? *at_uv : *material; }
     };
 
@@ -158,6 +189,8 @@ private:
         v.material = sp.material;
         if (sp.material->varies) v.at_uv.emplace(Material{sp.material->model_at(sp.uv)});
         v.binding = effective(*sp.material, mb);
+        const size_t index = size_t(sp.material - &scene_.material(0));
+        if (index < coatings_.size()) v.coating = coatings_[index];
         for (int which = 0; which < 2; ++which) {
             const TexelBinding& tb = which == 0 ? mb.diffuse_texels : mb.specular_texels;
             if (!tb.bound()) continue;
@@ -173,7 +206,7 @@ private:
     // bsdf_jacobian of the vertex's BSDF, with the texel slots scattered to their texels.
     template <typename Add>
     void jacobian(const VertexBsdf& v, const Vec3f& wi, const Vec3f& wo, bool delta, Add&& add) const {
-        bsdf_jacobian(v.m(), v.binding, wi, wo, delta, [&](int off, const Rgb& df) {
+        bsdf_jacobian(v.m(), v.binding, v.coating.get(), wi, wo, delta, [&](int off, const Rgb& df) {
             if (off < set_.size) return add(off, df);
             const int k = off - set_.size, which = k / 3, ch = k % 3;
             const TexelFootprint& fp = v.footprint[size_t(which)];
@@ -236,6 +269,7 @@ private:
     PathRules rules_;
     bool hide_;
     DiffFaults faults_;
+    std::vector<std::shared_ptr<const RoughCoatingDerivative>> coatings_;  // by material index
 };
 
 // The camera ray of sample `sample` of pixel (x, y), drawn as PixelIntegrator draws it.

@@ -28,7 +28,10 @@ std::vector<std::string> xml_names(const SceneParameter& p, const std::string& b
         case ParamField::RoughPlasticDiffuse: return {"diffuse_reflectance", "diffuseReflectance"};
         case ParamField::PhongExponent: return {"exponent"};
         case ParamField::RoughConductorAlpha:
-        case ParamField::RoughDielectricAlpha: return {"alpha"};
+        case ParamField::RoughDielectricAlpha:
+        case ParamField::RoughPlasticAlpha: return {"alpha"};
+        case ParamField::AlphaU: return {"alpha_u", "alphaU"};
+        case ParamField::AlphaV: return {"alpha_v", "alphaV"};
         case ParamField::MeshRadiance:
         case ParamField::SphereRadiance:
         case ParamField::ConstantRadiance: return {"radiance"};
@@ -122,6 +125,9 @@ std::string scene_file_with_values(const std::string& scene_file, const Paramete
             continue;
         }
         set_value(element, xml_names(p, bsdf_type), v);
+        if (xml_names(p, bsdf_type).front() == "alpha")  // a file's equal alpha_u and alpha_v were one alpha: now given as alpha
+            for (const char* n : {"alpha_u", "alphaU", "alpha_v", "alphaV"})
+                if (pugi::xml_node c = element.find_child_by_attribute("name", n)) element.remove_child(c);
     }
     // Files the scene names are found from the original folder.
     const std::string dir = std::filesystem::absolute(std::filesystem::path(scene_file)).parent_path().string();

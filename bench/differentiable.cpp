@@ -55,14 +55,15 @@ std::string depth_label(int depth) { return depth < 0 ? std::string("unlimited (
 void differentiable_suite(const DifferentiableOptions& o) {
     fmt::print("## Differentiable rendering: cost of a gradient\n\n");
     fmt::print("CPU seconds of the process, median of {} interleaved rounds, {}x{} pixels, {} spp, every parameter of the "
-               "scene bound; ratios to the primal render (pt-mis's estimator) of the same spp.\n\n",
+               "scene bound; ratios to the primal render (pt-mis's estimator; volpath's in a medium) of the same spp.\n\n",
                o.repeats, o.size, o.size, o.spp);
-    fmt::print("| scene | parameters (floats) | pt-mis render (s) | primal (s) | gradient (s) | gradient / primal | iteration / primal |\n");
+    fmt::print("| scene | parameters (floats) | pt-mis or volpath render (s) | primal (s) | gradient (s) | gradient / primal | iteration / primal |\n");
     fmt::print("|---|---|---|---|---|---|---|\n");
-    // A row per scene: the course scenes by index, then the texture example (its texels bound too).
+    // A row per scene: the course scenes by index, the texture example (its texels bound too), the fog.
     struct Row {
         std::string name;
         SceneDescription d;
+        std::string integrator = "pt-mis";
     };
     std::vector<Row> rows;
     for (int index : o.scenes) rows.push_back({fmt::format("{} {}", index, builtin_scenes()[size_t(index)].name), make_builtin_scene(index)});
@@ -72,6 +73,7 @@ void differentiable_suite(const DifferentiableOptions& o) {
         for (const SceneParameter& p : scene_parameters(d)) texels += p.is_texels() ? p.size / 3 : 0;
         rows.push_back({fmt::format("diff-texture ({} texels)", texels), std::move(d)});
     }
+    if (!o.media_scene.empty()) rows.push_back({"fog-box (homogeneous medium)", load_scene_file(o.media_scene), "volpath"});
     for (const Row& row : rows) {
         const SceneDescription& d = row.d;
         const ParameterSet set = ParameterSet::choose(d, all_names(d));
@@ -83,7 +85,7 @@ void differentiable_suite(const DifferentiableOptions& o) {
         const Image adjoint = loss_adjoint(Image(o.size, o.size, Rgb(0.5f)), target, Loss{});
         std::vector<double> pt, primal, grad, ratio_g, ratio_it;
         for (int r = 0; r < o.repeats; ++r) {
-            pt.push_back(cpu_seconds([&] { run(*scene, "pt-mis", o.size, o.spp, 0, 1234); }));
+            pt.push_back(cpu_seconds([&] { run(*scene, row.integrator, o.size, o.spp, 0, 1234); }));
             const double p = cpu_seconds([&] { render_primal(*scene, s); });
             const double g = cpu_seconds([&] { gradient(*scene, set, s, adjoint); });
             primal.push_back(p), grad.push_back(g);

@@ -176,6 +176,7 @@ int main(int argc, char** argv) {
     dfc->add_option("--repeats", dfo.repeats, "Interleaved rounds (median reported)")->capture_default_str();
     dfc->add_option("--scenes", dfo.scenes, "Course scene indices")->delimiter(',')->capture_default_str();
     dfc->add_option("--texture-scene", dfo.texture_scene, "A scene file with a bitmap texture: a row with its texels bound (\"\": none)");
+    dfc->add_option("--media-scene", dfo.media_scene, "A scene file with a homogeneous medium: a row with its sigma_t and albedo bound (\"\": none)");
     SpectralOptions spo;
     CLI::App* spc = app.add_subcommand("spectral", "ns per call of the spectral layer's building blocks (docs/spectral.md)");
     spc->add_option("--count", spo.count, "Calls per timing")->capture_default_str();

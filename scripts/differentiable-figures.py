@@ -3,8 +3,11 @@
 `pathlab gradient` one: the progress strip, the loss and parameter curves, the forward-mode images.
 
 usage: scripts/differentiable-figures.py OPTIMIZE_DIR TARGET_PNG GRADIENT_DIR OUT_DIR
+       scripts/differentiable-figures.py --forward GRADIENT_DIR OUT_PNG   (the forward-mode strip alone)
 (Debian's /usr/bin/python3 with matplotlib.)"""
+import glob
 import json
+import os
 import sys
 
 import matplotlib
@@ -12,6 +15,24 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.image as mpimg
 import matplotlib.pyplot as plt
+
+
+def forward_strip(grad, out_png):
+    """The image and dI/dtheta per parameter of a `pathlab gradient` folder, side by side."""
+    images = [f"{grad}/primal.png"] + sorted(glob.glob(f"{grad}/d_*.png"))
+    fig, ax = plt.subplots(1, len(images), figsize=(2.6 * len(images), 2.9))
+    for a, f in zip(ax, images):
+        a.imshow(mpimg.imread(f), interpolation="nearest")
+        name = os.path.basename(f)[:-4]
+        a.set_title("image" if name == "primal" else "dI/d " + name[2:], fontsize=7)
+        a.axis("off")
+    plt.tight_layout()
+    plt.savefig(out_png, dpi=90)
+
+
+if sys.argv[1] == "--forward":
+    forward_strip(sys.argv[2], sys.argv[3])
+    sys.exit(0)
 
 opt, target, grad, out = sys.argv[1:5]
 j = json.load(open(f"{opt}/loss.json"))
@@ -51,15 +72,4 @@ plt.tight_layout()
 plt.savefig(f"{out}/loss.png", dpi=90)
 
 # Forward mode: dI/dtheta per parameter.
-import glob
-import os
-
-images = [f"{grad}/primal.png"] + sorted(glob.glob(f"{grad}/d_*.png"))
-fig, ax = plt.subplots(1, len(images), figsize=(2.6 * len(images), 2.9))
-for a, f in zip(ax, images):
-    a.imshow(mpimg.imread(f), interpolation="nearest")
-    name = os.path.basename(f)[:-4]
-    a.set_title("image" if name == "primal" else "dI/d " + name[2:], fontsize=7)
-    a.axis("off")
-plt.tight_layout()
-plt.savefig(f"{out}/forward.png", dpi=90)
+forward_strip(grad, f"{out}/forward.png")

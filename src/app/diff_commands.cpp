@@ -270,9 +270,9 @@ int run_params_command(const ParamsOptions& o) {
     for (const SceneParameter& p : params)
         fmt::print("{:<{}}  {:<7}  {:<34}  {:>4}  {}\n", p.name, width, p.kind(), value_text(p, parameter_value(scene.description, p)),
                    p.size, p.range());
-    if (params.empty()) fmt::print("(none: differentiable parameters need ids on the scene's <bsdf>, <shape> and <emitter> elements)\n");
+    if (params.empty()) fmt::print("(none: differentiable parameters need ids on the scene's <bsdf>, <shape>, <emitter> and <medium> elements)\n");
     if (const std::string medium = medium_in_use(scene.description); !medium.empty())
-        fmt::print("(this scene has the {}: gradient and optimize refuse it, as their path replay does not see participating media)\n", medium);
+        fmt::print("(this scene has the {}: gradient and optimize differentiate volpath's estimator)\n", medium);
     return 0;
 }
 
@@ -353,7 +353,8 @@ CLI::App* add_optimize_command(CLI::App& app, OptimizeOptions& o) {
     cmd->add_option("--optimizer", o.optimizer, "adam or gd (plain gradient descent)")->capture_default_str();
     cmd->add_option("--loss", o.loss, "l2 or l1 (mean over pixels and channels)")->capture_default_str();
     cmd->add_option("--region", o.region, "x0,y0,x1,y1: the loss over this pixel region only");
-    cmd->add_flag("--seed-per-iteration", o.seed_per_iteration, "New random numbers every iteration (default: the same ones)");
+    cmd->add_flag("--seed-per-iteration", o.seed_per_iteration,
+                  "New random numbers every iteration (default: the same ones, but for a medium's sigma_t)");
     cmd->add_option("--save-every", o.save_every, "Write the image every this many iterations (0: never)")->capture_default_str();
     cmd->add_option("--out", o.out_dir, "Folder for loss.json, loss.svg, images, params.json and scene.xml")->capture_default_str();
     cmd->add_flag("-q,--quiet", o.quiet, "No line per iteration");
@@ -392,6 +393,14 @@ int run_optimize_command(const OptimizeOptions& o) {
     settings.learning_rate = o.lr;
     settings.iterations = o.iterations;
     settings.seed_per_iteration = o.seed_per_iteration;
+    // A medium's extinction moves the free flights themselves: its gradient is heavy-tailed (a
+    // rare scattering event weighs 1 / sigma_t), and one fixed set of samples can be far off its
+    // mean and lead the optimiser away (docs/differentiable.md): new samples every iteration.
+    const auto extinction = std::find_if(set.params.begin(), set.params.end(), [](const SceneParameter& p) { return p.field == ParamField::MediumSigmaT; });
+    if (extinction != set.params.end() && !o.seed_per_iteration) {
+        settings.seed_per_iteration = true;
+        if (!o.quiet) fmt::print("({} is optimised with new random numbers every iteration: --seed-per-iteration)\n", extinction->name);
+    }
     if (o.iterations < 0) throw UsageError("--iterations must not be negative");
     if (!(o.lr > 0)) throw UsageError("--lr must be positive");
     refuse_out_dir_with_inputs(o.out_dir, scene, o.target, "optimize");
@@ -465,7 +474,7 @@ int run_optimize_command(const OptimizeOptions& o) {
         }
         if (!scene.file.empty()) {
             try {
-                write_text_file(o.out_dir + "/scene.xml", scene_file_with_values(scene.file, set, result, texel_files));
+                write_text_file(o.out_dir + "/scene.xml", scene_file_with_values(scene.file, set, result, texel_files, &desc));
             } catch (const std::runtime_error& e) {
                 fmt::print(stderr, "pathlab: {}\n", e.what());
             }

@@ -7,13 +7,19 @@
 
 #include <fmt/format.h>
 
-#include "scene/medium_in_use.hpp"
 
 namespace pathlab {
 namespace {
 
 std::vector<float> rgb(const Rgb& c) { return {c.x, c.y, c.z}; }
 Rgb rgb(const std::vector<float>& v) { return Rgb(v.at(0), v.at(1), v.at(2)); }
+
+// sigma_s / sigma_t per channel (0 where sigma_t is).
+Rgb medium_albedo(const HomogeneousMedium& m) {
+    Rgb a(0.0f);
+    for (int c = 0; c < 3; ++c) a[c] = m.sigma_t[c] > 0 ? m.sigma_s[c] / m.sigma_t[c] : 0.0f;
+    return a;
+}
 
 // The microfacet distribution of an anisotropic parameter's model (roughconductor or roughdielectric).
 template <class Model>
@@ -99,6 +105,7 @@ std::string SceneParameter::range() const {
         case ParamField::SphereRadiance:
         case ParamField::PointIntensity:
         case ParamField::ConstantRadiance: return ">= 1e-6";
+        case ParamField::MediumSigmaT: return ">= 1e-6";
         default: return "[0, 1]";
     }
 }
@@ -175,6 +182,12 @@ std::vector<SceneParameter> scene_parameters(const SceneDescription& d) {
         if (std::holds_alternative<EnvironmentLight>(d.lights[i]))
             out.push_back({id + ".radiance.value", ParamField::ConstantRadiance, uint32_t(i), 3});
     }
+    for (size_t i = 0; i < d.media.size(); ++i) {  // homogeneous media (a grid's voxels are not parameters)
+        const std::string& id = id_at(d.medium_ids, i);
+        if (id.empty() || !std::holds_alternative<HomogeneousMedium>(d.media[i])) continue;
+        out.push_back({id + ".sigma_t.value", ParamField::MediumSigmaT, uint32_t(i), 3});
+        out.push_back({id + ".albedo.value", ParamField::MediumAlbedo, uint32_t(i), 3});
+    }
     return out;
 }
 
@@ -193,6 +206,8 @@ std::vector<float> parameter_value(const SceneDescription& d, const SceneParamet
             case ParamField::MeshRadiance: return rgb(d.meshes.at(p.index).emission);
             case ParamField::SphereRadiance: return rgb(d.spheres.at(p.index).emission);
             case ParamField::PointIntensity: return rgb(std::get<PointLight>(d.lights.at(p.index)).intensity);
+            case ParamField::MediumSigmaT: return rgb(std::get<HomogeneousMedium>(d.media.at(p.index)).sigma_t);
+            case ParamField::MediumAlbedo: return rgb(medium_albedo(std::get<HomogeneousMedium>(d.media.at(p.index))));
             default: return rgb(std::get<EnvironmentLight>(d.lights.at(p.index)).radiance);
         }
     }
@@ -284,6 +299,14 @@ void set_parameter_value(SceneDescription& d, const SceneParameter& p, const std
         case ParamField::PointIntensity: std::get<PointLight>(d.lights.at(p.index)).intensity = rgb(v); return;
         case ParamField::ConstantRadiance: std::get<EnvironmentLight>(d.lights.at(p.index)).radiance = rgb(v); return;
         case ParamField::Texels: set_texels(d, p, v); return;
+        case ParamField::MediumSigmaT:
+        case ParamField::MediumAlbedo: {
+            HomogeneousMedium& m = std::get<HomogeneousMedium>(d.media.at(p.index));
+            const Rgb albedo = p.field == ParamField::MediumAlbedo ? rgb(v) : medium_albedo(m);
+            if (p.field == ParamField::MediumSigmaT) m.sigma_t = rgb(v);
+            m.sigma_s = albedo * m.sigma_t;
+            return;
+        }
         default: break;
     }
     MaterialModel& m = d.materials.at(p.index).model;
@@ -352,21 +375,17 @@ void clamp_parameter_value(const SceneParameter& p, std::vector<float>& v) {
         case ParamField::SphereRadiance:
         case ParamField::PointIntensity:
         case ParamField::ConstantRadiance: lo = 1e-6f, hi = 1e30f; break;
+        case ParamField::MediumSigmaT: lo = 1e-6f, hi = 1e30f; break;  // (> 0: a channel of sigma_t 0 would lose its albedo)
         default: break;
     }
     for (float& x : v) x = std::isnan(x) ? lo : std::clamp(x, lo, hi);
 }
 
 ParameterSet ParameterSet::choose(const SceneDescription& d, const std::vector<std::string>& names) {
-    if (const std::string medium = medium_in_use(d); !medium.empty())
-        throw std::invalid_argument(fmt::format(
-            "this scene has the {}: the path replay (pt-mis's estimator, which `gradient` and `optimize` differentiate) does not "
-            "see participating media and would differentiate the scene as if the medium were not there; remove the medium "
-            "(docs/differentiable.md: media are not differentiable yet)",
-            medium));
     const std::vector<SceneParameter> all = scene_parameters(d);
     ParameterSet s;
     s.materials.assign(d.materials.size(), MaterialBinding{});
+    s.media.assign(d.media.size(), MediumBinding{});
     std::vector<int> free_light(d.lights.size(), -1), mesh(d.meshes.size(), -1), sphere(d.spheres.size(), -1);
     for (const std::string& name : names) {
         const SceneParameter& p = find_parameter(all, name);
@@ -409,6 +428,17 @@ ParameterSet ParameterSet::choose(const SceneDescription& d, const std::vector<s
             case ParamField::RoughDielectricEta: mb->eta = off; break;
             case ParamField::MeshRadiance: mesh[p.index] = off; break;
             case ParamField::SphereRadiance: sphere[p.index] = off; break;
+            case ParamField::MediumSigmaT:
+            case ParamField::MediumAlbedo: {
+                MediumBinding& m = s.media[p.index];
+                if (m.slot < 0) {
+                    if (s.media_slots == kMaxDiffMedia)
+                        throw std::invalid_argument(fmt::format("parameters of at most {} media can be chosen at once", kMaxDiffMedia));
+                    m.slot = s.media_slots++;
+                }
+                (p.field == ParamField::MediumSigmaT ? m.sigma_t : m.albedo) = off;
+                break;
+            }
             default: free_light[p.index] = off; break;
         }
     }

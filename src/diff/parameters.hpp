@@ -9,6 +9,8 @@
 //   <shape id>.emitter.radiance.value       area emitter on a shape: radiance, rgb
 //   <emitter id>.intensity.value            point light: intensity, rgb
 //   <emitter id>.radiance.value             constant environment: radiance, rgb
+//   <medium id>.sigma_t.value               homogeneous medium: extinction per unit length, rgb
+//   <medium id>.albedo.value                homogeneous medium: sigma_s / sigma_t, rgb
 //   <bsdf id>.<reflectance>.data            a bitmap texture's texels in place of one of the rgb
 //                                           reflectances above (e.g. reflectance.data): width *
 //                                           height * 3 linear values, row-major, top row first
@@ -49,6 +51,8 @@ enum class ParamField {
     SphereRadiance,  // index: the sphere
     PointIntensity,  // index: the light in SceneDescription::lights
     ConstantRadiance,
+    MediumSigmaT,  // index: the medium
+    MediumAlbedo,
 };
 
 struct SceneParameter {
@@ -64,8 +68,9 @@ struct SceneParameter {
 
     bool is_material() const { return field < ParamField::MeshRadiance; }
     bool is_texels() const { return field == ParamField::Texels; }
-    // "bsdf", "texture" or "emitter".
-    std::string kind() const { return is_texels() ? "texture" : is_material() ? "bsdf" : "emitter"; }
+    bool is_medium() const { return field == ParamField::MediumSigmaT || field == ParamField::MediumAlbedo; }
+    // "bsdf", "texture", "emitter" or "medium".
+    std::string kind() const { return is_texels() ? "texture" : is_material() ? "bsdf" : is_medium() ? "medium" : "emitter"; }
     // The valid range, as the optimiser clamps to it ("[0, 1]", "> 0", ">= 0").
     std::string range() const;
 };
@@ -107,6 +112,14 @@ struct MaterialBinding {
         return diffuse >= 0 || specular >= 0 || exponent >= 0 || alpha >= 0 || alpha_u >= 0 || alpha_v >= 0 || eta >= 0 || texels();
     }
 };
+// A homogeneous medium's offsets (-1: not chosen), and its slot among the chosen media (the path
+// replay keeps d log(throughput) per slot).
+struct MediumBinding {
+    int sigma_t = -1, albedo = -1;
+    int slot = -1;
+};
+inline constexpr int kMaxDiffMedia = 8;  // media with chosen parameters, at most
+
 struct ParameterSet {
     std::vector<SceneParameter> params;
     std::vector<int> offsets;  // of params[i] in theta
@@ -116,10 +129,11 @@ struct ParameterSet {
     // By index in Scene::lights(), in Scene::build's order (free lights, then each emitting
     // mesh's triangles, then emitting spheres): the offset of the light's radiance/intensity.
     std::vector<int> lights;
+    std::vector<MediumBinding> media;  // by medium index
+    int media_slots = 0;
 
     // Chooses `names` of the description's parameters (std::invalid_argument for an unknown
-    // or repeated name, listing the valid ones, and for a scene with a participating medium,
-    // which the path replay does not see).
+    // or repeated name, listing the valid ones, and for more than kMaxDiffMedia media).
     static ParameterSet choose(const SceneDescription& d, const std::vector<std::string>& names);
 
     std::vector<float> values(const SceneDescription& d) const;

@@ -14,6 +14,7 @@
 
 #include "diff/bsdf_derivatives.hpp"
 #include "integrators/common/direct_lighting.hpp"
+#include "integrators/common/media_lighting.hpp"
 #include "integrators/common/path_rules.hpp"
 
 namespace pathlab {
@@ -69,10 +70,14 @@ public:
         for (size_t i = 0; i < set.materials.size(); ++i)
             if (const auto* r = std::get_if<RoughPlasticMaterial>(&scene.material(uint32_t(i)).model); r && set.materials[i].alpha >= 0)
                 coatings_[i] = coating_derivative(*r);
+        media_slots_.resize(size_t(set.media_slots));
+        for (const MediumBinding& b : set.media)
+            if (b.slot >= 0) media_slots_[size_t(b.slot)] = b;
     }
 
     template <Mode M>
     Rgb trace(const Ray& camera_ray, Sampler& sampler, Carry& c) const {
+        if (scene_.has_media()) return trace_media<M>(camera_ray, sampler, c);
         Intersection hit;
         if (!scene_.intersect(camera_ray, hit)) {
             if (hide_) return Rgb(0.0f);
@@ -264,12 +269,212 @@ private:
         return mb;
     }
 
+    // d log(throughput)/d theta for the chosen homogeneous media, per slot and channel: their
+    // sigma_t and albedo enter a path only as factors of its throughput, channel by channel
+    // (exp(-sigma_t l) along a piece of length l, sigma_s = albedo sigma_t where it scatters), and
+    // sampling is detached (the free-flight densities, the hero channel's, stay as they were).
+    struct MediaLog {
+        std::array<Rgb, kMaxDiffMedia> dt{}, da{};  // d log / d sigma_t, d log / d albedo
+        MediaLog operator+(const MediaLog& o) const {
+            MediaLog r;
+            for (size_t i = 0; i < kMaxDiffMedia; ++i) r.dt[i] = dt[i] + o.dt[i], r.da[i] = da[i] + o.da[i];
+            return r;
+        }
+    };
+    int slot_of(int32_t medium) const {
+        return medium >= 0 && size_t(medium) < set_.media.size() ? set_.media[size_t(medium)].slot : -1;
+    }
+    // A piece of length l through a medium: exp(-sigma_t l), d log/d sigma_t = -l.
+    void pass(MediaLog& log, int32_t medium, float length) const {
+        const int slot = slot_of(medium);
+        if (slot >= 0 && std::isfinite(length)) log.dt[size_t(slot)] -= Rgb(length);
+    }
+    // Scattering in a medium: sigma_s = albedo sigma_t, d log/d sigma_t = 1 / sigma_t, d log/d albedo = 1 / albedo
+    // (a channel of sigma_t or albedo 0 carries no throughput: nothing to add).
+    void scatter(MediaLog& log, int32_t medium) const {
+        const int slot = slot_of(medium);
+        if (slot < 0) return;
+        const auto& h = std::get<HomogeneousMedium>(scene_.medium(medium));
+        for (int k = 0; k < 3; ++k) {
+            if (!(h.sigma_t[k] > 0) || !(h.sigma_s[k] > 0)) continue;
+            log.dt[size_t(slot)][k] += 1 / h.sigma_t[k];
+            log.da[size_t(slot)][k] += h.sigma_t[k] / h.sigma_s[k];
+        }
+    }
+    // A term C (radiance added to the sample) whose throughput has d log/d theta `log`.
+    template <Mode M>
+    void media_term(const Rgb& C, const MediaLog& log, Carry& c) const {
+        for (int slot = 0; slot < set_.media_slots; ++slot) {
+            const MediumBinding& b = media_slots_[size_t(slot)];
+            const Rgb gt = C * log.dt[size_t(slot)], ga = C * log.da[size_t(slot)];
+            for (int k = 0; k < 3; ++k) {
+                if constexpr (M == Mode::Reverse) {
+                    if (b.sigma_t >= 0) c.grad[b.sigma_t + k] += double(c.delta[k] * gt[k]);
+                    if (b.albedo >= 0) c.grad[b.albedo + k] += double(c.delta[k] * ga[k]);
+                } else if constexpr (M == Mode::Forward) {
+                    if (b.sigma_t >= 0) c.dL[k] += gt[k] * c.tangent[b.sigma_t + k];
+                    if (b.albedo >= 0) c.dL[k] += ga[k] * c.tangent[b.albedo + k];
+                }
+            }
+        }
+    }
+    // A term f Le k added at a vertex with throughput beta (the free-flight weights, the shadow
+    // ray's transmittance and 1 / density folded in) and media log `log`.
+    template <Mode M>
+    void scatter_term(const VertexBsdf* v, const Vec3f& wi, const Vec3f& wo, bool delta, const Rgb& f, const Rgb& Le, float k, int light,
+                      float scale, const Rgb& beta, const Rgb& dbeta, const MediaLog& log, Carry& c) const {
+        if constexpr (M != Mode::Primal) {
+            vertex_term<M>(v, wi, wo, delta, f, Le, k, light, scale, beta, dbeta, c);
+            if (set_.media_slots > 0) media_term<M>(beta * (f * Le * k), log, c);
+        }
+    }
+
+    // volpath's estimator (path/volpath.cpp, without --null-depth skip), whose media, shadow
+    // rays and MIS pairs it follows through the same functions (walk_media, estimate_light,
+    // sample_scatter): the same image. Besides the surfaces' BSDF and emitter terms, each term
+    // gets its media's: C (d log beta/d theta), with beta's log carried along the path.
+    template <Mode M>
+    Rgb trace_media(const Ray& camera_ray, Sampler& sampler, Carry& c) const {
+        RgbWavelengths wl;
+        MediumState<RgbTransport> st{sampler, wl, 1.0f};
+        MediaLog walk;  // of the walk being taken
+        const auto on_piece = [&](const Vec3f&, const Vec3f&, float length, int32_t medium, const Rgb&, const Rgb&, float) {
+            pass(walk, medium, length);
+        };
+        Rgb seg(1.0f);
+        MediumWalk w = walk_media(scene_, camera_ray, scene_.camera_medium(), st, seg, nullptr, on_piece);
+        if (w.kind == MediumWalk::kMedium) scatter(walk, w.medium);
+        MediaLog log = walk;  // of beta
+        Rgb beta = seg, dbeta(0.0f);
+        Rgb L(0.0f);
+        // What the camera sees directly.
+        if (w.kind == MediumWalk::kEscaped || (w.kind == MediumWalk::kSurface && !hide_)) {
+            if (hide_) return Rgb(0.0f);
+            const bool sky = w.kind == MediumWalk::kEscaped;
+            const Rgb Le = sky ? escaped_radiance(scene_, w.dir, wl) : emitted_radiance(scene_, w.isect, -w.dir, wl);
+            L = beta * Le / st.density();
+            if (!is_black(L)) {
+                emitter_term<M>(sky ? scene_.environment_light() : w.isect.light, beta / st.density(), 1.0f, c);
+                if (set_.media_slots > 0) media_term<M>(L, log, c);
+                if constexpr (M == Mode::Reverse) c.Lr -= L;
+            }
+            if (sky) return L;
+        }
+        for (int bounces = 0, step = 0; w.kind != MediumWalk::kLost && step < kMaxBounces; ++step) {
+            if (!rules_.may_bounce(bounces)) break;
+            ScatterVertex v;
+            v.medium = w.medium;
+            ShadingPoint sp;
+            std::optional<VertexBsdf> vb;
+            if (w.kind == MediumWalk::kSurface) {
+                sp = make_shading_point(scene_, w.isect, w.dir);
+                if (sp.material->is_black()) break;
+                v.sp = &sp;
+                v.hit = &w;
+                v.p = sp.p;
+                const size_t mat_index = size_t(sp.material - &scene_.material(0));
+                const MaterialBinding& mb = mat_index < set_.materials.size() ? set_.materials[mat_index] : kNone;
+                if (mb.any()) vb.emplace(vertex_bsdf(sp, mb));
+            } else {
+                v.p = w.p;
+                v.wi = -w.dir / length(w.dir);
+                v.phase = &medium_phase(scene_.medium(w.medium));
+            }
+            const VertexBsdf* vbsdf = vb ? &*vb : nullptr;
+            const Vec3f wi_local = v.sp ? sp.wi : Vec3f(0.0f);
+
+            // Next-event estimation: each light sample's term, with its shadow ray's media.
+            {
+                const float density = st.density();
+                LightHook<M> hook{*this, v, sp, vbsdf, beta, dbeta, density, log, c};
+                const Rgb direct = estimate_light(scene_, v, sampler, st, true, wl, rules_.power_mis(), NoGuide{},
+                                                  static_cast<LightSampleSeen<RgbWavelengths>*>(nullptr), bounces == 0, hook);
+                L += beta * direct / density;
+            }
+            // The BSDF or phase sample: the emission its walk finds, then the continuation.
+            walk = MediaLog{};
+            const ScatterSample<RgbTransport> n =
+                sample_scatter(scene_, v, sampler, st, true, wl, rules_.power_mis(), nullptr, NoGuide{}, bounces == 0, on_piece);
+            if (!n.sampled) break;
+            if (n.next.kind == MediumWalk::kMedium) scatter(walk, n.next.medium);
+            const float density = st.density();
+            const Rgb found = beta * n.next_seg * n.found / density;
+            L += found;
+            if (!is_black(found)) {
+                const Rgb W = beta * n.next_seg / density;
+                scatter_term<M>(vbsdf, wi_local, n.wo_local, n.delta, n.f, n.Le, n.k, n.light, 1.0f, W, dbeta * n.next_seg / density,
+                                log + walk, c);
+            }
+            if (!rules_.may_bounce(bounces + 1)) break;
+            if (n.next.kind == MediumWalk::kEscaped || n.next.kind == MediumWalk::kLost) break;
+            const Rgb before = beta;
+            beta = beta * n.next_seg * n.weight;
+            if constexpr (M == Mode::Forward) {
+                dbeta = dbeta * n.next_seg * n.weight;
+                if (vbsdf) dbeta += before * n.next_seg * (jacobian_dot(*vbsdf, wi_local, n.wo_local, n.delta, c.tangent) * (std::abs(n.wo_local.z) / n.pdf));
+            }
+            log = log + walk;
+            // Russian roulette on beta / density, as volpath.
+            const Rgb kept = beta;
+            if (!survive_roulette(bounces + 1, beta, st.density(), sampler)) break;
+            if constexpr (M == Mode::Forward)
+                for (int k = 0; k < 3; ++k) dbeta[k] = kept[k] != 0 ? dbeta[k] * (beta[k] / kept[k]) : 0.0f;
+            // Reverse: the continuation's weight f scales everything still to come, Lr.
+            if constexpr (M == Mode::Reverse) {
+                if (vbsdf && !faults_.drop_continuation) {
+                    Rgb W(0.0f);
+                    for (int k = 0; k < 3; ++k)
+                        if (n.f[k] > 0) W[k] = c.delta[k] * c.Lr[k] / n.f[k];
+                    add_bsdf_adjoint(*vbsdf, wi_local, n.wo_local, n.delta, W, c);
+                }
+            }
+            ++bounces;
+            w = n.next;
+        }
+        return L;
+    }
+
+    // estimate_light's hook (media_lighting.hpp): each light sample's term at a vertex.
+    template <Mode M>
+    struct LightHook {
+        static constexpr bool kActive = M != Mode::Primal;
+        const PathReplay& r;
+        const ScatterVertex& v;
+        const ShadingPoint& sp;
+        const VertexBsdf* vbsdf;
+        const Rgb& beta;
+        const Rgb& dbeta;
+        float density;
+        const MediaLog& log;
+        Carry& c;
+        MediaLog shadow{};
+        void begin() { shadow = MediaLog{}; }
+        void piece(int32_t medium, float length) { r.pass(shadow, medium, length); }
+        void sample(const NeeSample& nee, const Rgb& f, const Rgb& Le, float k, const Rgb& Tr, const Rgb&) {
+            const Light& light = r.scene_.lights()[size_t(nee.choice.index)];
+            const float scale = std::holds_alternative<PointLight>(light) ? 1 / (nee.ls.distance * nee.ls.distance) : 1.0f;
+            const Vec3f wo = v.sp ? sp.frame.to_local(nee.ls.wi) : Vec3f(0.0f);
+            r.scatter_term<M>(vbsdf, v.sp ? sp.wi : Vec3f(0.0f), wo, false, f, Le, k, nee.choice.index, scale, beta * Tr / density,
+                              dbeta * Tr / density, log + shadow, c);
+        }
+    };
+
+    // Russian roulette on beta / density, the path's actual weight (volpath's).
+    bool survive_roulette(int bounces, Rgb& beta, float density, Sampler& sampler) const {
+        if (density == 1) return rules_.survive_roulette(bounces, beta, sampler);
+        Rgb weight = beta / density;
+        if (!rules_.survive_roulette(bounces, weight, sampler)) return false;
+        beta = weight * density;
+        return true;
+    }
+
     const Scene& scene_;
     const ParameterSet& set_;
     PathRules rules_;
     bool hide_;
     DiffFaults faults_;
     std::vector<std::shared_ptr<const RoughCoatingDerivative>> coatings_;  // by material index
+    std::vector<MediumBinding> media_slots_;  // the chosen media's offsets, by slot
 };
 
 // The camera ray of sample `sample` of pixel (x, y), drawn as PixelIntegrator draws it.

@@ -1,7 +1,10 @@
 // Gradients of a rendered image with respect to scene parameters (parameters.hpp) by path
 // replay backpropagation (Vicini, Speierer and Jakob 2021, "Path Replay Backpropagation"), for
 // the estimator of pt-mis (next-event estimation and BSDF sampling combined by MIS at every
-// vertex, Russian roulette), with detached sampling as Mitsuba 3's `prb`.
+// vertex, Russian roulette), with detached sampling as Mitsuba 3's `prb`; in a scene with
+// participating media, volpath's (its free flights, phase samples and shadow rays' transmittance;
+// a homogeneous medium's sigma_t and albedo are factors of the throughput, whose d log the replay
+// carries along the path).
 //
 // Reverse mode, per pixel sample (Sampler(seed, pixel, sample) as pt-mis draws it):
 //  1. the primal pass traces the path and returns its radiance L (bit for bit pt-mis's sample);
@@ -49,7 +52,7 @@ struct DiffSettings {
     DiffFaults faults = {};  // none, except in tests
 };
 
-// pt-mis's image (the mean of spp samples per pixel; box filter, pinhole or any camera).
+// pt-mis's image, volpath's in a scene with media (the mean of spp samples per pixel; box filter, pinhole or any camera).
 Image render_primal(const Scene& scene, const DiffSettings& s);
 
 // dLoss/dtheta for the set's theta, where adjoint(x, y) = dLoss/dI(x, y) (the image is the mean

@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <sstream>
 #include <stdexcept>
+#include <variant>
 
 #include <fmt/format.h>
 #include <pugixml.hpp>
@@ -78,7 +79,7 @@ void set_filename(pugi::xml_node texture, const std::string& file) {
 }  // namespace
 
 std::string scene_file_with_values(const std::string& scene_file, const ParameterSet& set, const std::vector<float>& theta,
-                                   const std::map<std::string, std::string>& texel_files) {
+                                   const std::map<std::string, std::string>& texel_files, const SceneDescription* with_values) {
     pugi::xml_document doc;
     const pugi::xml_parse_result r = doc.load_file(scene_file.c_str(), pugi::parse_default | pugi::parse_comments);
     if (!r) throw std::runtime_error(fmt::format("{}: cannot be read again: {}", scene_file, r.description()));
@@ -98,6 +99,8 @@ std::string scene_file_with_values(const std::string& scene_file, const Paramete
                 element = element.child("bsdf");
             }
             if (element) bsdf_type = element.attribute("type").value();
+        } else if (p.is_medium()) {
+            element = find_by_id(scene, "medium", id);
         } else if (p.field == ParamField::MeshRadiance || p.field == ParamField::SphereRadiance) {
             element = find_by_id(scene, "shape", id);
             if (element) element = element.child("emitter");
@@ -117,6 +120,17 @@ std::string scene_file_with_values(const std::string& scene_file, const Paramete
                 throw std::runtime_error(fmt::format("{}: the bitmap <texture> of parameter {} is not in this file; its texels are in the "
                                                      "JSON output", scene_file, p.name));
             set_filename(texture, file->second);
+            continue;
+        }
+        if (p.is_medium()) {  // sigma_t and albedo together, in place of sigma_a, sigma_s and scale
+            if (!with_values) throw std::logic_error("scene_file_with_values: a medium's parameters need the description with their values");
+            const auto& m = std::get<HomogeneousMedium>(with_values->media.at(p.index));
+            Rgb albedo(0.0f);
+            for (int c = 0; c < 3; ++c) albedo[c] = m.sigma_t[c] > 0 ? m.sigma_s[c] / m.sigma_t[c] : 0.0f;
+            for (const char* n : {"sigma_a", "sigmaA", "sigma_s", "sigmaS", "scale"})
+                while (pugi::xml_node c = element.find_child_by_attribute("name", n)) element.remove_child(c);
+            set_value(element, {"albedo"}, {albedo.x, albedo.y, albedo.z});
+            set_value(element, {"sigma_t", "sigmaT"}, {m.sigma_t.x, m.sigma_t.y, m.sigma_t.z});
             continue;
         }
         if (p.field == ParamField::RoughDielectricEta) {  // only the ratio matters: int_ior = eta, ext_ior = 1

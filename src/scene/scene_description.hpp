@@ -35,6 +35,7 @@ struct SceneDescription {
     // How messages name each medium (by index in `media`; the vector may be shorter): its type
     // and a scene file's id ("homogeneous medium 'fog'"), or where the file declares it.
     std::vector<std::string> medium_labels;
+    std::vector<std::string> medium_ids;  // a scene file's id of each medium ("" for none; may be shorter)
     // Ids of the materials (by index in `materials`) and free lights (by index in `lights`), ""
     // for unnamed ones (either vector may be shorter): the names of differentiable parameters
     // (diff/parameters.hpp), as scene files' id attributes give them. Shapes carry their own id.

@@ -117,6 +117,8 @@ int32_t read_medium(XmlSource& xml, const pugi::xml_node& n, SceneBuilder& b) {
     const auto id = xml.optional_attr(n, "id");
     const SourceLocation at = xml.where(n);
     b.desc.medium_labels.resize(b.desc.media.size());
+    b.desc.medium_ids.resize(b.desc.media.size());
+    if (id) b.desc.medium_ids.back() = *id;
     b.desc.medium_labels.back() = id ? fmt::format("{} medium '{}'", type, *id) : fmt::format("{} medium of {}:{}", type, at.file, at.line);
     return int32_t(b.desc.media.size() - 1);
 }

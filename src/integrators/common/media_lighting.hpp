@@ -21,17 +21,29 @@ struct ScatterVertex {
     int32_t medium = -1;  // the medium the path arrived in
 };
 
+// What the path replay (src/diff/path_replay.cpp) asks of estimate_light: nothing, for the
+// renderers. A hook's begin() starts each light sample, piece(medium, length) follows its shadow
+// ray through the media, and sample(nee, f, Le, k, Tr, contribution) ends one that contributes
+// (contribution = f Le k Tr, k = cos * MIS weight / density).
+struct NoLightHook {
+    static constexpr bool kActive = false;
+    void begin() const {}
+    void piece(int32_t, float) const {}
+    template <class... A> void sample(const A&...) const {}
+};
+
 // Next-event estimation at a vertex: pt-mis's estimate_light_sample (the same random numbers,
 // the same arithmetic at a surface), with the shadow ray's transmittance. With `seen`, the light
 // it found (its direction, and Le Tr times the MIS weight over the sample's density).
-template <class T, class Guide = NoGuide>
+template <class T, class Guide = NoGuide, class Hook = NoLightHook>
 ColourOf<T> estimate_light(const Scene& scene, const ScatterVertex& v, Sampler& sampler, MediumState<T>& st, bool mis,
                            WavelengthsOf<T>& wl, bool power = false, const Guide& guide = {}, LightSampleSeen<WavelengthsOf<T>>* seen = nullptr,
-                           bool split = true) {
+                           bool split = true, Hook&& hook = {}) {
     using Colour = ColourOf<T>;
     Colour sum(0.0f);
     float seen_y = -1;  // with splitting, `seen` gets the brightest of the samples
     const auto one = [&](const NeeSample& nee) -> Colour {
+        hook.begin();
         const LightChoice choice = nee.choice;
         const LightSample* ls = &nee.ls;
         Colour f;
@@ -62,7 +74,11 @@ ColourOf<T> estimate_light(const Scene& scene, const ScatterVertex& v, Sampler& 
             }
         }
         if (!st.pass_null && scene.media_separated(medium, scene.light_medium(choice.index))) return Colour(0.0f);  // blocked: no ray needed
-        const Colour Tr = shadow_transmittance(scene, shadow, medium, st);
+        Colour Tr;
+        if constexpr (std::decay_t<Hook>::kActive)
+            Tr = shadow_transmittance(scene, shadow, medium, st, nullptr, [&](int32_t m, float length) { hook.piece(m, length); });
+        else
+            Tr = shadow_transmittance(scene, shadow, medium, st);
         if (is_black(Tr)) return Colour(0.0f);
         const float weight = !ls->delta ? (mis ? mis_heuristic(power, nee.pdf_source, guide.mis_pdf(ls->wi, pdf_scatter)) : 1.0f) : 1.0f;
         const Colour contribution = f * light_colour(scene, choice.index, ls->Le, wl) * (cosine * weight / nee.pdf);
@@ -72,6 +88,9 @@ ColourOf<T> estimate_light(const Scene& scene, const ScatterVertex& v, Sampler& 
             const float y = max_component(f * Li);
             if (y > seen_y) *seen = {true, ls->wi, Li}, seen_y = y;
         }
+        if constexpr (std::decay_t<Hook>::kActive)
+            hook.sample(nee, f, light_colour(scene, choice.index, ls->Le, wl), cosine * weight / nee.pdf, attenuated ? Tr : Colour(1.0f),
+                        attenuated ? contribution * Tr : contribution);
         return attenuated ? contribution * Tr : contribution;
     };
     for_each_nee_sample(scene, v.p, v.sp ? v.sp->frame.n : Vec3f(0.0f), sampler, nee_candidates(scene, v.sp, wl),
@@ -130,6 +149,13 @@ struct ScatterSample {
     float pdf = 0;                    // the solid-angle density of the sampled direction
     float pdf_scatter = 0;            // ... the BSDF's or phase function's own (pdf without a guide)
     bool delta = false;               // ... a Dirac delta's coefficient
+    // For the path replay: the BSDF's or phase function's value, a surface sample's local
+    // direction, and the light the walk found (-1: none) with its Le and k (found = f Le k).
+    ColourOf<T> f{0.0f};
+    Vec3f wo_local{};
+    int light = -1;
+    ColourOf<T> Le{0.0f};
+    float k = 0;
 };
 
 // The second half of the MIS pair at v (the first is estimate_light): a BSDF sample at a surface
@@ -138,10 +164,11 @@ struct ScatterSample {
 // found by a straight pass (kLobeNull) is weighed against light sampling at that origin. Where
 // `guide` guides, the direction comes from its mixture (NoGuide: the BSDF's or phase function's
 // sample alone); its random numbers are u, then the choice of half, then the half's own.
-template <class T, class Guide = NoGuide>
+// Each piece of the walk in a medium goes to on_piece, as walk_media says.
+template <class T, class Guide = NoGuide, class OnPiece = NoPieces>
 ScatterSample<T> sample_scatter(const Scene& scene, const ScatterVertex& v, Sampler& sampler, MediumState<T>& st, bool mis,
                                 WavelengthsOf<T>& wl, bool power = false, const MisOrigin* null_origin = nullptr, const Guide& guide = {},
-                                bool split = true) {
+                                bool split = true, OnPiece&& on_piece = {}) {
     using Colour = ColourOf<T>;
     ScatterSample<T> n;
     int light;
@@ -163,14 +190,21 @@ ScatterSample<T> sample_scatter(const Scene& scene, const ScatterVertex& v, Samp
         n.delta = s->delta;
         n.ray = sp.spawn(s->wo);
         n.medium = medium_after(w.media, w.isect.ng, wo_world, w.medium);
-        n.next = walk_media(scene, n.ray, n.medium, st, n.next_seg);
+        n.next = walk_media(scene, n.ray, n.medium, st, n.next_seg, nullptr, on_piece);
         n.weight = f * (std::abs(s->wo.z) / n.pdf);
+        n.f = f;
+        n.wo_local = s->wo;
         const bool passed = null_origin && (s->lobe & kLobeNull);
         const MisOrigin here{sp.p, sp.frame.n, n.pdf, s->delta, split};
         const MisOrigin& o = passed ? *null_origin : here;
         const EmitterHit e = emission_found(scene, n.next, o.p, o.n, light, o.split);
         const float weight = o.delta ? 1.0f : (mis ? mis_heuristic(power, o.pdf, e.pdf_light) : 0.0f);
-        if (!is_black(e.Le)) n.found = f * light_colour(scene, light, e.Le, wl) * (std::abs(s->wo.z) * weight / n.pdf);
+        if (!is_black(e.Le)) {
+            n.Le = light_colour(scene, light, e.Le, wl);
+            n.k = std::abs(s->wo.z) * weight / n.pdf;
+            n.found = f * n.Le * n.k;
+            n.light = light;
+        }
     } else {
         PhaseSample ps;
         if (!guided) {
@@ -186,10 +220,16 @@ ScatterSample<T> sample_scatter(const Scene& scene, const ScatterVertex& v, Samp
         n.pdf = guide.mixture(ps.wo, ps.pdfW);
         n.ray = Ray{v.p, ps.wo, kInf};
         n.medium = v.medium;
-        n.next = walk_media(scene, n.ray, n.medium, st, n.next_seg);
+        n.next = walk_media(scene, n.ray, n.medium, st, n.next_seg, nullptr, on_piece);
         const EmitterHit e = emission_found(scene, n.next, v.p, Vec3f(0.0f), light, split);
         const float weight = mis ? mis_heuristic(power, n.pdf, e.pdf_light) : 0.0f;
-        if (!is_black(e.Le)) n.found = Colour(ps.p) * light_colour(scene, light, e.Le, wl) * (weight / n.pdf);
+        n.f = Colour(ps.p);
+        if (!is_black(e.Le)) {
+            n.Le = light_colour(scene, light, e.Le, wl);
+            n.k = weight / n.pdf;
+            n.found = n.f * n.Le * n.k;
+            n.light = light;
+        }
         n.weight = Colour(ps.p / n.pdf);
     }
     return n;

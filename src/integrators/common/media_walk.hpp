@@ -125,8 +125,11 @@ MediumWalk walk_media(const Scene& scene, Ray ray, int32_t medium, MediumState<T
 // transmittance estimates between the index-matched boundaries it crosses (and, with
 // st.pass_null, of the null_transmission of the thin glass and masks it passes). `mis_T`, if given,
 // is multiplied by the MIS transmittance of the pieces (left alone when a surface blocks it).
-template <class T>
-ColourOf<T> shadow_transmittance(const Scene& scene, Ray shadow, int32_t medium, MediumState<T>& st, float* mis_T = nullptr) {
+// Each piece in a medium goes to on_piece(medium, length) (the path replay's derivatives of
+// homogeneous media: src/diff/path_replay.cpp).
+template <class T, class OnPiece = NoPieces>
+ColourOf<T> shadow_transmittance(const Scene& scene, Ray shadow, int32_t medium, MediumState<T>& st, float* mis_T = nullptr,
+                                 OnPiece&& on_piece = {}) {
     using Colour = ColourOf<T>;
     if (!scene.has_media() && !st.pass_null) return scene.occluded(shadow) ? Colour(0.0f) : Colour(1.0f);
     const bool segment = std::isfinite(shadow.tmax);
@@ -146,6 +149,7 @@ ColourOf<T> shadow_transmittance(const Scene& scene, Ray shadow, int32_t medium,
             const float t = hit ? isect.t : shadow.tmax;
             const float tmax = segment || hit ? t * len : kInf;
             const Medium& m = scene.medium(medium);
+            if constexpr (!std::is_same_v<std::decay_t<OnPiece>, NoPieces>) on_piece(medium, tmax);
             if (mis_T) {
                 float mis;
                 Tr *= estimate_transmittance_with_mis(m, medium_view(m, st.wl), shadow.o, shadow.d / len, tmax, st.rng(), st.majorant_factor, mis);

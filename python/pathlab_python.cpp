@@ -772,7 +772,8 @@ PYBIND11_MODULE(pathlab, m) {
     m.def("gradient", &py_gradient, py::arg("scene"), py::arg("parameters"), py::arg("adjoint"), py::kw_only(), py::arg("spp") = py::int_(4),
           py::arg("seed") = py::int_(1234), py::arg("max_depth") = py::none(), py::arg("rr_depth") = py::none(), py::arg("threads") = py::int_(0),
           "dLoss/dtheta by path replay for the named parameters, where adjoint (height, width, 3) is dLoss/dImage of pt-mis's image\n"
-          "of that size (render(scene, 'pt-mis', spp, seed) gives it; use another seed here, so the gradient is unbiased): a dict of\n"
+          "of that size, volpath's in a scene with media (render(scene, 'pt-mis', spp, seed) gives it; use another seed here, so the\n"
+          "gradient is unbiased): a dict of\n"
           "name to an array shaped as the parameter's value. As `pathlab gradient`.");
     m.def("optimize", &py_optimize, py::arg("scene"), py::arg("target"), py::arg("parameters"), py::kw_only(),
           py::arg("iterations") = py::int_(50), py::arg("lr") = 0.02, py::arg("optimizer") = "adam", py::arg("loss") = "l2",
@@ -780,5 +781,6 @@ PYBIND11_MODULE(pathlab, m) {
           py::arg("max_depth") = py::none(), py::arg("rr_depth") = py::none(), py::arg("threads") = py::int_(0),
           "Recovers the named parameters from a target image (array or file; its size is the render's) by gradient descent, as\n"
           "`pathlab optimize`: returns {'params': name -> value after the last step, 'loss': per iteration, 'best_loss'}.\n"
-          "pathlab.update(scene, result['params']) gives the optimised scene.");
+          "pathlab.update(scene, result['params']) gives the optimised scene. A medium's sigma_t is always optimised with new\n"
+          "random numbers every iteration (seed_per_iteration), as on the command line.");
 }

@@ -587,22 +587,25 @@ TEST(DiffGradients, MediaAgreeWithFiniteDifferences) {
 }
 
 TEST(DiffGradients, SameBytesWithAnyThreadCount) {
-    const SceneDescription d = course(3);
-    const ParameterSet set = ParameterSet::choose(d, {"red.diffuse_reflectance.value", "blue.exponent"});
-    const auto scene = Scene::build(d);
-    DiffSettings s;
-    s.width = s.height = 16;
-    const Image w = loss_weights(16, 16);
-    std::vector<double> one, many;
-    {
-        tbb::task_arena a(1);
-        a.execute([&] { one = gradient(*scene, set, s, w); });
+    const SceneDescription fog = load_scene_file(std::string(PATHLAB_SOURCE_DIR) + "/scenes/fog-box.xml");
+    for (const auto& [d, names] : {std::pair{course(3), std::vector<std::string>{"red.diffuse_reflectance.value", "blue.exponent"}},
+                                   std::pair{fog, std::vector<std::string>{"fog.sigma_t.value", "red.reflectance.value"}}}) {
+        const ParameterSet set = ParameterSet::choose(d, names);
+        const auto scene = Scene::build(d);
+        DiffSettings s;
+        s.width = s.height = 16;
+        const Image w = loss_weights(16, 16);
+        std::vector<double> one, many;
+        {
+            tbb::task_arena a(1);
+            a.execute([&] { one = gradient(*scene, set, s, w); });
+        }
+        {
+            tbb::task_arena a(4);
+            a.execute([&] { many = gradient(*scene, set, s, w); });
+        }
+        EXPECT_EQ(one, many) << names[0];
     }
-    {
-        tbb::task_arena a(4);
-        a.execute([&] { many = gradient(*scene, set, s, w); });
-    }
-    EXPECT_EQ(one, many);
 }
 
 namespace {

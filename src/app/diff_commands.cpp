@@ -393,14 +393,8 @@ int run_optimize_command(const OptimizeOptions& o) {
     settings.learning_rate = o.lr;
     settings.iterations = o.iterations;
     settings.seed_per_iteration = o.seed_per_iteration;
-    // A medium's extinction moves the free flights themselves: its gradient is heavy-tailed (a
-    // rare scattering event weighs 1 / sigma_t), and one fixed set of samples can be far off its
-    // mean and lead the optimiser away (docs/differentiable.md): new samples every iteration.
-    const auto extinction = std::find_if(set.params.begin(), set.params.end(), [](const SceneParameter& p) { return p.field == ParamField::MediumSigmaT; });
-    if (extinction != set.params.end() && !o.seed_per_iteration) {
-        settings.seed_per_iteration = true;
-        if (!o.quiet) fmt::print("({} is optimised with new random numbers every iteration: --seed-per-iteration)\n", extinction->name);
-    }
+    if (const SceneParameter* e = extinction_parameter(set); e && !o.seed_per_iteration && !o.quiet)
+        fmt::print("({} is optimised with new random numbers every iteration, as with --seed-per-iteration: docs/differentiable.md)\n", e->name);
     if (o.iterations < 0) throw UsageError("--iterations must not be negative");
     if (!(o.lr > 0)) throw UsageError("--lr must be positive");
     refuse_out_dir_with_inputs(o.out_dir, scene, o.target, "optimize");

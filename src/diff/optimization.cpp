@@ -7,11 +7,21 @@
 
 namespace pathlab {
 
+const SceneParameter* extinction_parameter(const ParameterSet& set) {
+    for (const SceneParameter& p : set.params)
+        if (p.field == ParamField::MediumSigmaT) return &p;
+    return nullptr;
+}
+
 OptimizationResult optimize(const SceneDescription& d, const ParameterSet& set, const Image& target, const OptimizationSettings& s,
                             const std::function<bool(const OptimizationStep&)>& each) {
     SceneDescription desc = d;
     Optimizer opt(s.optimizer, s.learning_rate, size_t(set.size));
     OptimizationResult r{set.values(desc), {}, std::numeric_limits<double>::infinity(), 0, false};
+    // A medium's extinction moves the free flights themselves: its gradient is heavy-tailed (a
+    // rare scattering event weighs 1 / sigma_t), and one fixed set of samples can be far off its
+    // mean and lead the optimiser away (docs/differentiable.md): new samples every iteration.
+    const bool seed_per_iteration = s.seed_per_iteration || extinction_parameter(set) != nullptr;
     r.best = r.theta;
     for (; r.iterations < s.iterations; ++r.iterations) {
         const int it = r.iterations;
@@ -20,7 +30,7 @@ OptimizationResult optimize(const SceneDescription& d, const ParameterSet& set, 
         DiffSettings primal = s.render;
         // The image of the loss and the gradient's replay use independent samples (seeds 2i and
         // 2i + 1 past the seed per iteration).
-        primal.seed = s.render.seed + (s.seed_per_iteration ? 2 * uint64_t(it) : 0);
+        primal.seed = s.render.seed + (seed_per_iteration ? 2 * uint64_t(it) : 0);
         const Image image = render_primal(*built, primal);
         const double L = loss_value(image, target, s.loss);
         if (L < r.best_loss) r.best_loss = L, r.best = r.theta;

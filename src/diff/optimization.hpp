@@ -19,8 +19,12 @@ struct OptimizationSettings {
     OptimizerKind optimizer = OptimizerKind::Adam;
     double learning_rate = 0.02;
     int iterations = 50;
-    bool seed_per_iteration = false;  // new random numbers every iteration (default: the same ones)
+    bool seed_per_iteration = false;  // new random numbers every iteration (default: the same ones; always with a medium's sigma_t)
 };
+
+// The chosen parameter that is a medium's extinction (whose optimisation always draws new random
+// numbers every iteration), or null.
+const SceneParameter* extinction_parameter(const ParameterSet& set);
 
 // One iteration, before its step: theta as rendered, the image, its loss and the gradient.
 struct OptimizationStep {

@@ -222,14 +222,16 @@ TEST(DiffParameters, MediaAreParameters) {
     fs::create_directories(dir);
     const std::string file = (dir / "milk.xml").string();
     std::ofstream(file) << R"(<scene version="3.0.0">
-<medium type="homogeneous" id="milk"><rgb name="sigma_a" value="0.1"/><rgb name="sigma_s" value="0.3, 0.2, 0.1"/><float name="scale" value="2"/></medium>
+<medium type="homogeneous" id="milk"><rgb name="sigma_a" value="0.1"/><rgb name="sigma_s" value="0.3, 0.2, 0.1"/><float name="scale" value="2"/>
+    <phase type="hg"><float name="g" value="0.5"/></phase></medium>
 <shape type="sphere"><bsdf type="null"/><ref name="interior" id="milk"/></shape>
 <shape type="sphere" id="lamp"><point name="center" value="0, 0, 4"/><emitter type="area"><rgb name="radiance" value="2"/></emitter></shape>
 </scene>)";
     SceneDescription milk = load_scene_file(file);
-    const ParameterSet both = ParameterSet::choose(milk, {"milk.albedo.value"});
+    const ParameterSet both = ParameterSet::choose(milk, {"milk.albedo.value", "milk.phase_function.g"});
     EXPECT_NEAR(both.values(milk)[0], 0.75f, 1e-6f);
-    const std::vector<float> albedo = {0.5f, 0.6f, 0.7f};
+    EXPECT_EQ(both.values(milk)[3], 0.5f);
+    const std::vector<float> albedo = {0.5f, 0.6f, 0.7f, -0.25f};
     both.set_values(milk, albedo);
     std::ofstream(dir / "written.xml") << scene_file_with_values(file, both, albedo, {}, &milk);
     const SceneDescription written = load_scene_file((dir / "written.xml").string());
@@ -239,6 +241,10 @@ TEST(DiffParameters, MediaAreParameters) {
         EXPECT_NEAR(a.sigma_t[k], b.sigma_t[k], 1e-6f) << k;
         EXPECT_NEAR(a.sigma_s[k], b.sigma_s[k], 1e-6f) << k;
     }
+    EXPECT_EQ(std::get<HgPhase>(b.phase).g, -0.25f);
+    std::vector<float> g = {0.0f, 0.0f, 0.0f, 1.5f};
+    both.clamp(g);
+    EXPECT_EQ(g[3], 0.99f);
     fs::remove_all(dir);
 }
 
@@ -558,7 +564,7 @@ TEST(DiffGradients, ForwardAgreesWithReverse) {
     for (const auto& [d, names] :
          {std::pair{metals(), std::vector<std::string>{"red.reflectance.value", "blue.alpha", "yellow.diffuse_reflectance.value",
                                                         "light.emitter.radiance.value"}},
-          std::pair{fog, std::vector<std::string>{"fog.sigma_t.value", "fog.albedo.value", "red.reflectance.value"}}}) {
+          std::pair{fog, std::vector<std::string>{"fog.sigma_t.value", "fog.albedo.value", "fog.phase_function.g", "red.reflectance.value"}}}) {
         const ParameterSet set = ParameterSet::choose(d, names);
         const auto scene = Scene::build(d);
         DiffSettings s;
@@ -583,6 +589,13 @@ TEST(DiffGradients, MediaAgreeWithFiniteDifferences) {
     const SceneDescription fog = load_scene_file(std::string(PATHLAB_SOURCE_DIR) + "/scenes/fog-box.xml");
     expect_agreement(check_against_fd(fog, "fog.sigma_t.value", tiny_settings(), 2048, 1e-2), "medium sigma_t");
     expect_agreement(check_against_fd(fog, "fog.albedo.value", tiny_settings(), 512, 1e-2), "medium albedo");
+    // g moves light between directions: weights that see where it goes; one scattering (depth 1),
+    // where the finite differences are least noisy (g moves the phase samples themselves). (Without
+    // the phase sample's d log p/d g z = -5.8; with the sign of mu wrong z = 62.)
+    DiffSettings single = tiny_settings();
+    single.max_depth = 1;
+    const Image gw = signed_weights(fog, "fog.phase_function.g", single);
+    expect_agreement(check_against_fd(fog, "fog.phase_function.g", single, 16384, 5e-2, {}, &gw), "medium phase g");
     expect_agreement(check_against_fd(fog, "red.reflectance.value", tiny_settings(), 128, 1e-2), "diffuse albedo in fog");
 }
 

@@ -106,6 +106,7 @@ std::string SceneParameter::range() const {
         case ParamField::PointIntensity:
         case ParamField::ConstantRadiance: return ">= 1e-6";
         case ParamField::MediumSigmaT: return ">= 1e-6";
+        case ParamField::MediumPhaseG: return "[-0.99, 0.99]";
         default: return "[0, 1]";
     }
 }
@@ -182,11 +183,14 @@ std::vector<SceneParameter> scene_parameters(const SceneDescription& d) {
         if (std::holds_alternative<EnvironmentLight>(d.lights[i]))
             out.push_back({id + ".radiance.value", ParamField::ConstantRadiance, uint32_t(i), 3});
     }
-    for (size_t i = 0; i < d.media.size(); ++i) {  // homogeneous media (a grid's voxels are not parameters)
+    for (size_t i = 0; i < d.media.size(); ++i) {  // (a grid's voxels are not parameters)
         const std::string& id = id_at(d.medium_ids, i);
-        if (id.empty() || !std::holds_alternative<HomogeneousMedium>(d.media[i])) continue;
-        out.push_back({id + ".sigma_t.value", ParamField::MediumSigmaT, uint32_t(i), 3});
-        out.push_back({id + ".albedo.value", ParamField::MediumAlbedo, uint32_t(i), 3});
+        if (id.empty()) continue;
+        if (std::holds_alternative<HomogeneousMedium>(d.media[i])) {
+            out.push_back({id + ".sigma_t.value", ParamField::MediumSigmaT, uint32_t(i), 3});
+            out.push_back({id + ".albedo.value", ParamField::MediumAlbedo, uint32_t(i), 3});
+        }
+        if (std::holds_alternative<HgPhase>(medium_phase(d.media[i]))) out.push_back({id + ".phase_function.g", ParamField::MediumPhaseG, uint32_t(i), 1});
     }
     return out;
 }
@@ -208,6 +212,7 @@ std::vector<float> parameter_value(const SceneDescription& d, const SceneParamet
             case ParamField::PointIntensity: return rgb(std::get<PointLight>(d.lights.at(p.index)).intensity);
             case ParamField::MediumSigmaT: return rgb(std::get<HomogeneousMedium>(d.media.at(p.index)).sigma_t);
             case ParamField::MediumAlbedo: return rgb(medium_albedo(std::get<HomogeneousMedium>(d.media.at(p.index))));
+            case ParamField::MediumPhaseG: return {std::get<HgPhase>(medium_phase(d.media.at(p.index))).g};
             default: return rgb(std::get<EnvironmentLight>(d.lights.at(p.index)).radiance);
         }
     }
@@ -299,6 +304,9 @@ void set_parameter_value(SceneDescription& d, const SceneParameter& p, const std
         case ParamField::PointIntensity: std::get<PointLight>(d.lights.at(p.index)).intensity = rgb(v); return;
         case ParamField::ConstantRadiance: std::get<EnvironmentLight>(d.lights.at(p.index)).radiance = rgb(v); return;
         case ParamField::Texels: set_texels(d, p, v); return;
+        case ParamField::MediumPhaseG:
+            std::visit([&](auto& m) { std::get<HgPhase>(m.phase).g = v[0]; }, d.media.at(p.index));
+            return;
         case ParamField::MediumSigmaT:
         case ParamField::MediumAlbedo: {
             HomogeneousMedium& m = std::get<HomogeneousMedium>(d.media.at(p.index));
@@ -376,6 +384,7 @@ void clamp_parameter_value(const SceneParameter& p, std::vector<float>& v) {
         case ParamField::PointIntensity:
         case ParamField::ConstantRadiance: lo = 1e-6f, hi = 1e30f; break;
         case ParamField::MediumSigmaT: lo = 1e-6f, hi = 1e30f; break;  // (> 0: a channel of sigma_t 0 would lose its albedo)
+        case ParamField::MediumPhaseG: lo = -0.99f, hi = 0.99f; break;
         default: break;
     }
     for (float& x : v) x = std::isnan(x) ? lo : std::clamp(x, lo, hi);
@@ -429,14 +438,15 @@ ParameterSet ParameterSet::choose(const SceneDescription& d, const std::vector<s
             case ParamField::MeshRadiance: mesh[p.index] = off; break;
             case ParamField::SphereRadiance: sphere[p.index] = off; break;
             case ParamField::MediumSigmaT:
-            case ParamField::MediumAlbedo: {
+            case ParamField::MediumAlbedo:
+            case ParamField::MediumPhaseG: {
                 MediumBinding& m = s.media[p.index];
                 if (m.slot < 0) {
                     if (s.media_slots == kMaxDiffMedia)
                         throw std::invalid_argument(fmt::format("parameters of at most {} media can be chosen at once", kMaxDiffMedia));
                     m.slot = s.media_slots++;
                 }
-                (p.field == ParamField::MediumSigmaT ? m.sigma_t : m.albedo) = off;
+                (p.field == ParamField::MediumSigmaT ? m.sigma_t : p.field == ParamField::MediumAlbedo ? m.albedo : m.g) = off;
                 break;
             }
             default: free_light[p.index] = off; break;

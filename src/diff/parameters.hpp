@@ -11,6 +11,7 @@
 //   <emitter id>.radiance.value             constant environment: radiance, rgb
 //   <medium id>.sigma_t.value               homogeneous medium: extinction per unit length, rgb
 //   <medium id>.albedo.value                homogeneous medium: sigma_s / sigma_t, rgb
+//   <medium id>.phase_function.g            a medium's Henyey-Greenstein phase function: g, float
 //   <bsdf id>.<reflectance>.data            a bitmap texture's texels in place of one of the rgb
 //                                           reflectances above (e.g. reflectance.data): width *
 //                                           height * 3 linear values, row-major, top row first
@@ -53,6 +54,7 @@ enum class ParamField {
     ConstantRadiance,
     MediumSigmaT,  // index: the medium
     MediumAlbedo,
+    MediumPhaseG,
 };
 
 struct SceneParameter {
@@ -68,7 +70,7 @@ struct SceneParameter {
 
     bool is_material() const { return field < ParamField::MeshRadiance; }
     bool is_texels() const { return field == ParamField::Texels; }
-    bool is_medium() const { return field == ParamField::MediumSigmaT || field == ParamField::MediumAlbedo; }
+    bool is_medium() const { return field >= ParamField::MediumSigmaT; }
     // "bsdf", "texture", "emitter" or "medium".
     std::string kind() const { return is_texels() ? "texture" : is_material() ? "bsdf" : is_medium() ? "medium" : "emitter"; }
     // The valid range, as the optimiser clamps to it ("[0, 1]", "> 0", ">= 0").
@@ -115,7 +117,7 @@ struct MaterialBinding {
 // A homogeneous medium's offsets (-1: not chosen), and its slot among the chosen media (the path
 // replay keeps d log(throughput) per slot).
 struct MediumBinding {
-    int sigma_t = -1, albedo = -1;
+    int sigma_t = -1, albedo = -1, g = -1;
     int slot = -1;
 };
 inline constexpr int kMaxDiffMedia = 8;  // media with chosen parameters, at most

@@ -273,11 +273,14 @@ private:
     // sigma_t and albedo enter a path only as factors of its throughput, channel by channel
     // (exp(-sigma_t l) along a piece of length l, sigma_s = albedo sigma_t where it scatters), and
     // sampling is detached (the free-flight densities, the hero channel's, stay as they were).
+    // (A medium's phase function enters as a factor p(wi, wo) where the path scatters in it:
+    // d log p/d g of Henyey-Greenstein's.)
     struct MediaLog {
         std::array<Rgb, kMaxDiffMedia> dt{}, da{};  // d log / d sigma_t, d log / d albedo
+        std::array<float, kMaxDiffMedia> dg{};      // d log / d g
         MediaLog operator+(const MediaLog& o) const {
             MediaLog r;
-            for (size_t i = 0; i < kMaxDiffMedia; ++i) r.dt[i] = dt[i] + o.dt[i], r.da[i] = da[i] + o.da[i];
+            for (size_t i = 0; i < kMaxDiffMedia; ++i) r.dt[i] = dt[i] + o.dt[i], r.da[i] = da[i] + o.da[i], r.dg[i] = dg[i] + o.dg[i];
             return r;
         }
     };
@@ -293,13 +296,23 @@ private:
     // (a channel of sigma_t or albedo 0 carries no throughput: nothing to add).
     void scatter(MediaLog& log, int32_t medium) const {
         const int slot = slot_of(medium);
-        if (slot < 0) return;
-        const auto& h = std::get<HomogeneousMedium>(scene_.medium(medium));
+        const auto* h = slot >= 0 ? std::get_if<HomogeneousMedium>(&scene_.medium(medium)) : nullptr;
+        if (!h) return;
         for (int k = 0; k < 3; ++k) {
-            if (!(h.sigma_t[k] > 0) || !(h.sigma_s[k] > 0)) continue;
-            log.dt[size_t(slot)][k] += 1 / h.sigma_t[k];
-            log.da[size_t(slot)][k] += h.sigma_t[k] / h.sigma_s[k];
+            if (!(h->sigma_t[k] > 0) || !(h->sigma_s[k] > 0)) continue;
+            log.dt[size_t(slot)][k] += 1 / h->sigma_t[k];
+            log.da[size_t(slot)][k] += h->sigma_t[k] / h->sigma_s[k];
         }
+    }
+    // The phase function's value p(wi, wo) where the path scatters in a medium (wi back along the
+    // path, wo onwards): Henyey-Greenstein's p = (1 - g^2) / (4 pi D^(3/2)), D = 1 + g^2 - 2 g mu,
+    // mu = -wi.wo, so d log p/d g = -2 g / (1 - g^2) - 3 (g - mu) / D.
+    void phase(MediaLog& log, int32_t medium, const Vec3f& wi, const Vec3f& wo) const {
+        const int slot = slot_of(medium);
+        if (slot < 0 || media_slots_[size_t(slot)].g < 0) return;
+        const float g = std::get<HgPhase>(medium_phase(scene_.medium(medium))).g, mu = -dot(wi, wo);
+        const float D = 1 + g * g - 2 * g * mu;
+        if (D > 0) log.dg[size_t(slot)] += -2 * g / (1 - g * g) - 3 * (g - mu) / D;
     }
     // A term C (radiance added to the sample) whose throughput has d log/d theta `log`.
     template <Mode M>
@@ -307,13 +320,16 @@ private:
         for (int slot = 0; slot < set_.media_slots; ++slot) {
             const MediumBinding& b = media_slots_[size_t(slot)];
             const Rgb gt = C * log.dt[size_t(slot)], ga = C * log.da[size_t(slot)];
+            const float dg = log.dg[size_t(slot)];
             for (int k = 0; k < 3; ++k) {
                 if constexpr (M == Mode::Reverse) {
                     if (b.sigma_t >= 0) c.grad[b.sigma_t + k] += double(c.delta[k] * gt[k]);
                     if (b.albedo >= 0) c.grad[b.albedo + k] += double(c.delta[k] * ga[k]);
+                    if (b.g >= 0) c.grad[b.g] += double(c.delta[k] * C[k] * dg);
                 } else if constexpr (M == Mode::Forward) {
                     if (b.sigma_t >= 0) c.dL[k] += gt[k] * c.tangent[b.sigma_t + k];
                     if (b.albedo >= 0) c.dL[k] += ga[k] * c.tangent[b.albedo + k];
+                    if (b.g >= 0) c.dL[k] += C[k] * dg * c.tangent[b.g];
                 }
             }
         }
@@ -397,6 +413,7 @@ private:
                 sample_scatter(scene_, v, sampler, st, true, wl, rules_.power_mis(), nullptr, NoGuide{}, bounces == 0, on_piece);
             if (!n.sampled) break;
             if (n.next.kind == MediumWalk::kMedium) scatter(walk, n.next.medium);
+            if (!v.sp) phase(walk, v.medium, v.wi, n.ray.d);  // the phase sample's p / pdf (the pdf detached)
             const float density = st.density();
             const Rgb found = beta * n.next_seg * n.found / density;
             L += found;
@@ -454,8 +471,10 @@ private:
             const Light& light = r.scene_.lights()[size_t(nee.choice.index)];
             const float scale = std::holds_alternative<PointLight>(light) ? 1 / (nee.ls.distance * nee.ls.distance) : 1.0f;
             const Vec3f wo = v.sp ? sp.frame.to_local(nee.ls.wi) : Vec3f(0.0f);
+            MediaLog l = log + shadow;
+            if (!v.sp) r.phase(l, v.medium, v.wi, nee.ls.wi);  // the phase function towards the light
             r.scatter_term<M>(vbsdf, v.sp ? sp.wi : Vec3f(0.0f), wo, false, f, Le, k, nee.choice.index, scale, beta * Tr / density,
-                              dbeta * Tr / density, log + shadow, c);
+                              dbeta * Tr / density, l, c);
         }
     };
 

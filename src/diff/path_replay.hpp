@@ -3,8 +3,8 @@
 // the estimator of pt-mis (next-event estimation and BSDF sampling combined by MIS at every
 // vertex, Russian roulette), with detached sampling as Mitsuba 3's `prb`; in a scene with
 // participating media, volpath's (its free flights, phase samples and shadow rays' transmittance;
-// a homogeneous medium's sigma_t and albedo are factors of the throughput, whose d log the replay
-// carries along the path).
+// a homogeneous medium's sigma_t and albedo, and a phase function's g, are factors of the
+// throughput, whose d log the replay carries along the path).
 //
 // Reverse mode, per pixel sample (Sampler(seed, pixel, sample) as pt-mis draws it):
 //  1. the primal pass traces the path and returns its radiance L (bit for bit pt-mis's sample);

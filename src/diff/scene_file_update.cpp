@@ -122,6 +122,14 @@ std::string scene_file_with_values(const std::string& scene_file, const Paramete
             set_filename(texture, file->second);
             continue;
         }
+        if (p.field == ParamField::MediumPhaseG) {
+            const pugi::xml_node phase = element.child("phase");
+            if (!phase)
+                throw std::runtime_error(fmt::format("{}: the <phase> of parameter {} is not in this file; its value is in the JSON output",
+                                                     scene_file, p.name));
+            set_value(phase, {"g"}, v);
+            continue;
+        }
         if (p.is_medium()) {  // sigma_t and albedo together, in place of sigma_a, sigma_s and scale
             if (!with_values) throw std::logic_error("scene_file_with_values: a medium's parameters need the description with their values");
             const auto& m = std::get<HomogeneousMedium>(with_values->media.at(p.index));

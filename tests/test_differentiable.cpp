@@ -435,39 +435,25 @@ TEST(DiffBsdf, RoughDielectricAlphaAndEtaMatchDifferencesOfEval) {
     }
 }
 
-// The primal pass is pt-mis's estimator: the same image as the renderer's pt-mis.
-// In a scene with media, the primal pass is volpath's estimator: the same image as volpath's.
-TEST(DiffGradients, PrimalIsVolpathInMedia) {
-    const auto scene = Scene::build(load_scene_file(std::string(PATHLAB_SOURCE_DIR) + "/scenes/fog-box.xml"));
-    DiffSettings s;
-    s.width = s.height = 16;
-    s.spp = 3;
-    const Image a = render_primal(*scene, s);
-    const PerspectiveCamera cam(scene->camera(), 16, 16);
-    const auto vol = find_integrator("volpath")->make(IntegratorOptions{});
-    Film film(16, 16);
-    RenderContext ctx{*scene, cam, 16, 16, s.seed};
-    vol->render_passes(ctx, film, 0, 3, {});
-    const Image m = film.mean();
-    for (size_t i = 0; i < a.pixel_count(); ++i)
-        for (int c = 0; c < 3; ++c) EXPECT_FLOAT_EQ(a[i][c], m[i][c]) << i;
-}
-
-TEST(DiffGradients, PrimalIsPtMis) {
-    const auto scene = Scene::build(course(3));
-    DiffSettings s;
-    s.width = s.height = 16;
-    s.spp = 3;
-    const Image a = render_primal(*scene, s);
-    const PerspectiveCamera cam(scene->camera(), 16, 16);
-    const IntegratorOptions o;
-    const auto pt = find_integrator("pt-mis")->make(o);
-    Film film(16, 16);
-    RenderContext ctx{*scene, cam, 16, 16, s.seed};
-    pt->render_passes(ctx, film, 0, 3, {});
-    const Image m = film.mean();
-    for (size_t i = 0; i < a.pixel_count(); ++i)
-        for (int c = 0; c < 3; ++c) EXPECT_FLOAT_EQ(a[i][c], m[i][c]) << i;
+// The primal pass is pt-mis's estimator: the same image as the renderer's pt-mis; in a scene with
+// media, volpath's.
+TEST(DiffGradients, PrimalIsPtMisOrVolpath) {
+    const SceneDescription fog = load_scene_file(std::string(PATHLAB_SOURCE_DIR) + "/scenes/fog-box.xml");
+    for (const auto& [d, integrator] : {std::pair{course(3), "pt-mis"}, std::pair{fog, "volpath"}}) {
+        const auto scene = Scene::build(d);
+        DiffSettings s;
+        s.width = s.height = 16;
+        s.spp = 3;
+        const Image a = render_primal(*scene, s);
+        const PerspectiveCamera cam(scene->camera(), 16, 16);
+        const auto renderer = find_integrator(integrator)->make(IntegratorOptions{});
+        Film film(16, 16);
+        RenderContext ctx{*scene, cam, 16, 16, s.seed};
+        renderer->render_passes(ctx, film, 0, 3, {});
+        const Image m = film.mean();
+        for (size_t i = 0; i < a.pixel_count(); ++i)
+            for (int c = 0; c < 3; ++c) EXPECT_FLOAT_EQ(a[i][c], m[i][c]) << integrator << " " << i;
+    }
 }
 
 TEST(DiffGradients, DiffuseAlbedoAgreesWithFiniteDifferences) {

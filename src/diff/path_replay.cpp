@@ -433,7 +433,7 @@ private:
             log = log + walk;
             // Russian roulette on beta / density, as volpath.
             const Rgb kept = beta;
-            if (!survive_roulette(bounces + 1, beta, st.density(), sampler)) break;
+            if (!rules_.survive_roulette(bounces + 1, beta, st.density(), sampler)) break;
             if constexpr (M == Mode::Forward)
                 for (int k = 0; k < 3; ++k) dbeta[k] = kept[k] != 0 ? dbeta[k] * (beta[k] / kept[k]) : 0.0f;
             // Reverse: the continuation's weight f scales everything still to come, Lr.
@@ -477,15 +477,6 @@ private:
                               dbeta * Tr / density, l, c);
         }
     };
-
-    // Russian roulette on beta / density, the path's actual weight (volpath's).
-    bool survive_roulette(int bounces, Rgb& beta, float density, Sampler& sampler) const {
-        if (density == 1) return rules_.survive_roulette(bounces, beta, sampler);
-        Rgb weight = beta / density;
-        if (!rules_.survive_roulette(bounces, weight, sampler)) return false;
-        beta = weight * density;
-        return true;
-    }
 
     const Scene& scene_;
     const ParameterSet& set_;

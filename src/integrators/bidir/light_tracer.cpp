@@ -113,7 +113,7 @@ void LightTracer<T>::trace(const RenderContext& ctx, Sampler& sampler, SplatList
                 const PhaseSample ps = phase_sample(phase, wi, sampler.next2d());
                 if (!(ps.pdfW > 0)) return;
                 beta *= Colour(ps.p / ps.pdfW);
-                if (!survive_roulette(bounces, beta, st.density(), sampler)) return;
+                if (!rules_.survive_roulette(bounces, beta, st.density(), sampler)) return;
                 ray = Ray{w.p, ps.wo, kInf};
                 continue;
             }
@@ -146,21 +146,10 @@ void LightTracer<T>::trace(const RenderContext& ctx, Sampler& sampler, SplatList
         if (!s) return;
         beta *= bsdf_sample_colour(sp, *s, wl) * (std::abs(s->wo.z) / s->pdfW);
         if (wl.secondary_terminated()) beta = hero_lane(beta);
-        if (!survive_roulette(bounces, beta, media ? st.density() : 1.0f, sampler)) return;
+        if (!rules_.survive_roulette(bounces, beta, media ? st.density() : 1.0f, sampler)) return;
         if (media) medium = medium_after(boundary, hit.ng, sp.frame.to_world(s->wo), medium);
         ray = sp.spawn(s->wo);
     }
-}
-
-// Russian roulette on beta / density, the path's actual weight (the path tracers' rule on beta
-// exactly when the density is 1).
-template <class T>
-bool LightTracer<T>::survive_roulette(int bounces, ColourOf<T>& beta, float density, Sampler& sampler) const {
-    if (density == 1) return rules_.survive_roulette(bounces, beta, sampler);
-    ColourOf<T> weight = beta / density;
-    if (!rules_.survive_roulette(bounces, weight, sampler)) return false;
-    beta = weight * density;
-    return true;
 }
 
 template <class T>

@@ -55,8 +55,6 @@ public:
     static size_t chunk_size(size_t paths) { return std::max<size_t>(16, paths / 64); }
 
 private:
-    bool survive_roulette(int bounces, ColourOf<T>& beta, float density, Sampler& sampler) const;
-
     PathRules rules_;
     LightTracerFaults faults_;
     bool hide_emitters_ = false;

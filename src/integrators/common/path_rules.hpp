@@ -77,6 +77,17 @@ public:
         return true;
     }
 
+    // The same on beta / density, the weight of a path whose density is not 1 (volpath's spectral
+    // MIS over the channels: media/medium.hpp); pt-mis's roulette exactly when the density is 1.
+    template <class Colour>
+    bool survive_roulette(int bounces, Colour& beta, float density, Sampler& sampler) const {
+        if (density == 1) return survive_roulette(bounces, beta, sampler);
+        Colour weight = beta / density;
+        if (!survive_roulette(bounces, weight, sampler)) return false;
+        beta = weight * density;
+        return true;
+    }
+
     // Whether survive_roulette(bounces, ...) plays roulette at all (and draws a random number),
     // for code that replays its decisions (diff/path_replay.cpp).
     bool roulette_applies(int bounces) const { return !(rr_depth_ < 0 || bounces < rr_depth_); }

@@ -101,7 +101,7 @@ public:
             if (!rules_.skips_null() && !rules_.may_bounce(bounces + 1)) break;
             if (next.kind == MediumWalk::kEscaped || next.kind == MediumWalk::kLost) break;
             beta = beta * next_seg * weight_next;
-            if (bounce && !survive_roulette(bounces + 1, beta, st.density(), sampler)) break;
+            if (bounce && !rules_.survive_roulette(bounces + 1, beta, st.density(), sampler)) break;
             bounces += bounce ? 1 : 0;
             w = next;
         }
@@ -109,15 +109,6 @@ public:
     }
 
 private:
-    // Russian roulette on beta / density, the path's actual weight (pt-mis's exactly when the density is 1).
-    bool survive_roulette(int bounces, Colour& beta, float density, Sampler& sampler) const {
-        if (density == 1) return rules_.survive_roulette(bounces, beta, sampler);
-        Colour weight = beta / density;
-        if (!rules_.survive_roulette(bounces, weight, sampler)) return false;
-        beta = weight * density;
-        return true;
-    }
-
     PathRules rules_;
     VolpathSettings settings_;
 };

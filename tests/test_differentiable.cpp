@@ -132,6 +132,9 @@ DiffSettings tiny_settings() {
 // The course's scene 2 (ceiling light, diffuse) or 3 (glossy).
 SceneDescription course(int index) { return make_builtin_scene(index); }
 
+// scenes/fog-box.xml: the course's scene 4 in a homogeneous fog (medium 'fog', HG g 0.3).
+SceneDescription fog_box() { return load_scene_file(std::string(PATHLAB_SOURCE_DIR) + "/scenes/fog-box.xml"); }
+
 // Scene 1 (point light, glossy) with a broad floor lobe (n = 8): a strong exponent derivative.
 SceneDescription broad_gloss() {
     SceneDescription d = make_builtin_scene(1);
@@ -202,7 +205,7 @@ TEST(DiffParameters, CourseScenesNameTheirMaterialsAndLights) {
 // scene file as sigma_t and albedo whatever form it gave (here sigma_a, sigma_s and a scale).
 TEST(DiffParameters, MediaAreParameters) {
     namespace fs = std::filesystem;
-    SceneDescription fog = load_scene_file(std::string(PATHLAB_SOURCE_DIR) + "/scenes/fog-box.xml");
+    SceneDescription fog = fog_box();
     const ParameterSet set = ParameterSet::choose(fog, {"fog.sigma_t.value", "fog.albedo.value"});
     EXPECT_EQ(set.params[0].kind(), "medium");
     const std::vector<float> v = set.values(fog);
@@ -438,7 +441,7 @@ TEST(DiffBsdf, RoughDielectricAlphaAndEtaMatchDifferencesOfEval) {
 // The primal pass is pt-mis's estimator: the same image as the renderer's pt-mis; in a scene with
 // media, volpath's.
 TEST(DiffGradients, PrimalIsPtMisOrVolpath) {
-    const SceneDescription fog = load_scene_file(std::string(PATHLAB_SOURCE_DIR) + "/scenes/fog-box.xml");
+    const SceneDescription fog = fog_box();
     for (const auto& [d, integrator] : {std::pair{course(3), "pt-mis"}, std::pair{fog, "volpath"}}) {
         const auto scene = Scene::build(d);
         DiffSettings s;
@@ -546,7 +549,7 @@ TEST(DiffGradients, FiniteDifferenceTestCatchesFaults) {
 // Forward mode (one image per parameter) and reverse mode compute the same derivative of the
 // same paths: sum_p w(p) . dI(p)/dtheta equals t . dLoss/dtheta up to float rounding.
 TEST(DiffGradients, ForwardAgreesWithReverse) {
-    const SceneDescription fog = load_scene_file(std::string(PATHLAB_SOURCE_DIR) + "/scenes/fog-box.xml");
+    const SceneDescription fog = fog_box();
     for (const auto& [d, names] :
          {std::pair{metals(), std::vector<std::string>{"red.reflectance.value", "blue.alpha", "yellow.diffuse_reflectance.value",
                                                         "light.emitter.radiance.value"}},
@@ -572,7 +575,7 @@ TEST(DiffGradients, ForwardAgreesWithReverse) {
 // In fog: the medium's extinction and albedo, and a wall seen through it and lit through it
 // (volpath's estimator: free flights, phase samples, shadow rays' transmittance).
 TEST(DiffGradients, MediaAgreeWithFiniteDifferences) {
-    const SceneDescription fog = load_scene_file(std::string(PATHLAB_SOURCE_DIR) + "/scenes/fog-box.xml");
+    const SceneDescription fog = fog_box();
     expect_agreement(check_against_fd(fog, "fog.sigma_t.value", tiny_settings(), 2048, 1e-2), "medium sigma_t");
     expect_agreement(check_against_fd(fog, "fog.albedo.value", tiny_settings(), 512, 1e-2), "medium albedo");
     // g moves light between directions: weights that see where it goes; one scattering (depth 1),
@@ -586,7 +589,7 @@ TEST(DiffGradients, MediaAgreeWithFiniteDifferences) {
 }
 
 TEST(DiffGradients, SameBytesWithAnyThreadCount) {
-    const SceneDescription fog = load_scene_file(std::string(PATHLAB_SOURCE_DIR) + "/scenes/fog-box.xml");
+    const SceneDescription fog = fog_box();
     for (const auto& [d, names] : {std::pair{course(3), std::vector<std::string>{"red.diffuse_reflectance.value", "blue.exponent"}},
                                    std::pair{fog, std::vector<std::string>{"fog.sigma_t.value", "red.reflectance.value"}}}) {
         const ParameterSet set = ParameterSet::choose(d, names);
@@ -686,7 +689,7 @@ TEST(DiffOptimize, RecoversAHiddenEta) {
 // (The albedo's gradient is right, its sign changing at the truth at 256 spp, but at 4 spp its
 // noise is 100x its mean here: Adam moves it from 0.5 to 0.55-0.7 in 500 steps.)
 TEST(DiffOptimize, RecoversAHiddenFog) {
-    const SceneDescription truth = load_scene_file(std::string(PATHLAB_SOURCE_DIR) + "/scenes/fog-box.xml");
+    const SceneDescription truth = fog_box();
     DiffSettings s;
     s.width = s.height = 16;
     s.spp = 4;

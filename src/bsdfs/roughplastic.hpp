@@ -70,11 +70,14 @@ struct RoughPlasticMaterial {
     }
 
     // T(mu), linearly interpolated.
-    float T(float mu) const {
+    float T(float mu) const { return lookup(transmittance, mu); }
+    // A table over mu = k / (kTableSize - 1) at mu, linearly interpolated (T's, and its derivative's:
+    // diff/bsdf_derivatives.hpp).
+    static float lookup(const std::array<float, kTableSize>& table, float mu) {
         const float x = std::clamp(mu, 0.0f, 1.0f) * (kTableSize - 1);
         const int k = std::min(int(x), kTableSize - 2);
         const float t = x - float(k);
-        return transmittance[size_t(k)] * (1 - t) + transmittance[size_t(k + 1)] * t;
+        return table[size_t(k)] * (1 - t) + table[size_t(k + 1)] * t;
     }
 
     Rgb eval(const Vec3f& wi, const Vec3f& wo) const {

@@ -220,12 +220,7 @@ struct RoughCoatingDerivative {
         dfdr = (up.coat.fdr - down.coat.fdr) / (2 * h);
     }
     // dT/dalpha at mu, interpolated as RoughPlasticMaterial::T interpolates T.
-    float dT_at(float mu) const {
-        const float x = std::clamp(mu, 0.0f, 1.0f) * (RoughPlasticMaterial::kTableSize - 1);
-        const int k = std::min(int(x), RoughPlasticMaterial::kTableSize - 2);
-        const float t = x - float(k);
-        return dT[size_t(k)] * (1 - t) + dT[size_t(k + 1)] * t;
-    }
+    float dT_at(float mu) const { return RoughPlasticMaterial::lookup(dT, mu); }
 };
 
 // Calls add(offset, df/dtheta) for every bound scalar parameter of `m` whose derivative at

@@ -95,10 +95,7 @@ public:
         for (int bounces = 0; rules_.may_bounce(bounces); ++bounces) {
             const ShadingPoint sp = make_shading_point(scene_, hit, dir);
             if (sp.material->is_black()) break;
-            const size_t mat_index = size_t(sp.material - &scene_.material(0));
-            const MaterialBinding& mb = mat_index < set_.materials.size() ? set_.materials[mat_index] : kNone;
-            std::optional<VertexBsdf> vb;  // the vertex's differentiable BSDF, if it has bound parameters
-            if (mb.any()) vb.emplace(vertex_bsdf(sp, mb));
+            const std::optional<VertexBsdf> vb = vertex_bsdf(sp);
             const VertexBsdf* v = vb ? &*vb : nullptr;
 
             // Next-event estimation, as estimate_light_sample(mis = true).
@@ -124,8 +121,7 @@ public:
                             const float k = std::abs(wo.z) * weight / pdf_light;
                             const Rgb direct = f * ls->Le * k;
                             L += beta * direct;
-                            const float scale = std::holds_alternative<PointLight>(light) ? 1 / (ls->distance * ls->distance) : 1.0f;
-                            vertex_term<M>(v, sp.wi, wo, false, f, ls->Le, k, choice.index, scale, beta, dbeta, c);
+                            vertex_term<M>(v, sp.wi, wo, false, f, ls->Le, k, choice.index, emission_scale(light, ls->distance), beta, dbeta, c);
                         }
                     }
                 }
@@ -171,8 +167,6 @@ public:
     }
 
 private:
-    static inline const MaterialBinding kNone{};
-
     // The differentiable side of a vertex's BSDF: the model at the hit (a textured material's
     // at its uv, so that a derivative that depends on another parameter sees its value there),
     // the binding, and for a reflectance given by texels the texels the lookup read with their
@@ -189,13 +183,16 @@ private:
         const Material& m() const { return at_uv ? *at_uv : *material; }
     };
 
-    VertexBsdf vertex_bsdf(const ShadingPoint& sp, const MaterialBinding& mb) const {
+    // (None where the material has no bound parameter.)
+    std::optional<VertexBsdf> vertex_bsdf(const ShadingPoint& sp) const {
+        const size_t index = size_t(sp.material - &scene_.material(0));
+        if (index >= set_.materials.size() || !set_.materials[index].any()) return std::nullopt;
+        const MaterialBinding& mb = set_.materials[index];
         VertexBsdf v;
         v.material = sp.material;
         if (sp.material->varies) v.at_uv.emplace(Material{sp.material->model_at(sp.uv)});
         v.binding = effective(*sp.material, mb);
-        const size_t index = size_t(sp.material - &scene_.material(0));
-        if (index < coatings_.size()) v.coating = coatings_[index];
+        v.coating = coatings_[index];
         for (int which = 0; which < 2; ++which) {
             const TexelBinding& tb = which == 0 ? mb.diffuse_texels : mb.specular_texels;
             if (!tb.bound()) continue;
@@ -217,6 +214,12 @@ private:
             const TexelFootprint& fp = v.footprint[size_t(which)];
             for (int j = 0; j < fp.count; ++j) add(v.texel_offset[size_t(which)] + 3 * int(fp.index[size_t(j)]) + ch, df * fp.weight[size_t(j)]);
         });
+    }
+
+    // dLe/dtheta per unit of a light's parameter, seen from `distance`: a point light's intensity
+    // reaches as intensity / d^2, the other emitters' radiance as itself.
+    static float emission_scale(const Light& light, float distance) {
+        return std::holds_alternative<PointLight>(light) ? 1 / (distance * distance) : 1.0f;
     }
 
     // A term beta f Le k added at a vertex (f the BSDF towards the emitter, Le its radiance,
@@ -388,9 +391,7 @@ private:
                 v.sp = &sp;
                 v.hit = &w;
                 v.p = sp.p;
-                const size_t mat_index = size_t(sp.material - &scene_.material(0));
-                const MaterialBinding& mb = mat_index < set_.materials.size() ? set_.materials[mat_index] : kNone;
-                if (mb.any()) vb.emplace(vertex_bsdf(sp, mb));
+                vb = vertex_bsdf(sp);
             } else {
                 v.p = w.p;
                 v.wi = -w.dir / length(w.dir);
@@ -468,8 +469,7 @@ private:
         void begin() { shadow = MediaLog{}; }
         void piece(int32_t medium, float length) { r.pass(shadow, medium, length); }
         void sample(const NeeSample& nee, const Rgb& f, const Rgb& Le, float k, const Rgb& Tr, const Rgb&) {
-            const Light& light = r.scene_.lights()[size_t(nee.choice.index)];
-            const float scale = std::holds_alternative<PointLight>(light) ? 1 / (nee.ls.distance * nee.ls.distance) : 1.0f;
+            const float scale = r.emission_scale(r.scene_.lights()[size_t(nee.choice.index)], nee.ls.distance);
             const Vec3f wo = v.sp ? sp.frame.to_local(nee.ls.wi) : Vec3f(0.0f);
             MediaLog l = log + shadow;
             if (!v.sp) r.phase(l, v.medium, v.wi, nee.ls.wi);  // the phase function towards the light
